@@ -1,0 +1,140 @@
+/*
+ * frusta: a real-time ray tracing library for CPUs.
+ *
+ * Public API. Every symbol is prefixed fr_. Handles are opaque. Functions that
+ * can fail return an fr_error; on failure fr_last_error() holds a one-line
+ * message (per thread) naming the problem.
+ *
+ *   fr_scene *s;
+ *   if (fr_scene_load("dragon.ply.zst", &s) != FR_OK) { puts(fr_last_error()); ... }
+ *   if (fr_scene_commit(s) != FR_OK) ...
+ *   fr_ray r = {{0,0,-1}, 0.0f, {0,0,1}, INFINITY};
+ *   fr_hit h;
+ *   fr_intersect1(s, &r, &h);   // h.prim == FR_INVALID_ID on a miss
+ *   fr_scene_release(s);
+ */
+#ifndef FRUSTA_H
+#define FRUSTA_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define FR_VERSION_MAJOR 0
+#define FR_VERSION_MINOR 1
+
+#define FR_INVALID_ID 0xFFFFFFFFu
+
+typedef enum fr_error {
+  FR_OK = 0,
+  FR_ERR_ARG,         /* an argument is invalid (NULL, zero size, unknown name) */
+  FR_ERR_IO,          /* a file could not be opened, read or written */
+  FR_ERR_FORMAT,      /* a file is malformed, truncated or lies about its counts */
+  FR_ERR_NOMEM,       /* an allocation failed or a size would overflow */
+  FR_ERR_UNSUPPORTED, /* the request is valid but not supported here */
+  FR_ERR_STATE        /* the object is not in the state the call needs */
+} fr_error;
+
+/* The message of the last failing call on this thread ("" if none). */
+const char *fr_last_error(void);
+const char *fr_error_name(fr_error e);
+
+/* ---- instruction set ------------------------------------------------------
+ * Kernels exist for AVX-512, AVX2 and plain C. At start-up the best one the CPU
+ * supports is chosen; the environment variable FRUSTA_ISA=avx512|avx2|scalar
+ * forces one. fr_set_isa changes it for the whole process. */
+typedef enum fr_isa { FR_ISA_SCALAR = 0, FR_ISA_AVX2 = 1, FR_ISA_AVX512 = 2 } fr_isa;
+fr_error fr_set_isa(fr_isa isa);   /* FR_ERR_UNSUPPORTED if the CPU lacks it */
+fr_isa fr_get_isa(void);
+const char *fr_isa_name(fr_isa isa);
+int fr_isa_supported(fr_isa isa);
+
+/* ---- scenes ---------------------------------------------------------------- */
+typedef struct fr_scene fr_scene;
+
+typedef struct fr_material {
+  char name[64];
+  float diffuse[3];      /* Kd */
+  float specular[3];     /* Ks */
+  float shininess;       /* Ns */
+  float transmission[3]; /* Tf, or 1-d */
+  float ior;             /* Ni */
+  float emission[3];     /* Ke */
+} fr_material;
+
+/* Loads a scene file: PLY and OBJ(+MTL) by frusta's own readers (triangle
+ * numbers follow the file's face order after fan triangulation), any other
+ * format Assimp reads through Assimp. A trailing .zst is decompressed
+ * transparently (also for the MTL an OBJ names). */
+fr_error fr_scene_load(const char *path, fr_scene **out);
+/* The procedural built-in scene (spheres and boxes on a floor, ~300K triangles). */
+fr_error fr_scene_builtin(fr_scene **out);
+/* A scene from arrays (copied). idx holds 3 indices per triangle. */
+fr_error fr_scene_from_arrays(const float *xyz, size_t nverts, const uint32_t *idx,
+                              size_t ntris, fr_scene **out);
+void fr_scene_release(fr_scene *s);
+
+/* Builds the acceleration structures; must be called before tracing. */
+fr_error fr_scene_commit(fr_scene *s);
+
+size_t fr_scene_triangle_count(const fr_scene *s);
+size_t fr_scene_vertex_count(const fr_scene *s);
+const float *fr_scene_vertices(const fr_scene *s);    /* xyz per vertex */
+const uint32_t *fr_scene_indices(const fr_scene *s);  /* 3 per triangle */
+void fr_scene_bounds(const fr_scene *s, float lower[3], float upper[3]);
+size_t fr_scene_material_count(const fr_scene *s);
+const fr_material *fr_scene_material(const fr_scene *s, size_t i);
+uint32_t fr_scene_triangle_material(const fr_scene *s, uint32_t prim); /* FR_INVALID_ID if none */
+/* Triangles dropped from the BVH because they are degenerate or not finite. */
+size_t fr_scene_skipped_triangles(const fr_scene *s);
+
+typedef struct fr_bvh_stats {
+  /* binary BVH */
+  size_t bvh2_inner, bvh2_leaves;
+  double bvh2_sah, bvh2_leaf_fill;   /* mean triangles per leaf */
+  /* 4-wide BVH */
+  size_t bvh4_inner, bvh4_leaves;
+  double bvh4_sah, bvh4_node_fill;   /* mean children per inner node (of 4) */
+  double bvh4_leaf_fill;             /* mean triangles per leaf (of 4) */
+  size_t bvh4_bytes, tri_bytes;      /* nodes, leaf triangle blocks */
+  double build_seconds;              /* BVH2 + BVH4 + triangle records */
+  int depth4;
+} fr_bvh_stats;
+fr_error fr_scene_stats(const fr_scene *s, fr_bvh_stats *out);
+
+/* ---- single rays ----------------------------------------------------------- */
+typedef struct fr_ray {
+  float org[3];
+  float tnear;
+  float dir[3];   /* need not be normalized; t is in units of dir */
+  float tfar;     /* may be +inf */
+} fr_ray;
+
+typedef struct fr_hit {
+  float t;        /* +inf on a miss */
+  float u, v;     /* barycentric weights of the triangle's 2nd and 3rd vertex */
+  uint32_t prim;  /* triangle number in file order, FR_INVALID_ID on a miss */
+  float ng[3];    /* unnormalized geometric normal (v1-v0) x (v2-v0) */
+} fr_hit;
+
+/* Closest hit with tnear < t < tfar. Rays with NaN fields or tnear > tfar miss. */
+void fr_intersect1(const fr_scene *s, const fr_ray *ray, fr_hit *hit);
+/* 1 if anything lies in (tnear, tfar), else 0. */
+int fr_occluded1(const fr_scene *s, const fr_ray *ray);
+
+/* Streams of n independent rays (no coherence assumed). */
+void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n);
+void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occluded, size_t n);
+
+/* ---- reference paths (for tests and measurement, not speed) ---------------- */
+/* Plain scalar traversal of the binary BVH with the scalar Plücker test. */
+void fr_intersect1_reference(const fr_scene *s, const fr_ray *ray, fr_hit *hit);
+int fr_occluded1_reference(const fr_scene *s, const fr_ray *ray);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,71 @@
+#include "bvh2.h"
+#include <string.h>
+#include "base/alloc.h"
+#include "base/error.h"
+
+typedef struct conv { const fr_build_tree *t; fr_bvh2 *b; } conv;
+
+static uint32_t convert(conv *c, int32_t bi) {
+  const fr_build_node *n = &c->t->nodes[bi];
+  if (n->left < 0) {
+    c->b->nleaves++;
+    return FR_BVH2_LEAF | (n->count << FR_BVH2_COUNT_SHIFT) | n->first;
+  }
+  uint32_t self = (uint32_t)c->b->nnodes++;
+  int32_t kids[2] = {n->left, n->right};
+  for (int k = 0; k < 2; k++) {
+    aabb bx = c->t->nodes[kids[k]].box;
+    fr_bvh2_node *d = &c->b->nodes[self];
+    d->lo_x[k] = bx.lo.x; d->hi_x[k] = bx.hi.x;
+    d->lo_y[k] = bx.lo.y; d->hi_y[k] = bx.hi.y;
+    d->lo_z[k] = bx.lo.z; d->hi_z[k] = bx.hi.z;
+    uint32_t r = convert(c, kids[k]);
+    c->b->nodes[self].child[k] = r;
+  }
+  return self;
+}
+
+fr_error fr_bvh2_from_build(const fr_build_tree *t, fr_bvh2 *out) {
+  memset(out, 0, sizeof *out);
+  size_t inner = t->nnodes / 2 + 1;
+  out->nodes = fr_alloc_aligned(fr_mul_size(inner, sizeof(fr_bvh2_node)), 64);
+  out->prims = fr_alloc_aligned(fr_mul_size(t->nprims, sizeof(uint32_t)), 64);
+  if (!out->nodes || !out->prims) {
+    fr_bvh2_free(out);
+    return fr_fail(FR_ERR_NOMEM, "BVH2: out of memory");
+  }
+  memset(out->nodes, 0, inner * sizeof(fr_bvh2_node));
+  memcpy(out->prims, t->prims, t->nprims * sizeof(uint32_t));
+  out->nprims = t->nprims;
+  out->bounds = t->nodes[0].box;
+  conv c = {t, out};
+  out->root = convert(&c, 0);
+  return FR_OK;
+}
+
+void fr_bvh2_free(fr_bvh2 *b) {
+  fr_free_aligned(b->nodes);
+  fr_free_aligned(b->prims);
+  memset(b, 0, sizeof *b);
+}
+
+static double child_area(const fr_bvh2_node *n, int k) {
+  double dx = n->hi_x[k] - n->lo_x[k], dy = n->hi_y[k] - n->lo_y[k], dz = n->hi_z[k] - n->lo_z[k];
+  return dx * dy + dy * dz + dz * dx;
+}
+
+/* SAH with a node visit and a triangle test both costing 1. */
+double fr_bvh2_sah(const fr_bvh2 *b) {
+  double root = aabb_half_area(b->bounds);
+  if (!(root > 0.0)) return 0.0;
+  double cost = (b->root & FR_BVH2_LEAF) ? (double)(b->root >> FR_BVH2_COUNT_SHIFT & 15) : 1.0;
+  for (size_t i = 0; i < b->nnodes; i++) {
+    const fr_bvh2_node *n = &b->nodes[i];
+    for (int k = 0; k < 2; k++) {
+      double w = child_area(n, k) / root;
+      uint32_t r = n->child[k];
+      cost += (r & FR_BVH2_LEAF) ? w * (double)(r >> FR_BVH2_COUNT_SHIFT & 15) : w;
+    }
+  }
+  return cost;
+}

@@ -1,0 +1,270 @@
+#include "bvh_build.h"
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include "base/alloc.h"
+#include "base/error.h"
+
+#define NBINS 32
+#define PAR_BIN 65536   /* nodes with more primitives bin in parallel */
+#define JOB_MIN 4096    /* below PAR_BIN, subtrees become jobs */
+
+typedef struct ref { aabb box; vec3 c2; uint32_t id; } ref; /* c2: twice the centroid */
+
+typedef struct builder {
+  ref *refs;
+  fr_build_node *nodes;
+  atomic_size_t nnodes;
+} builder;
+
+typedef struct bin { aabb box; uint32_t count; } bin;
+typedef struct bins { bin b[3][NBINS]; } bins;
+
+typedef struct split { int axis, pos; float cost; } split;
+
+static size_t alloc_nodes(builder *bd, size_t k) { return atomic_fetch_add(&bd->nnodes, k); }
+
+static inline int bin_of(float c, float lo, float scale) {
+  int i = (int)((c - lo) * scale);
+  return i < 0 ? 0 : i >= NBINS ? NBINS - 1 : i;
+}
+
+static void bins_clear(bins *b) {
+  for (int a = 0; a < 3; a++)
+    for (int i = 0; i < NBINS; i++) { b->b[a][i].box = aabb_empty(); b->b[a][i].count = 0; }
+}
+
+static void bins_add(bins *b, const ref *r, aabb cb, const float scale[3]) {
+  for (int a = 0; a < 3; a++) {
+    int i = bin_of(v3_get(r->c2, a), v3_get(cb.lo, a), scale[a]);
+    b->b[a][i].box = aabb_merge(b->b[a][i].box, r->box);
+    b->b[a][i].count++;
+  }
+}
+
+/* Cost in units of one 4-wide triangle test; a node visit costs 1. */
+static inline float blocks(uint32_t n) { return (float)((n + FR_BUILD_MAX_LEAF - 1) / FR_BUILD_MAX_LEAF); }
+
+static split best_split(const bins *b, const float scale[3]) {
+  split best = {-1, 0, INFINITY};
+  for (int a = 0; a < 3; a++) {
+    if (scale[a] <= 0.0f) continue;
+    float rarea[NBINS];
+    uint32_t rcount[NBINS];
+    aabb acc = aabb_empty();
+    uint32_t cnt = 0;
+    for (int i = NBINS - 1; i > 0; i--) {
+      acc = aabb_merge(acc, b->b[a][i].box);
+      cnt += b->b[a][i].count;
+      rarea[i] = aabb_half_area(acc);
+      rcount[i] = cnt;
+    }
+    acc = aabb_empty();
+    cnt = 0;
+    for (int i = 1; i < NBINS; i++) {
+      acc = aabb_merge(acc, b->b[a][i - 1].box);
+      cnt += b->b[a][i - 1].count;
+      if (cnt == 0 || rcount[i] == 0) continue;
+      float cost = aabb_half_area(acc) * blocks(cnt) + rarea[i] * blocks(rcount[i]);
+      if (cost < best.cost) { best.cost = cost; best.axis = a; best.pos = i; }
+    }
+  }
+  return best;
+}
+
+static aabb centroid_bounds(const ref *refs, size_t b, size_t e) {
+  aabb cb = aabb_empty();
+  for (size_t i = b; i < e; i++) cb = aabb_grow(cb, refs[i].c2);
+  return cb;
+}
+
+/* Partitions [b,e) by the split; returns the middle. Falls back to the index
+ * median when no useful split exists (all centroids equal, or too deep). */
+static size_t partition(ref *refs, size_t b, size_t e, split s, aabb cb, const float scale[3]) {
+  if (s.axis < 0) return b + (e - b) / 2;
+  size_t i = b, j = e;
+  float lo = v3_get(cb.lo, s.axis), sc = scale[s.axis];
+  while (i < j) {
+    if (bin_of(v3_get(refs[i].c2, s.axis), lo, sc) < s.pos) i++;
+    else { j--; ref t = refs[i]; refs[i] = refs[j]; refs[j] = t; }
+  }
+  if (i == b || i == e) return b + (e - b) / 2;
+  return i;
+}
+
+static void make_scale(aabb cb, float scale[3]) {
+  for (int a = 0; a < 3; a++) {
+    float ext = v3_get(cb.hi, a) - v3_get(cb.lo, a);
+    scale[a] = ext > 0.0f ? (float)NBINS * (1.0f - 1e-5f) / ext : 0.0f;
+  }
+}
+
+/* Decides how node [b,e) splits; returns 0 for a leaf, else the middle. */
+static size_t decide(builder *bd, size_t b, size_t e, aabb box, int depth, int parallel) {
+  size_t n = e - b;
+  if (n <= 1) return 0;
+  ref *refs = bd->refs;
+  aabb cb;
+  float scale[3];
+  bins bn;
+  split s = {-1, 0, INFINITY};
+  if (parallel) {
+    cb = aabb_empty();
+#pragma omp parallel
+    {
+      aabb local = aabb_empty();
+#pragma omp for nowait
+      for (size_t i = b; i < e; i++) local = aabb_grow(local, refs[i].c2);
+#pragma omp critical
+      cb = aabb_merge(cb, local);
+    }
+    make_scale(cb, scale);
+    bins_clear(&bn);
+#pragma omp parallel
+    {
+      bins *local = malloc(sizeof(bins));
+      if (local) {
+        bins_clear(local);
+#pragma omp for nowait
+        for (size_t i = b; i < e; i++) bins_add(local, &refs[i], cb, scale);
+#pragma omp critical
+        for (int a = 0; a < 3; a++)
+          for (int k = 0; k < NBINS; k++) {
+            bn.b[a][k].box = aabb_merge(bn.b[a][k].box, local->b[a][k].box);
+            bn.b[a][k].count += local->b[a][k].count;
+          }
+        free(local);
+      }
+    }
+    /* a failed scratch allocation would leave counts short: redo serially */
+    uint32_t total = 0;
+    for (int k = 0; k < NBINS; k++) total += bn.b[0][k].count;
+    if (total != n) {
+      bins_clear(&bn);
+      for (size_t i = b; i < e; i++) bins_add(&bn, &refs[i], cb, scale);
+    }
+  } else {
+    cb = centroid_bounds(refs, b, e);
+    make_scale(cb, scale);
+    bins_clear(&bn);
+    for (size_t i = b; i < e; i++) bins_add(&bn, &refs[i], cb, scale);
+  }
+  if (depth < FR_BUILD_MAX_DEPTH) s = best_split(&bn, scale);
+  if (n <= FR_BUILD_MAX_LEAF) {
+    float leaf = aabb_half_area(box) * blocks((uint32_t)n);
+    if (!(s.cost + aabb_half_area(box) < leaf)) return 0;
+  }
+  return partition(refs, b, e, s, cb, scale);
+}
+
+static aabb range_box(const ref *refs, size_t b, size_t e) {
+  aabb box = aabb_empty();
+  for (size_t i = b; i < e; i++) box = aabb_merge(box, refs[i].box);
+  return box;
+}
+
+static void make_leaf(builder *bd, size_t node, size_t b, size_t e) {
+  fr_build_node *nd = &bd->nodes[node];
+  nd->left = nd->right = -1;
+  nd->first = (uint32_t)b;
+  nd->count = (uint32_t)(e - b);
+}
+
+static void build_serial(builder *bd, size_t node, size_t b, size_t e, int depth) {
+  size_t mid = decide(bd, b, e, bd->nodes[node].box, depth, 0);
+  if (!mid) { make_leaf(bd, node, b, e); return; }
+  size_t c = alloc_nodes(bd, 2);
+  bd->nodes[node].left = (int32_t)c;
+  bd->nodes[node].right = (int32_t)(c + 1);
+  bd->nodes[node].count = 0;
+  bd->nodes[c].box = range_box(bd->refs, b, mid);
+  bd->nodes[c + 1].box = range_box(bd->refs, mid, e);
+  build_serial(bd, c, b, mid, depth + 1);
+  build_serial(bd, c + 1, mid, e, depth + 1);
+}
+
+typedef struct job { size_t node, b, e; int depth; } job;
+typedef struct jobs { job *v; size_t n, cap; } jobs;
+
+static int jobs_push(jobs *js, job j) {
+  if (js->n == js->cap) {
+    size_t nc = js->cap ? 2 * js->cap : 64;
+    job *q = realloc(js->v, nc * sizeof(job));
+    if (!q) return 0;
+    js->v = q;
+    js->cap = nc;
+  }
+  js->v[js->n++] = j;
+  return 1;
+}
+
+static int job_cmp(const void *x, const void *y) {
+  size_t a = ((const job *)x)->e - ((const job *)x)->b, b = ((const job *)y)->e - ((const job *)y)->b;
+  return a < b ? 1 : a > b ? -1 : 0;
+}
+
+fr_error fr_build_sah(const aabb *boxes, const uint32_t *ids, size_t n, fr_build_tree *out) {
+  memset(out, 0, sizeof *out);
+  if (n == 0) return fr_fail(FR_ERR_ARG, "BVH build: no primitives");
+  builder bd;
+  bd.refs = malloc(fr_mul_size(n, sizeof(ref)));
+  bd.nodes = malloc(fr_mul_size(2 * n, sizeof(fr_build_node)));
+  jobs todo = {0}, stack = {0};
+  if (!bd.refs || !bd.nodes) goto oom;
+  atomic_init(&bd.nnodes, 1);
+#pragma omp parallel for schedule(static)
+  for (size_t i = 0; i < n; i++) {
+    bd.refs[i].box = boxes[i];
+    bd.refs[i].c2 = aabb_center2(boxes[i]);
+    bd.refs[i].id = ids[i];
+  }
+  aabb root = aabb_empty();
+  for (size_t i = 0; i < n; i++) root = aabb_merge(root, boxes[i]);
+  bd.nodes[0].box = root;
+
+  /* Phase 1: split large nodes top-down (binning them with all threads) until
+   * the pieces are small enough to be jobs. */
+  if (!jobs_push(&stack, (job){0, 0, n, 0})) goto oom;
+  while (stack.n) {
+    job j = stack.v[--stack.n];
+    size_t cnt = j.e - j.b;
+    int par = cnt >= PAR_BIN;
+    if (!par && (n >= PAR_BIN || cnt < JOB_MIN)) {
+      if (!jobs_push(&todo, j)) goto oom;
+      continue;
+    }
+    size_t mid = decide(&bd, j.b, j.e, bd.nodes[j.node].box, j.depth, par);
+    if (!mid) { make_leaf(&bd, j.node, j.b, j.e); continue; }
+    size_t c = alloc_nodes(&bd, 2);
+    bd.nodes[j.node].left = (int32_t)c;
+    bd.nodes[j.node].right = (int32_t)(c + 1);
+    bd.nodes[j.node].count = 0;
+    bd.nodes[c].box = range_box(bd.refs, j.b, mid);
+    bd.nodes[c + 1].box = range_box(bd.refs, mid, j.e);
+    if (!jobs_push(&stack, (job){c + 1, mid, j.e, j.depth + 1})) goto oom;
+    if (!jobs_push(&stack, (job){c, j.b, mid, j.depth + 1})) goto oom;
+  }
+  /* Phase 2: independent subtrees, largest first. */
+  qsort(todo.v, todo.n, sizeof(job), job_cmp);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (size_t i = 0; i < todo.n; i++) build_serial(&bd, todo.v[i].node, todo.v[i].b, todo.v[i].e, todo.v[i].depth);
+
+  out->nnodes = atomic_load(&bd.nnodes);
+  out->nodes = bd.nodes;
+  out->nprims = n;
+  out->prims = malloc(fr_mul_size(n, sizeof(uint32_t)));
+  if (!out->prims) goto oom;
+  for (size_t i = 0; i < n; i++) out->prims[i] = bd.refs[i].id;
+  free(bd.refs); free(todo.v); free(stack.v);
+  return FR_OK;
+oom:
+  free(bd.refs); free(bd.nodes); free(todo.v); free(stack.v);
+  memset(out, 0, sizeof *out);
+  return fr_fail(FR_ERR_NOMEM, "BVH build: out of memory for %zu primitives", n);
+}
+
+void fr_build_tree_free(fr_build_tree *t) {
+  free(t->nodes);
+  free(t->prims);
+  memset(t, 0, sizeof *t);
+}

@@ -1,0 +1,33 @@
+/*
+ * Binned SAH builder (32 bins per axis, Wald 2007), parallel with OpenMP:
+ * nodes over FR_BUILD_PAR_BIN primitives are binned by all threads together,
+ * smaller subtrees are built as independent jobs. The result is a plain
+ * binary tree that bvh2.c and bvh4.c turn into their traversal layouts.
+ */
+#ifndef FR_ACCEL_BVH_BUILD_H
+#define FR_ACCEL_BVH_BUILD_H
+#include <stddef.h>
+#include <stdint.h>
+#include "base/vec3.h"
+#include "frusta.h"
+
+#define FR_BUILD_MAX_LEAF 4   /* triangles per leaf: one 4-wide test */
+#define FR_BUILD_MAX_DEPTH 64 /* deeper subtrees fall back to median splits */
+
+typedef struct fr_build_node {
+  aabb box;
+  int32_t left, right;     /* children, or -1 for a leaf */
+  uint32_t first, count;   /* leaf: range in fr_build_tree.prims */
+} fr_build_node;
+
+typedef struct fr_build_tree {
+  fr_build_node *nodes;    /* nodes[0] is the root */
+  size_t nnodes;
+  uint32_t *prims;         /* primitive ids in leaf order */
+  size_t nprims;
+} fr_build_tree;
+
+/* boxes: one per primitive; ids: the primitive id of each box. */
+fr_error fr_build_sah(const aabb *boxes, const uint32_t *ids, size_t n, fr_build_tree *out);
+void fr_build_tree_free(fr_build_tree *t);
+#endif

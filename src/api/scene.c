@@ -1,0 +1,189 @@
+/* The public scene API: creation, commit (BVH build), queries and tracing. */
+#include "scene.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "base/alloc.h"
+#include "base/error.h"
+#include "base/timer.h"
+#include "geom/builtin_scene.h"
+#include "io/import.h"
+#include "trace/bvh2_reference.h"
+#include "trace/kernels.h"
+
+static fr_scene *scene_new(void) {
+  fr_scene *s = calloc(1, sizeof *s);
+  if (s) fr_mesh_init(&s->mesh);
+  return s;
+}
+
+/* The scene's name: its folder for files in a folder named after it
+ * (../shared/scenes/spd_balls/balls.ply.zst -> spd_balls), else the file name
+ * without extensions. */
+static void scene_name(const char *path, char *out, size_t cap) {
+  char buf[4096];
+  snprintf(buf, sizeof buf, "%s", path);
+  char *slash = strrchr(buf, '/');
+  char *file = slash ? slash + 1 : buf;
+  char *dot = strchr(file, '.');
+  if (dot) *dot = 0;
+  if (slash) {
+    *slash = 0;
+    char *pslash = strrchr(buf, '/');
+    const char *dir = pslash ? pslash + 1 : buf;
+    size_t fl = strlen(file), dl = strlen(dir);
+    if (dl >= fl && strcmp(dir + dl - fl, file) == 0) { snprintf(out, cap, "%s", dir); return; }
+  }
+  snprintf(out, cap, "%s", file);
+}
+
+fr_error fr_scene_load(const char *path, fr_scene **out) {
+  if (!out) return fr_fail(FR_ERR_ARG, "fr_scene_load: out is NULL");
+  *out = NULL;
+  fr_scene *s = scene_new();
+  if (!s) return fr_fail(FR_ERR_NOMEM, "out of memory");
+  fr_error e = fr_import(path, &s->mesh);
+  if (e) { fr_scene_release(s); return e; }
+  scene_name(path, s->name, sizeof s->name);
+  *out = s;
+  return FR_OK;
+}
+
+fr_error fr_scene_builtin(fr_scene **out) {
+  if (!out) return fr_fail(FR_ERR_ARG, "fr_scene_builtin: out is NULL");
+  *out = NULL;
+  fr_scene *s = scene_new();
+  if (!s) return fr_fail(FR_ERR_NOMEM, "out of memory");
+  fr_error e = fr_builtin_scene(&s->mesh);
+  if (!e) e = fr_mesh_validate(&s->mesh, "builtin");
+  if (e) { fr_scene_release(s); return e; }
+  snprintf(s->name, sizeof s->name, "builtin");
+  *out = s;
+  return FR_OK;
+}
+
+fr_error fr_scene_from_arrays(const float *xyz, size_t nverts, const uint32_t *idx, size_t ntris, fr_scene **out) {
+  if (!out || (!xyz && nverts) || (!idx && ntris)) return fr_fail(FR_ERR_ARG, "fr_scene_from_arrays: NULL array");
+  *out = NULL;
+  fr_scene *s = scene_new();
+  if (!s) return fr_fail(FR_ERR_NOMEM, "out of memory");
+  fr_error e = FR_OK;
+  for (size_t i = 0; i < nverts && !e; i++) e = fr_mesh_add_vertex(&s->mesh, xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+  for (size_t i = 0; i < ntris && !e; i++) e = fr_mesh_add_triangle(&s->mesh, idx[3 * i], idx[3 * i + 1], idx[3 * i + 2], FR_INVALID_ID);
+  if (!e) e = fr_mesh_validate(&s->mesh, "arrays");
+  if (e) { fr_scene_release(s); return e; }
+  snprintf(s->name, sizeof s->name, "arrays");
+  *out = s;
+  return FR_OK;
+}
+
+void fr_scene_release(fr_scene *s) {
+  if (!s) return;
+  fr_mesh_free(&s->mesh);
+  fr_bvh2_free(&s->bvh2);
+  fr_bvh4_free(&s->bvh4);
+  free(s);
+}
+
+fr_error fr_scene_commit(fr_scene *s) {
+  if (!s) return fr_fail(FR_ERR_ARG, "fr_scene_commit: scene is NULL");
+  if (s->committed) return FR_OK;
+  double t0 = fr_seconds();
+  const fr_mesh *m = &s->mesh;
+  aabb *boxes = malloc(fr_mul_size(m->ntris, sizeof(aabb)));
+  uint32_t *ids = malloc(fr_mul_size(m->ntris, sizeof(uint32_t)));
+  if (!boxes || !ids) { free(boxes); free(ids); return fr_fail(FR_ERR_NOMEM, "out of memory for %zu triangles", m->ntris); }
+  size_t n = 0;
+  s->bounds = aabb_empty();
+  for (size_t t = 0; t < m->ntris; t++) {
+    if (fr_mesh_triangle_degenerate(m, t)) continue;
+    aabb b = aabb_empty();
+    for (int k = 0; k < 3; k++) b = aabb_grow(b, v3_load(m->pos + 3 * (size_t)m->idx[3 * t + k]));
+    boxes[n] = b;
+    ids[n++] = (uint32_t)t;
+    s->bounds = aabb_merge(s->bounds, b);
+  }
+  s->skipped = m->ntris - n;
+  if (n == 0) { free(boxes); free(ids); return fr_fail(FR_ERR_FORMAT, "%s: every triangle is degenerate", s->name); }
+  fr_build_tree tree;
+  fr_error e = fr_build_sah(boxes, ids, n, &tree);
+  free(boxes);
+  free(ids);
+  if (e) return e;
+  e = fr_bvh2_from_build(&tree, &s->bvh2);
+  if (!e) e = fr_bvh4_from_build(&tree, m, &s->bvh4);
+  fr_build_tree_free(&tree);
+  if (e) { fr_bvh2_free(&s->bvh2); fr_bvh4_free(&s->bvh4); return e; }
+  s->build_seconds = fr_seconds() - t0;
+  s->committed = 1;
+  return FR_OK;
+}
+
+size_t fr_scene_triangle_count(const fr_scene *s) { return s ? s->mesh.ntris : 0; }
+size_t fr_scene_vertex_count(const fr_scene *s) { return s ? s->mesh.nverts : 0; }
+const float *fr_scene_vertices(const fr_scene *s) { return s ? s->mesh.pos : NULL; }
+const uint32_t *fr_scene_indices(const fr_scene *s) { return s ? s->mesh.idx : NULL; }
+size_t fr_scene_skipped_triangles(const fr_scene *s) { return s ? s->skipped : 0; }
+size_t fr_scene_material_count(const fr_scene *s) { return s ? s->mesh.nmats : 0; }
+const fr_material *fr_scene_material(const fr_scene *s, size_t i) { return s && i < s->mesh.nmats ? &s->mesh.mats[i] : NULL; }
+
+uint32_t fr_scene_triangle_material(const fr_scene *s, uint32_t prim) {
+  if (!s || !s->mesh.mat || prim >= s->mesh.ntris) return FR_INVALID_ID;
+  return s->mesh.mat[prim];
+}
+
+void fr_scene_bounds(const fr_scene *s, float lower[3], float upper[3]) {
+  aabb b = aabb_empty();
+  if (s && s->committed) b = s->bounds;
+  else if (s)
+    for (size_t i = 0; i < s->mesh.nverts; i++) b = aabb_grow(b, v3_load(s->mesh.pos + 3 * i));
+  lower[0] = b.lo.x; lower[1] = b.lo.y; lower[2] = b.lo.z;
+  upper[0] = b.hi.x; upper[1] = b.hi.y; upper[2] = b.hi.z;
+}
+
+fr_error fr_scene_stats(const fr_scene *s, fr_bvh_stats *st) {
+  if (!s || !st) return fr_fail(FR_ERR_ARG, "fr_scene_stats: NULL argument");
+  if (!s->committed) return fr_fail(FR_ERR_STATE, "fr_scene_stats: scene not committed");
+  memset(st, 0, sizeof *st);
+  st->bvh2_inner = s->bvh2.nnodes;
+  st->bvh2_leaves = s->bvh2.nleaves;
+  st->bvh2_sah = fr_bvh2_sah(&s->bvh2);
+  st->bvh2_leaf_fill = s->bvh2.nleaves ? (double)s->bvh2.nprims / (double)s->bvh2.nleaves : 0.0;
+  st->bvh4_inner = s->bvh4.nnodes;
+  st->bvh4_leaves = s->bvh4.nleaves;
+  st->bvh4_sah = fr_bvh4_sah(&s->bvh4, &st->bvh4_node_fill, &st->bvh4_leaf_fill);
+  st->bvh4_bytes = s->bvh4.nnodes * sizeof(fr_bvh4_node);
+  st->tri_bytes = s->bvh4.nleaves * sizeof(fr_tri4);
+  st->build_seconds = s->build_seconds;
+  st->depth4 = s->bvh4.depth;
+  return FR_OK;
+}
+
+/* Tracing on an uncommitted scene finds nothing rather than crashing. */
+void fr_intersect1(const fr_scene *s, const fr_ray *ray, fr_hit *hit) {
+  if (!s->committed) { fr_hit_miss(hit); return; }
+  fr_kernels_active()->intersect1(&s->bvh4, ray, hit);
+}
+
+int fr_occluded1(const fr_scene *s, const fr_ray *ray) {
+  return s->committed ? fr_kernels_active()->occluded1(&s->bvh4, ray) : 0;
+}
+
+void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
+  if (!s->committed) { for (size_t i = 0; i < n; i++) fr_hit_miss(&hits[i]); return; }
+  fr_kernels_active()->intersect_stream(&s->bvh4, rays, hits, n);
+}
+
+void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
+  if (!s->committed) { memset(occ, 0, n); return; }
+  fr_kernels_active()->occluded_stream(&s->bvh4, rays, occ, n);
+}
+
+void fr_intersect1_reference(const fr_scene *s, const fr_ray *ray, fr_hit *hit) {
+  if (!s->committed) { fr_hit_miss(hit); return; }
+  fr_bvh2_intersect_reference(&s->bvh2, &s->mesh, ray, hit);
+}
+
+int fr_occluded1_reference(const fr_scene *s, const fr_ray *ray) {
+  return s->committed ? fr_bvh2_occluded_reference(&s->bvh2, &s->mesh, ray) : 0;
+}

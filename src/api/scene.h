@@ -1,0 +1,19 @@
+/* The scene behind the opaque fr_scene handle (internal: tools and tests of
+ * this repository may look inside, users of libfrusta cannot). */
+#ifndef FR_API_SCENE_H
+#define FR_API_SCENE_H
+#include "accel/bvh2.h"
+#include "accel/bvh4.h"
+#include "geom/mesh.h"
+
+struct fr_scene {
+  fr_mesh mesh;
+  fr_bvh2 bvh2;
+  fr_bvh4 bvh4;
+  int committed;
+  size_t skipped;       /* degenerate triangles left out of the BVH */
+  aabb bounds;
+  double build_seconds;
+  char name[64];        /* scene name for views and reports */
+};
+#endif

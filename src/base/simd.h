@@ -1,0 +1,115 @@
+/*
+ * The thin SIMD wrapper the kernels are written against.
+ *
+ * A kernel source includes this header and is compiled once per ISA with one
+ * of FR_BUILD_ISA_AVX512, FR_BUILD_ISA_AVX2 or FR_BUILD_ISA_SCALAR defined; FR_ISA_FN(name)
+ * gives each compilation its own symbol names. Semantics are identical on every
+ * level (min/max return the second operand when one is NaN, like minps), and no
+ * level contracts a*b+c into an FMA, so all three give bit-identical answers;
+ * the tests hold them to that.
+ *
+ *   vfloat4 / vmask4   four lanes: single-ray BVH4 traversal, 4-triangle leaves
+ */
+#ifndef FR_BASE_SIMD_H
+#define FR_BASE_SIMD_H
+
+#include <stdint.h>
+
+#if defined(FR_BUILD_ISA_AVX512)
+#define FR_ISA_SUFFIX avx512
+#elif defined(FR_BUILD_ISA_AVX2)
+#define FR_ISA_SUFFIX avx2
+#elif defined(FR_BUILD_ISA_SCALAR)
+#define FR_ISA_SUFFIX scalar
+#else
+#error "define one of FR_BUILD_ISA_AVX512, FR_BUILD_ISA_AVX2, FR_BUILD_ISA_SCALAR"
+#endif
+#define FR_CAT2(a, b) a##_##b
+#define FR_CAT(a, b) FR_CAT2(a, b)
+#define FR_ISA_FN(name) FR_CAT(name, FR_ISA_SUFFIX)
+
+#define FR_INLINE static inline __attribute__((always_inline))
+
+#if defined(FR_BUILD_ISA_AVX512) || defined(FR_BUILD_ISA_AVX2)
+#include <immintrin.h>
+
+typedef struct vfloat4 { __m128 v; } vfloat4;
+#if defined(FR_BUILD_ISA_AVX512)
+typedef struct vmask4 { __mmask8 m; } vmask4;
+#else
+typedef struct vmask4 { __m128 m; } vmask4;
+#endif
+
+FR_INLINE vfloat4 vf4(float a) { vfloat4 r = {_mm_set1_ps(a)}; return r; }
+FR_INLINE vfloat4 vf4_load(const float *p) { vfloat4 r = {_mm_load_ps(p)}; return r; }
+FR_INLINE void vf4_store(float *p, vfloat4 a) { _mm_store_ps(p, a.v); }
+FR_INLINE vfloat4 vf4_add(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_add_ps(a.v, b.v)}; return r; }
+FR_INLINE vfloat4 vf4_sub(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_sub_ps(a.v, b.v)}; return r; }
+FR_INLINE vfloat4 vf4_mul(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_mul_ps(a.v, b.v)}; return r; }
+FR_INLINE vfloat4 vf4_div(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_div_ps(a.v, b.v)}; return r; }
+FR_INLINE vfloat4 vf4_min(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_min_ps(a.v, b.v)}; return r; }
+FR_INLINE vfloat4 vf4_max(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_max_ps(a.v, b.v)}; return r; }
+FR_INLINE vfloat4 vf4_neg(vfloat4 a) { vfloat4 r = {_mm_xor_ps(a.v, _mm_set1_ps(-0.0f))}; return r; }
+
+#if defined(FR_BUILD_ISA_AVX512)
+#define FR_CMP4(a, b, op) { _mm_cmp_ps_mask((a).v, (b).v, op) }
+FR_INLINE vmask4 vm4_and(vmask4 a, vmask4 b) { vmask4 r = {(__mmask8)(a.m & b.m)}; return r; }
+FR_INLINE vmask4 vm4_or(vmask4 a, vmask4 b) { vmask4 r = {(__mmask8)(a.m | b.m)}; return r; }
+FR_INLINE int vm4_bits(vmask4 a) { return a.m & 0xF; }
+FR_INLINE vfloat4 vf4_select(vmask4 m, vfloat4 t, vfloat4 f) { vfloat4 r = {_mm_mask_blend_ps(m.m, f.v, t.v)}; return r; }
+#else
+#define FR_CMP4(a, b, op) { _mm_cmp_ps((a).v, (b).v, op) }
+FR_INLINE vmask4 vm4_and(vmask4 a, vmask4 b) { vmask4 r = {_mm_and_ps(a.m, b.m)}; return r; }
+FR_INLINE vmask4 vm4_or(vmask4 a, vmask4 b) { vmask4 r = {_mm_or_ps(a.m, b.m)}; return r; }
+FR_INLINE int vm4_bits(vmask4 a) { return _mm_movemask_ps(a.m); }
+FR_INLINE vfloat4 vf4_select(vmask4 m, vfloat4 t, vfloat4 f) { vfloat4 r = {_mm_blendv_ps(f.v, t.v, m.m)}; return r; }
+#endif
+FR_INLINE vmask4 vf4_lt(vfloat4 a, vfloat4 b) { vmask4 r = FR_CMP4(a, b, _CMP_LT_OQ); return r; }
+FR_INLINE vmask4 vf4_le(vfloat4 a, vfloat4 b) { vmask4 r = FR_CMP4(a, b, _CMP_LE_OQ); return r; }
+FR_INLINE vmask4 vf4_gt(vfloat4 a, vfloat4 b) { vmask4 r = FR_CMP4(a, b, _CMP_GT_OQ); return r; }
+FR_INLINE vmask4 vf4_ge(vfloat4 a, vfloat4 b) { vmask4 r = FR_CMP4(a, b, _CMP_GE_OQ); return r; }
+FR_INLINE vmask4 vf4_ne(vfloat4 a, vfloat4 b) { vmask4 r = FR_CMP4(a, b, _CMP_NEQ_UQ); return r; }
+
+#else /* FR_ISA_SCALAR: plain C, one lane at a time */
+
+typedef struct vfloat4 { float f[4]; } vfloat4;
+typedef struct vmask4 { unsigned m; } vmask4;
+
+#define FR_LANES4(expr) { vfloat4 r; for (int i = 0; i < 4; i++) r.f[i] = (expr); return r; }
+#define FR_MASK4(expr) { vmask4 r = {0}; for (int i = 0; i < 4; i++) r.m |= (unsigned)(expr) << i; return r; }
+FR_INLINE vfloat4 vf4(float a) FR_LANES4(a)
+FR_INLINE vfloat4 vf4_load(const float *p) FR_LANES4(p[i])
+FR_INLINE void vf4_store(float *p, vfloat4 a) { for (int i = 0; i < 4; i++) p[i] = a.f[i]; }
+FR_INLINE vfloat4 vf4_add(vfloat4 a, vfloat4 b) FR_LANES4(a.f[i] + b.f[i])
+FR_INLINE vfloat4 vf4_sub(vfloat4 a, vfloat4 b) FR_LANES4(a.f[i] - b.f[i])
+FR_INLINE vfloat4 vf4_mul(vfloat4 a, vfloat4 b) FR_LANES4(a.f[i] * b.f[i])
+FR_INLINE vfloat4 vf4_div(vfloat4 a, vfloat4 b) FR_LANES4(a.f[i] / b.f[i])
+FR_INLINE vfloat4 vf4_min(vfloat4 a, vfloat4 b) FR_LANES4(a.f[i] < b.f[i] ? a.f[i] : b.f[i])
+FR_INLINE vfloat4 vf4_max(vfloat4 a, vfloat4 b) FR_LANES4(a.f[i] > b.f[i] ? a.f[i] : b.f[i])
+FR_INLINE vfloat4 vf4_neg(vfloat4 a) FR_LANES4(-a.f[i])
+FR_INLINE vmask4 vf4_lt(vfloat4 a, vfloat4 b) FR_MASK4(a.f[i] < b.f[i])
+FR_INLINE vmask4 vf4_le(vfloat4 a, vfloat4 b) FR_MASK4(a.f[i] <= b.f[i])
+FR_INLINE vmask4 vf4_gt(vfloat4 a, vfloat4 b) FR_MASK4(a.f[i] > b.f[i])
+FR_INLINE vmask4 vf4_ge(vfloat4 a, vfloat4 b) FR_MASK4(a.f[i] >= b.f[i])
+FR_INLINE vmask4 vf4_ne(vfloat4 a, vfloat4 b) FR_MASK4(!(a.f[i] == b.f[i]))
+FR_INLINE vmask4 vm4_and(vmask4 a, vmask4 b) { vmask4 r = {a.m & b.m}; return r; }
+FR_INLINE vmask4 vm4_or(vmask4 a, vmask4 b) { vmask4 r = {a.m | b.m}; return r; }
+FR_INLINE int vm4_bits(vmask4 a) { return (int)a.m; }
+FR_INLINE vfloat4 vf4_select(vmask4 m, vfloat4 t, vfloat4 f) FR_LANES4(((m.m >> i) & 1) ? t.f[i] : f.f[i])
+#endif
+
+/* cross and dot of 3-vectors held as three vfloat4 (structure of arrays) */
+typedef struct vec3f4 { vfloat4 x, y, z; } vec3f4;
+FR_INLINE vec3f4 v3f4_sub(vec3f4 a, vec3f4 b) { vec3f4 r = {vf4_sub(a.x, b.x), vf4_sub(a.y, b.y), vf4_sub(a.z, b.z)}; return r; }
+FR_INLINE vec3f4 v3f4_add(vec3f4 a, vec3f4 b) { vec3f4 r = {vf4_add(a.x, b.x), vf4_add(a.y, b.y), vf4_add(a.z, b.z)}; return r; }
+FR_INLINE vec3f4 v3f4_cross(vec3f4 a, vec3f4 b) {
+  vec3f4 r = {vf4_sub(vf4_mul(a.y, b.z), vf4_mul(a.z, b.y)),
+              vf4_sub(vf4_mul(a.z, b.x), vf4_mul(a.x, b.z)),
+              vf4_sub(vf4_mul(a.x, b.y), vf4_mul(a.y, b.x))};
+  return r;
+}
+FR_INLINE vfloat4 v3f4_dot(vec3f4 a, vec3f4 b) {
+  return vf4_add(vf4_add(vf4_mul(a.x, b.x), vf4_mul(a.y, b.y)), vf4_mul(a.z, b.z));
+}
+#endif
+

@@ -1,0 +1,176 @@
+/*
+ * Wavefront OBJ + MTL reader. Faces are fan-triangulated in file order (so
+ * triangle numbers match the PLY of the same scene); `usemtl` sets each
+ * triangle's material, `mtllib` files are looked up beside the OBJ, also as
+ * NAME.zst. Normals, texture coordinates, groups and smoothing are ignored.
+ */
+#include <stdio.h>
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include "base/error.h"
+#include "io/file_read.h"
+#include "io/import.h"
+
+#define MAX_POLY 4096
+#define MAX_LINE 65536
+
+typedef struct lines { const char *p, *end; size_t lineno; } lines;
+
+/* Next line (without its newline) into buf; 0 at end of data. */
+static int next_line(lines *l, const char **s, size_t *len) {
+  if (l->p >= l->end) return 0;
+  const char *nl = memchr(l->p, '\n', (size_t)(l->end - l->p));
+  const char *e = nl ? nl : l->end;
+  *s = l->p;
+  *len = (size_t)(e - l->p);
+  l->p = nl ? nl + 1 : l->end;
+  l->lineno++;
+  return 1;
+}
+
+static const char *skip_ws(const char *p, const char *e) {
+  while (p < e && (*p == ' ' || *p == '\t' || *p == '\r')) p++;
+  return p;
+}
+
+static int parse_floats(const char *p, const char *e, float *out, int n) {
+  for (int i = 0; i < n; i++) {
+    p = skip_ws(p, e);
+    if (p >= e) return i;
+    char *q;
+    out[i] = strtof(p, &q);
+    if (q == p || q > e) return i;
+    p = q;
+  }
+  return n;
+}
+
+/* Copies the first word after the keyword into name (NUL-terminated). */
+static void parse_name(const char *p, const char *e, char *name, size_t cap) {
+  p = skip_ws(p, e);
+  const char *q = e;
+  while (q > p && (q[-1] == ' ' || q[-1] == '\t' || q[-1] == '\r')) q--;
+  size_t n = (size_t)(q - p);
+  if (n >= cap) n = cap - 1;
+  memcpy(name, p, n);
+  name[n] = 0;
+}
+
+static int keyword(const char *s, size_t len, const char *kw) {
+  size_t k = strlen(kw);
+  return len > k && memcmp(s, kw, k) == 0 && (s[k] == ' ' || s[k] == '\t');
+}
+
+static void load_mtllib(const char *objpath, const char *name, fr_mesh *m) {
+  char dir[4096], path[8192];
+  snprintf(dir, sizeof dir, "%s", objpath);
+  char *slash = strrchr(dir, '/');
+  if (slash) slash[1] = 0; else dir[0] = 0;
+  const char *cands[2] = {"", ".zst"};
+  for (int i = 0; i < 2; i++) {
+    snprintf(path, sizeof path, "%s%s%s", dir, name, cands[i]);
+    if (!fr_file_exists(path)) continue;
+    char *data;
+    size_t size;
+    if (fr_read_file(path, &data, &size) == FR_OK) {
+      fr_import_mtl(path, data, size, m); /* a broken MTL leaves default materials */
+      free(data);
+    }
+    return;
+  }
+  /* a missing MTL is not fatal: triangles keep their (default) named materials */
+}
+
+fr_error fr_import_obj(const char *path, const char *data, size_t size, fr_mesh *m) {
+  lines l = {data, data + size, 0};
+  const char *s;
+  size_t len;
+  uint32_t mat = FR_INVALID_ID;
+  long long poly[MAX_POLY];
+  while (next_line(&l, &s, &len)) {
+    if (len > MAX_LINE) return fr_fail(FR_ERR_FORMAT, "%s:%zu: line too long", path, l.lineno);
+    const char *e = s + len;
+    s = skip_ws(s, e);
+    len = (size_t)(e - s);
+    if (keyword(s, len, "v")) {
+      float xyz[3];
+      if (parse_floats(s + 1, e, xyz, 3) != 3) return fr_fail(FR_ERR_FORMAT, "%s:%zu: vertex needs three numbers", path, l.lineno);
+      fr_error err = fr_mesh_add_vertex(m, xyz[0], xyz[1], xyz[2]);
+      if (err) return err;
+    } else if (keyword(s, len, "f")) {
+      int n = 0;
+      const char *p = s + 1;
+      for (;;) {
+        p = skip_ws(p, e);
+        if (p >= e) break;
+        if (n == MAX_POLY) return fr_fail(FR_ERR_FORMAT, "%s:%zu: face has more than %d vertices", path, l.lineno, MAX_POLY);
+        char *q;
+        errno = 0;
+        long long v = strtoll(p, &q, 10);
+        if (q == p || q > e || errno) return fr_fail(FR_ERR_FORMAT, "%s:%zu: bad face index", path, l.lineno);
+        /* OBJ indices are 1-based; negative ones count back from the last vertex */
+        if (v < 0) v = (long long)m->nverts + v;
+        else if (v > 0) v -= 1;
+        else return fr_fail(FR_ERR_FORMAT, "%s:%zu: face index 0", path, l.lineno);
+        if (v < 0 || v >= (long long)m->nverts)
+          return fr_fail(FR_ERR_FORMAT, "%s:%zu: face index out of range (%zu vertices so far)", path, l.lineno, m->nverts);
+        poly[n++] = v;
+        p = q;
+        while (p < e && *p != ' ' && *p != '\t' && *p != '\r') p++; /* skip /vt/vn */
+      }
+      for (int j = 2; j < n; j++) {
+        fr_error err = fr_mesh_add_triangle(m, (uint32_t)poly[0], (uint32_t)poly[j - 1], (uint32_t)poly[j], mat);
+        if (err) return err;
+      }
+    } else if (keyword(s, len, "usemtl")) {
+      char name[64];
+      parse_name(s + 6, e, name, sizeof name);
+      fr_error err = fr_mesh_material(m, name, &mat);
+      if (err) return err;
+    } else if (keyword(s, len, "mtllib")) {
+      char name[1024];
+      parse_name(s + 6, e, name, sizeof name);
+      if (name[0] && !strstr(name, "..")) load_mtllib(path, name, m);
+    }
+    /* vt, vn, g, o, s, l and comments: not needed */
+  }
+  return FR_OK;
+}
+
+fr_error fr_import_mtl(const char *path, const char *data, size_t size, fr_mesh *m) {
+  lines l = {data, data + size, 0};
+  const char *s;
+  size_t len;
+  fr_material *cur = NULL;
+  (void)path;
+  while (next_line(&l, &s, &len)) {
+    const char *e = s + len;
+    s = skip_ws(s, e);
+    len = (size_t)(e - s);
+    if (keyword(s, len, "newmtl")) {
+      char name[64];
+      uint32_t id;
+      parse_name(s + 6, e, name, sizeof name);
+      fr_error err = fr_mesh_material(m, name, &id);
+      if (err) return err;
+      cur = &m->mats[id];
+      continue;
+    }
+    if (!cur) continue;
+    float f[3];
+    int n;
+    if (keyword(s, len, "Kd") && parse_floats(s + 2, e, f, 3) == 3) memcpy(cur->diffuse, f, sizeof f);
+    else if (keyword(s, len, "Ks") && parse_floats(s + 2, e, f, 3) == 3) memcpy(cur->specular, f, sizeof f);
+    else if (keyword(s, len, "Ke") && parse_floats(s + 2, e, f, 3) == 3) memcpy(cur->emission, f, sizeof f);
+    else if (keyword(s, len, "Tf") && (n = parse_floats(s + 2, e, f, 3)) >= 1) {
+      for (int i = 0; i < 3; i++) cur->transmission[i] = f[n == 3 ? i : 0];
+    } else if (keyword(s, len, "Ns") && parse_floats(s + 2, e, f, 1) == 1) cur->shininess = f[0];
+    else if (keyword(s, len, "Ni") && parse_floats(s + 2, e, f, 1) == 1) cur->ior = f[0];
+    else if (keyword(s, len, "d") && parse_floats(s + 1, e, f, 1) == 1) {
+      if (cur->transmission[0] == 0 && cur->transmission[1] == 0 && cur->transmission[2] == 0)
+        cur->transmission[0] = cur->transmission[1] = cur->transmission[2] = 1.0f - f[0];
+    }
+  }
+  return FR_OK;
+}

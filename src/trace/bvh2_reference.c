@@ -1,0 +1,72 @@
+#include "bvh2_reference.h"
+#include <math.h>
+#include "geom/tri_pluecker.h"
+#include "trace/kernels.h"
+
+/* same widening as the SIMD kernels (see bvh4_single.c) */
+#define ROUND_DOWN (1.0f - 0x1p-21f)
+#define ROUND_UP (1.0f + 0x1p-21f)
+
+static int box_hit(const fr_bvh2_node *n, int k, vec3 o, vec3 rd, float tnear, float tfar) {
+  float lo[3] = {n->lo_x[k], n->lo_y[k], n->lo_z[k]}, hi[3] = {n->hi_x[k], n->hi_y[k], n->hi_z[k]};
+  float oo[3] = {o.x, o.y, o.z}, r[3] = {rd.x, rd.y, rd.z};
+  float tn = tnear, tf = tfar;
+  for (int a = 0; a < 3; a++) {
+    float t0 = (lo[a] - oo[a]) * r[a], t1 = (hi[a] - oo[a]) * r[a];
+    if (r[a] < 0.0f) { float t = t0; t0 = t1; t1 = t; }
+    tn = t0 > tn ? t0 : tn;
+    tf = t1 < tf ? t1 : tf;
+  }
+  return tn * ROUND_DOWN <= tf * ROUND_UP;
+}
+
+static vec3 vertex(const fr_mesh *m, uint32_t prim, int k) { return v3_load(m->pos + 3 * (size_t)m->idx[3 * (size_t)prim + k]); }
+
+static float rcp(float d) {
+  if (fabsf(d) < 1e-18f) d = copysignf(1e-18f, d);
+  return 1.0f / d;
+}
+
+/* Visits every leaf whose box the ray reaches; stops early when any_hit finds one. */
+static int traverse(const fr_bvh2 *b, const fr_mesh *m, const fr_ray *ray, fr_hit *hit, int any_hit) {
+  if (fr_ray_invalid(ray)) return 0;
+  vec3 o = v3_load(ray->org), d = v3_load(ray->dir);
+  vec3 rd = v3(rcp(d.x), rcp(d.y), rcp(d.z));
+  float tfar = ray->tfar;
+  uint32_t stack[256];
+  int sp = 0, found = 0;
+  stack[sp++] = b->root;
+  while (sp) {
+    uint32_t ref = stack[--sp];
+    if (ref & FR_BVH2_LEAF) {
+      uint32_t first = ref & FR_BVH2_FIRST_MASK, count = (ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
+      for (uint32_t i = first; i < first + count; i++) {
+        uint32_t prim = b->prims[i];
+        vec3 p0 = vertex(m, prim, 0), p1 = vertex(m, prim, 1), p2 = vertex(m, prim, 2);
+        float t, u, v;
+        if (!fr_tri_pluecker(o, d, ray->tnear, tfar, p0, p1, p2, &t, &u, &v)) continue;
+        if (any_hit) return 1;
+        found = 1;
+        tfar = t;
+        hit->t = t; hit->u = u; hit->v = v; hit->prim = prim;
+        vec3 ng = v3_cross(v3_sub(p1, p0), v3_sub(p2, p0));
+        hit->ng[0] = ng.x; hit->ng[1] = ng.y; hit->ng[2] = ng.z;
+      }
+      continue;
+    }
+    const fr_bvh2_node *n = &b->nodes[ref];
+    for (int k = 0; k < 2; k++)
+      if (box_hit(n, k, o, rd, ray->tnear, tfar) && sp < 256) stack[sp++] = n->child[k];
+  }
+  return found;
+}
+
+void fr_bvh2_intersect_reference(const fr_bvh2 *b, const fr_mesh *m, const fr_ray *ray, fr_hit *hit) {
+  fr_hit_miss(hit);
+  traverse(b, m, ray, hit, 0);
+}
+
+int fr_bvh2_occluded_reference(const fr_bvh2 *b, const fr_mesh *m, const fr_ray *ray) {
+  fr_hit h;
+  return traverse(b, m, ray, &h, 1);
+}

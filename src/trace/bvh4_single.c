@@ -1,0 +1,230 @@
+/*
+ * Single-ray traversal of the 4-wide BVH (Benthin et al., MIC paper §IV):
+ * one ray, four child boxes per SIMD test, nearest child first, and four
+ * triangles per SIMD test in the leaves (watertight Plücker, see
+ * geom/tri_pluecker.h). Compiled once per ISA through base/simd.h.
+ */
+#include <math.h>
+#include <string.h>
+#include "base/simd.h"
+#include "trace/kernels.h"
+
+/* Conservative slab test (Ize, "Robust BVH Ray Traversal"): widen each box
+ * interval by a few ulps so that rounding in (plane - org) * rdir never culls a
+ * box a triangle hit lies in; this keeps the traversal as watertight as the
+ * triangle test. */
+#define ROUND_DOWN (1.0f - 0x1p-21f)
+#define ROUND_UP (1.0f + 0x1p-21f)
+
+/* Entries a traversal can have pending: three per level, and the builder caps
+ * the depth (FR_BUILD_MAX_DEPTH plus median splits of at most 2^27 triangles). */
+#define STACK_SIZE (3 * (FR_BUILD_MAX_DEPTH + 32) + 4)
+
+typedef struct ray4 {
+  vfloat4 ox, oy, oz, dx, dy, dz, rx, ry, rz;
+  int near_x, near_y, near_z; /* float offsets of the near planes in a node */
+  float tnear;
+} ray4;
+
+static inline float safe_rcp(float d) {
+  /* a zero direction component would give inf * 0 = NaN at a box plane */
+  if (fabsf(d) < 1e-18f) d = copysignf(1e-18f, d);
+  return 1.0f / d;
+}
+
+static inline void ray4_setup(ray4 *r, const fr_ray *ray) {
+  float rx = safe_rcp(ray->dir[0]), ry = safe_rcp(ray->dir[1]), rz = safe_rcp(ray->dir[2]);
+  r->ox = vf4(ray->org[0]); r->oy = vf4(ray->org[1]); r->oz = vf4(ray->org[2]);
+  r->dx = vf4(ray->dir[0]); r->dy = vf4(ray->dir[1]); r->dz = vf4(ray->dir[2]);
+  r->rx = vf4(rx); r->ry = vf4(ry); r->rz = vf4(rz);
+  /* node layout: lo_x 0, hi_x 4, lo_y 8, hi_y 12, lo_z 16, hi_z 20 */
+  r->near_x = rx >= 0.0f ? 0 : 4;
+  r->near_y = ry >= 0.0f ? 8 : 12;
+  r->near_z = rz >= 0.0f ? 16 : 20;
+  r->tnear = ray->tnear;
+}
+
+/* Returns the mask of children hit within [tnear, tfar]; dist gets their entry distances. */
+FR_INLINE int box4(const fr_bvh4_node *n, const ray4 *r, float tfar, vfloat4 *dist) {
+  const float *f = (const float *)n;
+  vfloat4 tnx = vf4_mul(vf4_sub(vf4_load(f + r->near_x), r->ox), r->rx);
+  vfloat4 tny = vf4_mul(vf4_sub(vf4_load(f + r->near_y), r->oy), r->ry);
+  vfloat4 tnz = vf4_mul(vf4_sub(vf4_load(f + r->near_z), r->oz), r->rz);
+  vfloat4 tfx = vf4_mul(vf4_sub(vf4_load(f + (r->near_x ^ 4)), r->ox), r->rx);
+  vfloat4 tfy = vf4_mul(vf4_sub(vf4_load(f + (r->near_y ^ 4)), r->oy), r->ry);
+  vfloat4 tfz = vf4_mul(vf4_sub(vf4_load(f + (r->near_z ^ 4)), r->oz), r->rz);
+  vfloat4 tn = vf4_max(vf4_max(tnx, tny), vf4_max(tnz, vf4(r->tnear)));
+  vfloat4 tf = vf4_min(vf4_min(tfx, tfy), vf4_min(tfz, vf4(tfar)));
+  tn = vf4_mul(tn, vf4(ROUND_DOWN));
+  *dist = tn;
+  return vm4_bits(vf4_le(tn, vf4_mul(tf, vf4(ROUND_UP))));
+}
+
+typedef struct tri4_result { vfloat4 t, w1, w2, inv; vec3f4 ng; int mask; } tri4_result;
+
+/* Four triangles against one ray; mask of lanes hit in (tnear, tfar). */
+FR_INLINE void tri4_test(const fr_tri4 *tr, const ray4 *r, float tfar, tri4_result *res) {
+  vec3f4 o = {r->ox, r->oy, r->oz}, d = {r->dx, r->dy, r->dz};
+  vec3f4 p0 = {vf4_load(tr->v0[0]), vf4_load(tr->v0[1]), vf4_load(tr->v0[2])};
+  vec3f4 p1 = {vf4_load(tr->v1[0]), vf4_load(tr->v1[1]), vf4_load(tr->v1[2])};
+  vec3f4 p2 = {vf4_load(tr->v2[0]), vf4_load(tr->v2[1]), vf4_load(tr->v2[2])};
+  vec3f4 v0 = v3f4_sub(p0, o), v1 = v3f4_sub(p1, o), v2 = v3f4_sub(p2, o);
+  vfloat4 w0 = v3f4_dot(d, v3f4_cross(v3f4_sub(v1, v2), v3f4_add(v1, v2)));
+  vfloat4 w1 = v3f4_dot(d, v3f4_cross(v3f4_sub(v2, v0), v3f4_add(v2, v0)));
+  vfloat4 w2 = v3f4_dot(d, v3f4_cross(v3f4_sub(v0, v1), v3f4_add(v0, v1)));
+  vfloat4 zero = vf4(0.0f);
+  vfloat4 lo = vf4_min(w0, vf4_min(w1, w2)), hi = vf4_max(w0, vf4_max(w1, w2));
+  vmask4 inside = vm4_or(vf4_ge(lo, zero), vf4_le(hi, zero));
+  vfloat4 den = vf4_add(vf4_add(w0, w1), w2);
+  vec3f4 ng = v3f4_cross(v3f4_sub(v1, v0), v3f4_sub(v2, v0));
+  vfloat4 tpl = v3f4_dot(v0, ng);
+  vfloat4 inv = vf4_div(vf4(1.0f), den);
+  vfloat4 t = vf4_mul(vf4_add(tpl, tpl), inv);
+  /* NaN (unused lanes, den == 0) fails the ordered compares on t */
+  vmask4 ok = vm4_and(vm4_and(inside, vf4_ne(den, zero)),
+                      vm4_and(vf4_gt(t, vf4(r->tnear)), vf4_lt(t, vf4(tfar))));
+  res->t = t; res->w1 = w1; res->w2 = w2; res->inv = inv; res->ng = ng;
+  res->mask = vm4_bits(ok);
+}
+
+static inline float lane(vfloat4 v, int i) {
+  float f[4] __attribute__((aligned(16)));
+  vf4_store(f, v);
+  return f[i];
+}
+
+typedef struct entry { uint32_t ref; float dist; } entry;
+
+/* Pushes the hit children farthest first and returns the nearest. */
+FR_INLINE uint32_t order_children(const fr_bvh4_node *n, int mask, vfloat4 dist4, entry *stack, int *sp) {
+  float dist[4] __attribute__((aligned(16)));
+  vf4_store(dist, dist4);
+  int i0 = __builtin_ctz(mask);
+  mask &= mask - 1;
+  if (!mask) return n->child[i0];
+  int i1 = __builtin_ctz(mask);
+  mask &= mask - 1;
+  if (!mask) {
+    if (dist[i1] < dist[i0]) { int t = i0; i0 = i1; i1 = t; }
+    stack[(*sp)++] = (entry){n->child[i1], dist[i1]};
+    return n->child[i0];
+  }
+  entry e[4] = {{n->child[i0], dist[i0]}, {n->child[i1], dist[i1]}};
+  int k = 2;
+  while (mask) {
+    int i = __builtin_ctz(mask);
+    mask &= mask - 1;
+    e[k++] = (entry){n->child[i], dist[i]};
+  }
+  for (int a = 1; a < k; a++) { /* insertion sort, farthest first */
+    entry x = e[a];
+    int b = a - 1;
+    while (b >= 0 && e[b].dist < x.dist) { e[b + 1] = e[b]; b--; }
+    e[b + 1] = x;
+  }
+  for (int a = 0; a < k - 1; a++) stack[(*sp)++] = e[a];
+  return e[k - 1].ref;
+}
+
+static void intersect1(const fr_bvh4 *b, const fr_ray *ray, fr_hit *hit) {
+  fr_hit_miss(hit);
+  if (fr_ray_invalid(ray)) return;
+  ray4 r;
+  ray4_setup(&r, ray);
+  float tfar = ray->tfar;
+  entry stack[STACK_SIZE];
+  int sp = 0;
+  stack[sp++] = (entry){b->root, -INFINITY};
+  const fr_tri4 *best_blk = 0;
+  tri4_result best;
+  memset(&best, 0, sizeof best);
+  int best_lane = 0;
+  while (sp) {
+    entry top = stack[--sp];
+    if (top.dist > tfar * ROUND_UP) continue;
+    uint32_t ref = top.ref;
+    while (!(ref & FR_BVH4_LEAF)) {
+      const fr_bvh4_node *n = &b->nodes[ref];
+      vfloat4 dist;
+      int mask = box4(n, &r, tfar, &dist);
+      if (!mask) goto next;
+      ref = order_children(n, mask, dist, stack, &sp);
+    }
+    {
+      const fr_tri4 *blk = &b->tris[ref & ~FR_BVH4_LEAF];
+      tri4_result res;
+      tri4_test(blk, &r, tfar, &res);
+      if (res.mask) {
+        int m = res.mask, bl = __builtin_ctz(m);
+        float bt = lane(res.t, bl);
+        for (m &= m - 1; m; m &= m - 1) {
+          int i = __builtin_ctz(m);
+          float ti = lane(res.t, i);
+          if (ti < bt) { bt = ti; bl = i; }
+        }
+        tfar = bt;
+        best = res;
+        best_lane = bl;
+        best_blk = blk;
+      }
+    }
+  next:;
+  }
+  if (best_blk) {
+    float inv = lane(best.inv, best_lane);
+    hit->t = tfar;
+    hit->u = lane(best.w1, best_lane) * inv;
+    hit->v = lane(best.w2, best_lane) * inv;
+    hit->prim = best_blk->prim[best_lane];
+    hit->ng[0] = lane(best.ng.x, best_lane);
+    hit->ng[1] = lane(best.ng.y, best_lane);
+    hit->ng[2] = lane(best.ng.z, best_lane);
+  }
+}
+
+static int occluded1(const fr_bvh4 *b, const fr_ray *ray) {
+  if (fr_ray_invalid(ray)) return 0;
+  ray4 r;
+  ray4_setup(&r, ray);
+  const float tfar = ray->tfar;
+  entry stack[STACK_SIZE];
+  int sp = 0;
+  stack[sp++] = (entry){b->root, -INFINITY};
+  while (sp) {
+    uint32_t ref = stack[--sp].ref;
+    while (!(ref & FR_BVH4_LEAF)) {
+      const fr_bvh4_node *n = &b->nodes[ref];
+      vfloat4 dist;
+      int mask = box4(n, &r, tfar, &dist);
+      if (!mask) goto next;
+      /* any hit ends the search, so order matters less; nearest first still
+       * finds occluders sooner in closed scenes */
+      ref = order_children(n, mask, dist, stack, &sp);
+    }
+    {
+      tri4_result res;
+      tri4_test(&b->tris[ref & ~FR_BVH4_LEAF], &r, tfar, &res);
+      if (res.mask) return 1;
+    }
+  next:;
+  }
+  return 0;
+}
+
+static void intersect_stream(const fr_bvh4 *b, const fr_ray *rays, fr_hit *hits, size_t n) {
+  for (size_t i = 0; i < n; i++) intersect1(b, &rays[i], &hits[i]);
+}
+
+static void occluded_stream(const fr_bvh4 *b, const fr_ray *rays, uint8_t *occ, size_t n) {
+  for (size_t i = 0; i < n; i++) occ[i] = (uint8_t)occluded1(b, &rays[i]);
+}
+
+#if defined(FR_BUILD_ISA_AVX512)
+#define THIS_ISA FR_ISA_AVX512
+#elif defined(FR_BUILD_ISA_AVX2)
+#define THIS_ISA FR_ISA_AVX2
+#else
+#define THIS_ISA FR_ISA_SCALAR
+#endif
+
+const fr_kernels FR_ISA_FN(fr_kernels) = {THIS_ISA, intersect1, occluded1, intersect_stream, occluded_stream};

@@ -1,0 +1,61 @@
+#include "kernels.h"
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include "base/error.h"
+
+static _Atomic(const fr_kernels *) active;
+
+int fr_isa_supported(fr_isa isa) {
+  switch (isa) {
+  case FR_ISA_SCALAR: return 1;
+  case FR_ISA_AVX2: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  case FR_ISA_AVX512:
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+           __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw");
+  }
+  return 0;
+}
+
+const char *fr_isa_name(fr_isa isa) {
+  switch (isa) {
+  case FR_ISA_SCALAR: return "scalar";
+  case FR_ISA_AVX2: return "avx2";
+  case FR_ISA_AVX512: return "avx512";
+  }
+  return "unknown";
+}
+
+static const fr_kernels *table(fr_isa isa) {
+  return isa == FR_ISA_AVX512 ? &fr_kernels_avx512 : isa == FR_ISA_AVX2 ? &fr_kernels_avx2 : &fr_kernels_scalar;
+}
+
+static const fr_kernels *choose(void) {
+  const char *env = getenv("FRUSTA_ISA");
+  if (env && *env) {
+    for (int i = FR_ISA_SCALAR; i <= FR_ISA_AVX512; i++)
+      if (strcmp(env, fr_isa_name((fr_isa)i)) == 0 && fr_isa_supported((fr_isa)i)) return table((fr_isa)i);
+    /* an unknown or unsupported request falls through to the best level */
+  }
+  for (int i = FR_ISA_AVX512; i >= FR_ISA_SCALAR; i--)
+    if (fr_isa_supported((fr_isa)i)) return table((fr_isa)i);
+  return &fr_kernels_scalar;
+}
+
+const fr_kernels *fr_kernels_active(void) {
+  const fr_kernels *k = atomic_load_explicit(&active, memory_order_acquire);
+  if (!k) {
+    k = choose();
+    atomic_store_explicit(&active, k, memory_order_release);
+  }
+  return k;
+}
+
+fr_error fr_set_isa(fr_isa isa) {
+  if (isa < FR_ISA_SCALAR || isa > FR_ISA_AVX512) return fr_fail(FR_ERR_ARG, "unknown ISA %d", (int)isa);
+  if (!fr_isa_supported(isa)) return fr_fail(FR_ERR_UNSUPPORTED, "this CPU does not support %s", fr_isa_name(isa));
+  atomic_store_explicit(&active, table(isa), memory_order_release);
+  return FR_OK;
+}
+
+fr_isa fr_get_isa(void) { return fr_kernels_active()->isa; }
