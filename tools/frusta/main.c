@@ -1,1 +1,31 @@
-int main(void){return 0;}
+/* frusta: render | bench | trace | stats */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "cli.h"
+#include "commands.h"
+
+static void usage(FILE *f) {
+  fprintf(f,
+          "usage: frusta <command> [options]\n"
+          "  render SCENE|--builtin --out FILE.png|.exr|.pfm [--shade eyelight|normals|shadows]\n"
+          "         [--size WxH] [--eye x,y,z --at x,y,z --up x,y,z --fov deg] [--light x,y,z] [--threads N]\n"
+          "  bench  SCENE|--builtin --workload W|all --mode M|all [--tracer frusta|embree|both] [--threads N]\n"
+          "         [--size WxH] [view flags] [--light x,y,z] [--area c,e1,e2] [--repeat K]\n"
+          "  trace  SCENE RAYS --query closest|any --out FILE [--tracer frusta|embree]\n"
+          "  stats  SCENE|--builtin [--embree]\n"
+          "Scenes: PLY, OBJ(+MTL) and what Assimp reads, optionally .zst. FRUSTA_ISA=avx512|avx2|scalar forces an ISA.\n");
+}
+
+int main(int argc, char **argv) {
+  if (argc < 2) { usage(stderr); return CLI_USAGE_ERROR; }
+  const char *cmd = argv[1];
+  if (strcmp(cmd, "-h") == 0 || strcmp(cmd, "--help") == 0 || strcmp(cmd, "help") == 0) { usage(stdout); return 0; }
+  const char *isa = getenv("FRUSTA_ISA");
+  if (isa && *isa && cli_set_isa(isa) != 0) return 1;
+  if (strcmp(cmd, "render") == 0) return cmd_render(argc - 2, argv + 2);
+  if (strcmp(cmd, "bench") == 0) return cmd_bench(argc - 2, argv + 2);
+  if (strcmp(cmd, "trace") == 0) return cmd_trace(argc - 2, argv + 2);
+  if (strcmp(cmd, "stats") == 0) return cmd_stats(argc - 2, argv + 2);
+  return cli_error(CLI_USAGE_ERROR, "unknown command '%s' (render, bench, trace or stats)", cmd);
+}

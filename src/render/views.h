@@ -1,0 +1,18 @@
+/* Cameras and lights of the scenes in ../shared/scenes (its README's table),
+ * of the built-in scene, and a fallback from a scene's bounds. */
+#ifndef FR_RENDER_VIEWS_H
+#define FR_RENDER_VIEWS_H
+#include "base/vec3.h"
+
+typedef struct fr_view {
+  vec3 eye, at, up;
+  float fov;
+  vec3 light;                 /* point light */
+  vec3 area_c, area_e1, area_e2; /* quad light c + s e1 + t e2 */
+} fr_view;
+
+/* 1 if name has a known view. */
+int fr_view_lookup(const char *name, fr_view *v);
+/* A 3/4 view of the box with lights above it. */
+fr_view fr_view_from_bounds(aabb b);
+#endif

@@ -1,0 +1,246 @@
+#include "workload.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "base/rng.h"
+#include "base/timer.h"
+
+#define TILE 8
+#define TILE_PIX (TILE * TILE)
+#define MAX_SEC 16 /* secondary rays per pixel */
+
+static const char *names[FR_WL_COUNT] = {"primary", "shadow", "soft16", "ao16", "diffuse8", "specular8"};
+
+const char *fr_workload_name(fr_workload_kind k) { return k < FR_WL_COUNT ? names[k] : "?"; }
+
+int fr_workload_parse(const char *name, fr_workload_kind *k) {
+  for (int i = 0; i < FR_WL_COUNT; i++)
+    if (strcmp(name, names[i]) == 0) { *k = (fr_workload_kind)i; return 1; }
+  return 0;
+}
+
+typedef struct buffers {
+  fr_ray rays[TILE_PIX * MAX_SEC];
+  fr_hit hits[TILE_PIX * MAX_SEC];
+  uint8_t occ[TILE_PIX * MAX_SEC];
+  int px[TILE_PIX], py[TILE_PIX];
+  fr_hit prim_hit[TILE_PIX];
+  fr_ray prim_ray[TILE_PIX];
+  int owner[TILE_PIX * MAX_SEC];
+} buffers;
+
+/* Unit geometric normal of a hit, facing the ray; taken from the scene so that
+ * every tracer shades with the same normals. */
+static vec3 facing_normal(const fr_scene *s, const fr_hit *h, vec3 d) {
+  const float *p = fr_scene_vertices(s);
+  const uint32_t *ix = fr_scene_indices(s) + 3 * (size_t)h->prim;
+  vec3 a = v3_load(p + 3 * (size_t)ix[0]), b = v3_load(p + 3 * (size_t)ix[1]), c = v3_load(p + 3 * (size_t)ix[2]);
+  vec3 n = v3_norm(v3_cross(v3_sub(b, a), v3_sub(c, a)));
+  return v3_dot(n, d) > 0.0f ? v3_scale(n, -1.0f) : n;
+}
+
+static vec3 hit_point(const fr_ray *r, const fr_hit *h) {
+  return v3_add(v3_load(r->org), v3_scale(v3_load(r->dir), h->t));
+}
+
+static void onb(vec3 n, vec3 *t, vec3 *b) {
+  /* Duff et al., "Building an Orthonormal Basis, Revisited" */
+  float sign = copysignf(1.0f, n.z);
+  float a = -1.0f / (sign + n.z), bb = n.x * n.y * a;
+  *t = v3(1.0f + sign * n.x * n.x * a, sign * bb, -sign * n.x);
+  *b = v3(bb, sign + n.y * n.y * a, -n.y);
+}
+
+static vec3 cosine_dir(vec3 n, float u1, float u2) {
+  vec3 t, b;
+  onb(n, &t, &b);
+  float r = sqrtf(u1), phi = 2.0f * (float)M_PI * u2;
+  float x = r * cosf(phi), y = r * sinf(phi), z = sqrtf(fmaxf(0.0f, 1.0f - u1));
+  return v3_add(v3_add(v3_scale(t, x), v3_scale(b, y)), v3_scale(n, z));
+}
+
+static fr_ray make_ray(vec3 o, vec3 d, float tnear, float tfar) {
+  fr_ray r = {{o.x, o.y, o.z}, tnear, {d.x, d.y, d.z}, tfar};
+  return r;
+}
+
+static vec3 albedo(const fr_scene *s, uint32_t prim) {
+  uint32_t m = fr_scene_triangle_material(s, prim);
+  const fr_material *mat = m == FR_INVALID_ID ? NULL : fr_scene_material(s, m);
+  return mat ? v3(mat->diffuse[0], mat->diffuse[1], mat->diffuse[2]) : v3(0.8f, 0.8f, 0.8f);
+}
+
+/* One tile: returns rays traced; writes shaded pixels when w->image is set. */
+static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, int tx, int ty) {
+  const int W = w->cam.width, H = w->cam.height;
+  int n = 0;
+  /* pixels in 4x4 blocks, so groups of 16 rays are coherent */
+  for (int by = 0; by < TILE; by += 4)
+    for (int bx = 0; bx < TILE; bx += 4)
+      for (int y = 0; y < 4; y++)
+        for (int x = 0; x < 4; x++) {
+          int X = tx + bx + x, Y = ty + by + y;
+          if (X >= W || Y >= H) continue;
+          B->px[n] = X; B->py[n] = Y;
+          B->prim_ray[n] = fr_camera_ray(&w->cam, X, Y);
+          B->rays[n] = B->prim_ray[n];
+          n++;
+        }
+  uint64_t rays = (uint64_t)n;
+  t->intersect(t->ctx, B->rays, B->prim_hit, (size_t)n, 1);
+  float lit[TILE_PIX];
+  for (int i = 0; i < n; i++) lit[i] = 1.0f;
+
+  int m = 0;
+  switch (w->kind) {
+  case FR_WL_PRIMARY:
+    break;
+  case FR_WL_SHADOW:
+  case FR_WL_SOFT16:
+  case FR_WL_AO16: {
+    int per = w->kind == FR_WL_SHADOW ? 1 : 16;
+    for (int i = 0; i < n; i++) {
+      const fr_hit *h = &B->prim_hit[i];
+      if (h->prim == FR_INVALID_ID) continue;
+      vec3 d = v3_load(B->prim_ray[i].dir), p = hit_point(&B->prim_ray[i], h), nn = facing_normal(w->scene, h, d);
+      fr_rng rng = fr_rng_seed(w->seed, (uint64_t)B->py[i] * (uint64_t)W + (uint64_t)B->px[i]);
+      for (int k = 0; k < per; k++) {
+        vec3 dir;
+        float tfar;
+        if (w->kind == FR_WL_AO16) {
+          dir = cosine_dir(nn, fr_rng_float(&rng), fr_rng_float(&rng));
+          tfar = INFINITY;
+        } else {
+          vec3 L = w->view.light;
+          if (w->kind == FR_WL_SOFT16) { /* stratified 4x4 on the quad */
+            float s = ((float)(k & 3) + fr_rng_float(&rng)) * 0.25f, q = ((float)(k >> 2) + fr_rng_float(&rng)) * 0.25f;
+            L = v3_add(w->view.area_c, v3_add(v3_scale(w->view.area_e1, s), v3_scale(w->view.area_e2, q)));
+          }
+          vec3 to = v3_sub(L, p);
+          float dist = v3_len(to);
+          dir = v3_scale(to, 1.0f / dist);
+          tfar = dist * (1.0f - 1e-4f);
+        }
+        B->rays[m] = make_ray(p, dir, w->eps, tfar);
+        B->owner[m++] = i;
+      }
+    }
+    rays += (uint64_t)m;
+    t->occluded(t->ctx, B->rays, B->occ, (size_t)m, 0);
+    int cnt[TILE_PIX] = {0};
+    for (int k = 0; k < m; k++) cnt[B->owner[k]] += !B->occ[k];
+    for (int i = 0; i < n; i++) lit[i] = (float)cnt[i] / (float)per;
+    break;
+  }
+  case FR_WL_DIFFUSE8:
+  case FR_WL_SPECULAR8: {
+    fr_rng rng[TILE_PIX];
+    fr_ray cur[TILE_PIX];
+    fr_hit ch[TILE_PIX];
+    int alive[TILE_PIX], na = 0;
+    for (int i = 0; i < n; i++)
+      if (B->prim_hit[i].prim != FR_INVALID_ID) {
+        alive[na++] = i;
+        cur[i] = B->prim_ray[i];
+        ch[i] = B->prim_hit[i];
+        rng[i] = fr_rng_seed(w->seed, (uint64_t)B->py[i] * (uint64_t)W + (uint64_t)B->px[i]);
+      }
+    for (int bounce = 0; bounce < 8 && na > 0; bounce++) {
+      for (int a = 0; a < na; a++) {
+        int i = alive[a];
+        vec3 d = v3_load(cur[i].dir), p = hit_point(&cur[i], &ch[i]), nn = facing_normal(w->scene, &ch[i], d);
+        vec3 nd = w->kind == FR_WL_DIFFUSE8 ? cosine_dir(nn, fr_rng_float(&rng[i]), fr_rng_float(&rng[i]))
+                                            : v3_sub(d, v3_scale(nn, 2.0f * v3_dot(d, nn)));
+        B->rays[a] = make_ray(p, nd, w->eps, INFINITY);
+        cur[i] = B->rays[a];
+      }
+      rays += (uint64_t)na;
+      t->intersect(t->ctx, B->rays, B->hits, (size_t)na, 0);
+      int nn2 = 0;
+      for (int a = 0; a < na; a++) {
+        int i = alive[a];
+        cur[i] = B->rays[a]; /* a tracer may have written to the array */
+        cur[i].tfar = INFINITY;
+        if (B->hits[a].prim == FR_INVALID_ID) continue;
+        ch[i] = B->hits[a];
+        alive[nn2++] = i;
+      }
+      na = nn2;
+    }
+    break;
+  }
+  default:
+    break;
+  }
+
+  if (w->image) {
+    for (int i = 0; i < n; i++) {
+      float *px = w->image + 3 * ((size_t)B->py[i] * (size_t)W + (size_t)B->px[i]);
+      const fr_hit *h = &B->prim_hit[i];
+      if (h->prim == FR_INVALID_ID) { px[0] = px[1] = px[2] = 0.05f; continue; }
+      vec3 d = v3_load(B->prim_ray[i].dir), nn = facing_normal(w->scene, h, d), c;
+      float cosv = fabsf(v3_dot(nn, d));
+      if (w->shade == FR_SHADE_NORMALS) {
+        c = v3_scale(v3_add(nn, v3(1, 1, 1)), 0.5f);
+      } else if (w->shade == FR_SHADE_LIGHT && w->kind == FR_WL_SHADOW) {
+        vec3 p = hit_point(&B->prim_ray[i], h), L = v3_norm(v3_sub(w->view.light, p));
+        c = v3_scale(albedo(w->scene, h->prim), 0.15f * cosv + 0.85f * lit[i] * fmaxf(0.0f, v3_dot(nn, L)));
+      } else if (w->shade == FR_SHADE_LIGHT) {
+        c = v3_scale(albedo(w->scene, h->prim), lit[i] * (0.25f + 0.75f * cosv));
+      } else {
+        c = v3_scale(albedo(w->scene, h->prim), cosv);
+      }
+      px[0] = c.x; px[1] = c.y; px[2] = c.z;
+    }
+  }
+  return rays;
+}
+
+fr_workload_result fr_workload_run(const fr_workload *w, const fr_tracer *t) {
+  const int tiles_x = (w->cam.width + TILE - 1) / TILE, tiles_y = (w->cam.height + TILE - 1) / TILE;
+  const int ntiles = tiles_x * tiles_y;
+  uint64_t total = 0;
+  int done = 0, last_pct = -1;
+  double t0 = fr_seconds();
+#pragma omp parallel num_threads(w->threads) reduction(+ : total)
+  {
+    buffers *B = malloc(sizeof(buffers));
+#pragma omp for schedule(dynamic, 1)
+    for (int i = 0; i < ntiles; i++) {
+      if (!B) continue;
+      total += run_tile(w, t, B, (i % tiles_x) * TILE, (i / tiles_x) * TILE);
+      if (w->progress) {
+        int d, pct;
+#pragma omp atomic capture
+        d = ++done;
+        pct = (int)(100.0 * d / ntiles);
+        if (pct / 10 != last_pct / 10 && fr_seconds() - t0 > 1.0) {
+#pragma omp critical
+          {
+            if (pct / 10 != last_pct / 10) { last_pct = pct; fprintf(stderr, "\rrender: %3d%%", pct); fflush(stderr); }
+          }
+        }
+      }
+    }
+    free(B);
+  }
+  fr_workload_result r = {total, fr_seconds() - t0};
+  if (w->progress && last_pct >= 0) fprintf(stderr, "\n");
+  return r;
+}
+
+static void frusta_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
+  (void)coherent;
+  fr_intersect_stream((const fr_scene *)ctx, rays, hits, n);
+}
+
+static void frusta_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
+  (void)coherent;
+  fr_occluded_stream((const fr_scene *)ctx, rays, occ, n);
+}
+
+fr_tracer fr_tracer_frusta(const fr_scene *s) {
+  fr_tracer t = {(void *)s, frusta_intersect, frusta_occluded};
+  return t;
+}

@@ -1,0 +1,38 @@
+/* Argument parsing and scene setup shared by the subcommands. */
+#ifndef FR_TOOL_CLI_H
+#define FR_TOOL_CLI_H
+#include "base/vec3.h"
+#include "frusta.h"
+#include "render/views.h"
+
+#define CLI_USAGE_ERROR 2
+
+/* Prints "frusta: <message>" on one line to stderr; returns 1 (or 2 for usage). */
+int cli_error(int code, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+int cli_parse_vec3(const char *s, vec3 *out);
+int cli_parse_int(const char *s, int lo, int hi, int *out);
+int cli_parse_float(const char *s, float *out);
+int cli_parse_size(const char *s, int *w, int *h);
+
+/* View flags shared by render and bench. */
+typedef struct cli_view {
+  int has_eye, has_at, has_up, has_fov, has_light, has_area;
+  vec3 eye, at, up, light, area[3];
+  float fov;
+  int width, height;
+} cli_view;
+
+/* Consumes argv[*i] (and its value) if it is a view flag: 1 consumed, 0 not a
+ * view flag, -1 error (already reported). */
+int cli_view_flag(int argc, char **argv, int *i, cli_view *v);
+/* The scene's own view with the flags applied. */
+fr_view cli_resolve_view(const fr_scene *s, const cli_view *v);
+
+/* Loads "--builtin" or a file and commits it; reports errors itself. */
+int cli_load_scene(const char *arg, fr_scene **s);
+/* Applies FRUSTA_ISA / --isa; reports errors itself. */
+int cli_set_isa(const char *name);
+float cli_scene_eps(const fr_scene *s);
+const char *cli_scene_name(const fr_scene *s);
+#endif

@@ -1,0 +1,128 @@
+/*
+ * frusta bench: the workloads of ../shared/spec/workloads.md, frusta and Embree
+ * side by side in one process, on the same scene, rays and threads. Each run
+ * is repeated K times; the line reports the best and the median.
+ */
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "api/scene.h"
+#include "cli.h"
+#include "commands.h"
+#include "embree_tracer.h"
+#include "render/workload.h"
+
+static const char *frusta_modes[] = {"single"};
+#define N_FRUSTA_MODES 1
+
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return x < y ? -1 : x > y;
+}
+
+static void run(const fr_workload *w0, const fr_tracer *t, const char *scene, size_t tris, const char *tracer,
+                const char *mode, int repeat) {
+  double secs[64];
+  uint64_t rays = 0;
+  for (int k = 0; k < repeat; k++) {
+    fr_workload_result r = fr_workload_run(w0, t);
+    secs[k] = r.seconds;
+    rays = r.rays;
+  }
+  qsort(secs, (size_t)repeat, sizeof(double), cmp_double);
+  double best = secs[0], med = secs[repeat / 2];
+  printf("scene=%s tris=%zu workload=%s tracer=%s mode=%s threads=%d rays=%llu seconds=%.4f mrays=%.2f median_seconds=%.4f median_mrays=%.2f\n",
+         scene, tris, fr_workload_name(w0->kind), tracer, mode, w0->threads, (unsigned long long)rays, best,
+         (double)rays / best * 1e-6, med, (double)rays / med * 1e-6);
+  fflush(stdout);
+}
+
+int cmd_bench(int argc, char **argv) {
+  const char *scene = NULL, *workload = NULL, *mode = NULL, *tracer = "frusta";
+  cli_view v;
+  memset(&v, 0, sizeof v);
+  v.width = 1024; v.height = 1024;
+  int threads = omp_get_num_procs(), repeat = 3;
+  for (int i = 0; i < argc; i++) {
+    int r = cli_view_flag(argc, argv, &i, &v);
+    if (r < 0) return CLI_USAGE_ERROR;
+    if (r > 0) continue;
+    const char *a = argv[i];
+    if (!strcmp(a, "--workload") || !strcmp(a, "--mode") || !strcmp(a, "--tracer") || !strcmp(a, "--threads") || !strcmp(a, "--repeat") || !strcmp(a, "--isa")) {
+      if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
+      const char *val = argv[++i];
+      if (!strcmp(a, "--workload")) workload = val;
+      else if (!strcmp(a, "--mode")) mode = val;
+      else if (!strcmp(a, "--tracer")) tracer = val;
+      else if (!strcmp(a, "--isa")) { if (cli_set_isa(val)) return 1; }
+      else if (!strcmp(a, "--threads")) { if (!cli_parse_int(val, 1, 1024, &threads)) return cli_error(CLI_USAGE_ERROR, "--threads wants 1..1024, got '%s'", val); }
+      else if (!cli_parse_int(val, 1, 64, &repeat)) return cli_error(CLI_USAGE_ERROR, "--repeat wants 1..64, got '%s'", val);
+    } else if (!strcmp(a, "--builtin") || a[0] != '-') {
+      if (scene) return cli_error(CLI_USAGE_ERROR, "bench takes one scene");
+      scene = a;
+    } else return cli_error(CLI_USAGE_ERROR, "bench: unknown option '%s'", a);
+  }
+  if (!scene || !workload || !mode)
+    return cli_error(CLI_USAGE_ERROR, "usage: frusta bench SCENE --workload W|all --mode M|all [--tracer frusta|embree|both] ...");
+  int use_frusta = !strcmp(tracer, "frusta") || !strcmp(tracer, "both");
+  int use_embree = !strcmp(tracer, "embree") || !strcmp(tracer, "both");
+  if (!use_frusta && !use_embree) return cli_error(CLI_USAGE_ERROR, "--tracer is frusta, embree or both, not '%s'", tracer);
+  fr_workload_kind wk = FR_WL_PRIMARY;
+  int all_wl = !strcmp(workload, "all");
+  if (!all_wl && !fr_workload_parse(workload, &wk))
+    return cli_error(CLI_USAGE_ERROR, "unknown workload '%s' (primary, shadow, soft16, ao16, diffuse8, specular8, all)", workload);
+  int all_modes = !strcmp(mode, "all");
+  ebr_mode em = EBR_SINGLE;
+  int frusta_has_mode = all_modes || !strcmp(mode, "single");
+  int embree_has_mode = all_modes || ebr_mode_parse(mode, &em);
+  if (use_frusta && !frusta_has_mode && !(use_embree && embree_has_mode))
+    return cli_error(CLI_USAGE_ERROR, "frusta has no mode '%s' (single, or all)", mode);
+  if (use_embree && !embree_has_mode && !(use_frusta && frusta_has_mode))
+    return cli_error(CLI_USAGE_ERROR, "embree has no mode '%s' (single, packet4, packet8, packet16, stream, all)", mode);
+
+  omp_set_num_threads(threads);
+  fr_scene *s;
+  if (cli_load_scene(scene, &s)) return 1;
+  fr_workload w;
+  memset(&w, 0, sizeof w);
+  w.view = cli_resolve_view(s, &v);
+  if (fr_camera_setup(&w.cam, w.view.eye, w.view.at, w.view.up, w.view.fov, v.width, v.height)) {
+    fr_scene_release(s);
+    return cli_error(CLI_USAGE_ERROR, "%s", fr_last_error());
+  }
+  w.scene = s;
+  w.eps = cli_scene_eps(s);
+  w.threads = threads;
+  w.seed = 7;
+  size_t tris = fr_scene_triangle_count(s);
+  fr_bvh_stats st;
+  fr_scene_stats(s, &st);
+  printf("build_seconds=%.3f tracer=frusta scene=%s tris=%zu threads=%d isa=%s sah=%.2f bytes_per_tri=%.1f\n",
+         st.build_seconds, s->name, tris, threads, fr_isa_name(fr_get_isa()), st.bvh4_sah,
+         (double)(st.bvh4_bytes + st.tri_bytes) / (double)tris);
+  ebr_scene *e = NULL;
+  if (use_embree) {
+    ebr_options o = {threads, 2, 0}; /* high quality, not robust: Embree's fastest tracing */
+    if (ebr_create(s, o, &e)) { fr_scene_release(s); return cli_error(1, "embree: cannot build the scene"); }
+    printf("build_seconds=%.3f tracer=embree scene=%s tris=%zu threads=%d quality=high bytes_per_tri=%.1f\n",
+           ebr_build_seconds(e), s->name, tris, threads, (double)ebr_bytes(e) / (double)tris);
+  }
+  for (int k = all_wl ? 0 : (int)wk; k < (all_wl ? FR_WL_COUNT : (int)wk + 1); k++) {
+    w.kind = (fr_workload_kind)k;
+    if (use_frusta && frusta_has_mode) {
+      fr_tracer t = fr_tracer_frusta(s);
+      for (int m = 0; m < N_FRUSTA_MODES; m++)
+        if (all_modes || !strcmp(mode, frusta_modes[m])) run(&w, &t, s->name, tris, "frusta", frusta_modes[m], repeat);
+    }
+    if (e && embree_has_mode)
+      for (int m = 0; m < EBR_MODE_COUNT; m++)
+        if (all_modes || m == (int)em) {
+          fr_tracer t = ebr_tracer(e, (ebr_mode)m);
+          run(&w, &t, s->name, tris, "embree", ebr_mode_name((ebr_mode)m), repeat);
+        }
+  }
+  ebr_release(e);
+  fr_scene_release(s);
+  return 0;
+}
