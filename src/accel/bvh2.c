@@ -7,7 +7,7 @@ typedef struct conv { const fr_build_tree *t; fr_bvh2 *b; } conv;
 
 static uint32_t convert(conv *c, int32_t bi) {
   const fr_build_node *n = &c->t->nodes[bi];
-  if (n->left < 0) {
+  if (n->count <= FR_BUILD_MAX_LEAF) {
     c->b->nleaves++;
     return FR_BVH2_LEAF | (n->count << FR_BVH2_COUNT_SHIFT) | n->first;
   }
@@ -27,7 +27,7 @@ static uint32_t convert(conv *c, int32_t bi) {
 
 fr_error fr_bvh2_from_build(const fr_build_tree *t, fr_bvh2 *out) {
   memset(out, 0, sizeof *out);
-  size_t inner = t->nnodes / 2 + 1;
+  size_t inner = t->nprims;
   out->nodes = fr_alloc_aligned(fr_mul_size(inner, sizeof(fr_bvh2_node)), 64);
   out->prims = fr_alloc_aligned(fr_mul_size(t->nprims, sizeof(uint32_t)), 64);
   if (!out->nodes || !out->prims) {

@@ -27,12 +27,13 @@ static uint32_t make_leaf(conv *c, const fr_build_node *n) {
   return FR_BVH4_LEAF | li;
 }
 
-/* Collapses the binary tree: a node adopts the grandchildren of its largest
- * inner child until it has four children (Embree's BVH4 builders do the same). */
+/* Collapses the binary tree: a node adopts the children of its largest child
+ * that holds more than one triangle until it has four children (Embree's BVH4
+ * builders do the same); children of at most four triangles become leaves. */
 static uint32_t convert(conv *c, int32_t bi, int depth) {
   const fr_build_node *n = &c->t->nodes[bi];
   if (depth > c->b->depth) c->b->depth = depth;
-  if (n->left < 0) return make_leaf(c, n);
+  if (n->count <= FR_BUILD_MAX_LEAF) return make_leaf(c, n);
   int32_t kids[4] = {n->left, n->right, -1, -1};
   int nk = 2;
   while (nk < 4) {
@@ -71,7 +72,7 @@ static uint32_t convert(conv *c, int32_t bi, int depth) {
 
 fr_error fr_bvh4_from_build(const fr_build_tree *t, const fr_mesh *m, fr_bvh4 *out) {
   memset(out, 0, sizeof *out);
-  size_t leaves = t->nnodes / 2 + 1, inner = t->nnodes / 2 + 1;
+  size_t leaves = t->nprims, inner = t->nprims;
   out->nodes = fr_alloc_aligned(fr_mul_size(inner, sizeof(fr_bvh4_node)), 64);
   out->tris = fr_alloc_aligned(fr_mul_size(leaves, sizeof(fr_tri4)), 64);
   if (!out->nodes || !out->tris) {

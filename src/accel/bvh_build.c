@@ -8,6 +8,7 @@
 #define NBINS 32
 #define PAR_BIN 65536   /* nodes with more primitives bin in parallel */
 #define JOB_MIN 4096    /* below PAR_BIN, subtrees become jobs */
+#define SMALL 12        /* nodes this small get an exact SAH sweep instead of bins */
 
 typedef struct ref { aabb box; vec3 c2; uint32_t id; } ref; /* c2: twice the centroid */
 
@@ -99,10 +100,45 @@ static void make_scale(aabb cb, float scale[3]) {
   }
 }
 
-/* Decides how node [b,e) splits; returns 0 for a leaf, else the middle. */
-static size_t decide(builder *bd, size_t b, size_t e, aabb box, int depth, int parallel) {
+/* Exact SAH for a few primitives: sort by centroid on each axis, sweep. */
+static size_t small_split(ref *refs, size_t b, size_t e) {
+  size_t n = e - b;
+  float best = INFINITY;
+  int best_axis = 0;
+  size_t best_pos = n / 2;
+  for (int a = 0; a < 3; a++) {
+    for (size_t i = b + 1; i < e; i++) { /* insertion sort on axis a */
+      ref x = refs[i];
+      size_t j = i;
+      while (j > b && v3_get(refs[j - 1].c2, a) > v3_get(x.c2, a)) { refs[j] = refs[j - 1]; j--; }
+      refs[j] = x;
+    }
+    float left[SMALL];
+    aabb acc = aabb_empty();
+    for (size_t i = 0; i + 1 < n; i++) { acc = aabb_merge(acc, refs[b + i].box); left[i] = aabb_half_area(acc); }
+    acc = aabb_empty();
+    for (size_t i = n - 1; i >= 1; i--) {
+      acc = aabb_merge(acc, refs[b + i].box);
+      float cost = left[i - 1] * blocks((uint32_t)i) + aabb_half_area(acc) * blocks((uint32_t)(n - i));
+      if (cost < best) { best = cost; best_axis = a; best_pos = i; }
+    }
+  }
+  if (best_axis != 2) { /* restore the winning order */
+    for (size_t i = b + 1; i < e; i++) {
+      ref x = refs[i];
+      size_t j = i;
+      while (j > b && v3_get(refs[j - 1].c2, best_axis) > v3_get(x.c2, best_axis)) { refs[j] = refs[j - 1]; j--; }
+      refs[j] = x;
+    }
+  }
+  return b + best_pos;
+}
+
+/* Decides how node [b,e) splits; returns 0 for a single primitive, else the middle. */
+static size_t decide(builder *bd, size_t b, size_t e, int depth, int parallel) {
   size_t n = e - b;
   if (n <= 1) return 0;
+  if (n <= SMALL && depth < FR_BUILD_MAX_DEPTH) return small_split(bd->refs, b, e);
   ref *refs = bd->refs;
   aabb cb;
   float scale[3];
@@ -150,10 +186,6 @@ static size_t decide(builder *bd, size_t b, size_t e, aabb box, int depth, int p
     for (size_t i = b; i < e; i++) bins_add(&bn, &refs[i], cb, scale);
   }
   if (depth < FR_BUILD_MAX_DEPTH) s = best_split(&bn, scale);
-  if (n <= FR_BUILD_MAX_LEAF) {
-    float leaf = aabb_half_area(box) * blocks((uint32_t)n);
-    if (!(s.cost + aabb_half_area(box) < leaf)) return 0;
-  }
   return partition(refs, b, e, s, cb, scale);
 }
 
@@ -171,12 +203,13 @@ static void make_leaf(builder *bd, size_t node, size_t b, size_t e) {
 }
 
 static void build_serial(builder *bd, size_t node, size_t b, size_t e, int depth) {
-  size_t mid = decide(bd, b, e, bd->nodes[node].box, depth, 0);
+  size_t mid = decide(bd, b, e, depth, 0);
   if (!mid) { make_leaf(bd, node, b, e); return; }
   size_t c = alloc_nodes(bd, 2);
   bd->nodes[node].left = (int32_t)c;
   bd->nodes[node].right = (int32_t)(c + 1);
-  bd->nodes[node].count = 0;
+  bd->nodes[node].first = (uint32_t)b;
+  bd->nodes[node].count = (uint32_t)(e - b);
   bd->nodes[c].box = range_box(bd->refs, b, mid);
   bd->nodes[c + 1].box = range_box(bd->refs, mid, e);
   build_serial(bd, c, b, mid, depth + 1);
@@ -233,12 +266,13 @@ fr_error fr_build_sah(const aabb *boxes, const uint32_t *ids, size_t n, fr_build
       if (!jobs_push(&todo, j)) goto oom;
       continue;
     }
-    size_t mid = decide(&bd, j.b, j.e, bd.nodes[j.node].box, j.depth, par);
+    size_t mid = decide(&bd, j.b, j.e, j.depth, par);
     if (!mid) { make_leaf(&bd, j.node, j.b, j.e); continue; }
     size_t c = alloc_nodes(&bd, 2);
     bd.nodes[j.node].left = (int32_t)c;
     bd.nodes[j.node].right = (int32_t)(c + 1);
-    bd.nodes[j.node].count = 0;
+    bd.nodes[j.node].first = (uint32_t)j.b;
+    bd.nodes[j.node].count = (uint32_t)cnt;
     bd.nodes[c].box = range_box(bd.refs, j.b, mid);
     bd.nodes[c + 1].box = range_box(bd.refs, mid, j.e);
     if (!jobs_push(&stack, (job){c + 1, mid, j.e, j.depth + 1})) goto oom;

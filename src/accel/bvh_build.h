@@ -1,8 +1,10 @@
 /*
- * Binned SAH builder (32 bins per axis, Wald 2007), parallel with OpenMP:
- * nodes over FR_BUILD_PAR_BIN primitives are binned by all threads together,
- * smaller subtrees are built as independent jobs. The result is a plain
- * binary tree that bvh2.c and bvh4.c turn into their traversal layouts.
+ * Binned SAH builder (32 bins per axis, Wald 2007; exact sweeps for small
+ * nodes), parallel with OpenMP: large nodes are binned by all threads
+ * together, smaller subtrees are built as independent jobs. The result is a
+ * binary tree split down to single primitives, each node knowing its range of
+ * primitives, so bvh2.c and bvh4.c can each choose their own leaves (the BVH4
+ * collapse opens small leaves to fill empty child slots, as Embree does).
  */
 #ifndef FR_ACCEL_BVH_BUILD_H
 #define FR_ACCEL_BVH_BUILD_H
@@ -16,8 +18,8 @@
 
 typedef struct fr_build_node {
   aabb box;
-  int32_t left, right;     /* children, or -1 for a leaf */
-  uint32_t first, count;   /* leaf: range in fr_build_tree.prims */
+  int32_t left, right;     /* children, or -1 for a single primitive */
+  uint32_t first, count;   /* the node's range in fr_build_tree.prims */
 } fr_build_node;
 
 typedef struct fr_build_tree {

@@ -11,8 +11,11 @@ static inline vec3 v3_add(vec3 a, vec3 b) { return v3(a.x + b.x, a.y + b.y, a.z 
 static inline vec3 v3_sub(vec3 a, vec3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
 static inline vec3 v3_mul(vec3 a, vec3 b) { return v3(a.x * b.x, a.y * b.y, a.z * b.z); }
 static inline vec3 v3_scale(vec3 a, float s) { return v3(a.x * s, a.y * s, a.z * s); }
-static inline vec3 v3_min(vec3 a, vec3 b) { return v3(fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z)); }
-static inline vec3 v3_max(vec3 a, vec3 b) { return v3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)); }
+/* ternaries, not fminf/fmaxf: they compile to minss/maxss (NaN never reaches boxes) */
+static inline float fr_minf(float a, float b) { return a < b ? a : b; }
+static inline float fr_maxf(float a, float b) { return a > b ? a : b; }
+static inline vec3 v3_min(vec3 a, vec3 b) { return v3(fr_minf(a.x, b.x), fr_minf(a.y, b.y), fr_minf(a.z, b.z)); }
+static inline vec3 v3_max(vec3 a, vec3 b) { return v3(fr_maxf(a.x, b.x), fr_maxf(a.y, b.y), fr_maxf(a.z, b.z)); }
 static inline float v3_dot(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 static inline vec3 v3_cross(vec3 a, vec3 b) {
   return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
