@@ -1,0 +1,175 @@
+/*
+ * Traversal against references on random scenes: the SIMD BVH4 kernels at
+ * every ISA level must give bit-identical answers to each other and to the
+ * plain scalar BVH2 traversal, and agree with a brute-force double-precision
+ * test wherever the ray is not within rounding distance of an edge.
+ */
+#include <stdlib.h>
+#include <string.h>
+#include "test_util.h"
+
+typedef struct scene_data { float *pos; uint32_t *idx; size_t nv, nt; } scene_data;
+
+static void add_tri(scene_data *s, vec3 a, vec3 b, vec3 c) {
+  vec3 p[3] = {a, b, c};
+  for (int k = 0; k < 3; k++) {
+    s->pos[3 * s->nv] = p[k].x; s->pos[3 * s->nv + 1] = p[k].y; s->pos[3 * s->nv + 2] = p[k].z;
+    s->idx[3 * s->nt + k] = (uint32_t)s->nv++;
+  }
+  s->nt++;
+}
+
+/* Random triangles of mixed kinds around `center` with extent `size`. */
+static scene_data make_scene(fr_rng *r, size_t n, vec3 center, float size) {
+  scene_data s = {malloc(n * 9 * sizeof(float)), malloc(n * 3 * sizeof(uint32_t)), 0, 0};
+  for (size_t i = 0; i < n; i++) {
+    vec3 a = v3_add(center, v3(urand(r, -size, size), urand(r, -size, size), urand(r, -size, size)));
+    float e = size * 0.1f;
+    vec3 b = v3_add(a, v3(urand(r, -e, e), urand(r, -e, e), urand(r, -e, e)));
+    vec3 c = v3_add(a, v3(urand(r, -e, e), urand(r, -e, e), urand(r, -e, e)));
+    switch (i % 6) {
+    case 0: b.z = a.z; c.z = a.z; break;                                  /* axis-aligned */
+    case 1: a.y = center.y; b.y = center.y; c.y = center.y; break;         /* coplanar set */
+    case 2: c = v3_add(a, v3_scale(v3_sub(b, a), 0.5f)); c.x += e * 1e-4f; break; /* sliver */
+    case 3: if (i % 12 == 3) c = b; break;                                /* some degenerate */
+    default: break;
+    }
+    add_tri(&s, a, b, c);
+  }
+  return s;
+}
+
+/* *src gets the triangle a ray starts on (kind 1), else FR_INVALID_ID. */
+static fr_ray random_ray(fr_rng *r, vec3 center, float size, const scene_data *s, int kind, uint32_t *src) {
+  *src = FR_INVALID_ID;
+  vec3 o = v3_add(center, v3(urand(r, -2 * size, 2 * size), urand(r, -2 * size, 2 * size), urand(r, -2 * size, 2 * size)));
+  vec3 target = v3_add(center, v3(urand(r, -size, size), urand(r, -size, size), urand(r, -size, size)));
+  float tnear = 0.0f;
+  if (kind == 1) { /* start on a surface */
+    size_t t = fr_rng_u32(r) % s->nt;
+    *src = (uint32_t)t;
+    float u = fr_rng_float(r) * 0.5f, v = fr_rng_float(r) * 0.5f;
+    vec3 a = v3_load(s->pos + 3 * s->idx[3 * t]), b = v3_load(s->pos + 3 * s->idx[3 * t + 1]), c = v3_load(s->pos + 3 * s->idx[3 * t + 2]);
+    o = v3_add(a, v3_add(v3_scale(v3_sub(b, a), u), v3_scale(v3_sub(c, a), v)));
+    tnear = 1e-4f * size;
+  } else if (kind == 2) { /* along an edge */
+    size_t t = fr_rng_u32(r) % s->nt;
+    vec3 a = v3_load(s->pos + 3 * s->idx[3 * t]), b = v3_load(s->pos + 3 * s->idx[3 * t + 1]);
+    o = v3_sub(a, v3_sub(b, a));
+    target = b;
+  } else if (kind == 3) { /* axis-parallel direction */
+    target = o;
+    int ax = (int)(fr_rng_u32(r) % 3);
+    if (ax == 0) target.x = center.x; else if (ax == 1) target.y = center.y; else target.z = center.z;
+    if (target.x == o.x && target.y == o.y && target.z == o.z) target.x += 1.0f;
+  }
+  vec3 d = v3_sub(target, o);
+  if (fr_rng_u32(r) & 1) d = v3_norm(d);
+  fr_ray ray = {{o.x, o.y, o.z}, tnear, {d.x, d.y, d.z}, (fr_rng_u32(r) % 4 == 0) ? urand(r, 0.2f, 1.0f) : INFINITY};
+  return ray;
+}
+
+static void check_scene(vec3 center, float size, uint64_t seed) {
+  fr_rng r = fr_rng_seed(seed, 1);
+  scene_data sd = make_scene(&r, 3000, center, size);
+  fr_scene *s;
+  assert_int_equal(fr_scene_from_arrays(sd.pos, sd.nv, sd.idx, sd.nt, &s), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  assert_true(fr_scene_skipped_triangles(s) > 0); /* the degenerate ones */
+  int checked = 0, hits = 0;
+  for (int i = 0; i < 4000; i++) {
+    uint32_t src;
+    fr_ray ray = random_ray(&r, center, size, &sd, i % 4, &src);
+    fr_hit ref, first;
+    fr_intersect1_reference(s, &ray, &ref);
+    int ref_occ = fr_occluded1_reference(s, &ray);
+    assert_int_equal(ref_occ, ref.prim != FR_INVALID_ID);
+    uint32_t bp;
+    double margin;
+    double bt = brute_force(sd.pos, sd.idx, sd.nt, &ray, &bp, &margin, 1);
+    /* Within rounding of an edge, or of the triangle a ray starts on (a grazing
+     * ray's t there is ill-conditioned), either answer is right. */
+    int clear = margin >= 1e-4 && (src == FR_INVALID_ID || ref.prim != src);
+    int first_isa = 1;
+    for (int isa = FR_ISA_SCALAR; isa <= FR_ISA_AVX512; isa++) {
+      if (!fr_isa_supported((fr_isa)isa)) continue;
+      assert_int_equal(fr_set_isa((fr_isa)isa), FR_OK);
+      fr_hit h;
+      fr_intersect1(s, &ray, &h);
+      /* every ISA runs the same arithmetic on the same tree: bit-identical answers */
+      if (first_isa) first = h;
+      first_isa = 0;
+      assert_memory_equal(&h.t, &first.t, sizeof(float));
+      assert_int_equal(h.prim, first.prim);
+      assert_true(h.t == h.t);
+      if (h.prim != FR_INVALID_ID) {
+        assert_true(h.u >= 0.0f && h.v >= 0.0f && h.u + h.v <= 1.0f + 1e-6f);
+        assert_false(fr_mesh_degenerate_prim(sd.pos, sd.idx, h.prim));
+      }
+      /* and the scalar BVH2 reference, with the same triangle test, finds the same t */
+      if (clear) {
+        assert_memory_equal(&h.t, &ref.t, sizeof(float));
+        assert_int_equal(fr_occluded1(s, &ray), ref_occ);
+      }
+    }
+    if (!clear) continue;
+    checked++;
+    if (isinf(bt)) {
+      assert_true(ref.prim == FR_INVALID_ID);
+    } else {
+      hits++;
+      assert_true(ref.prim != FR_INVALID_ID);
+      assert_true(fabs(ref.t - bt) <= 1e-4 * fmax(1.0, fabs(bt)));
+    }
+  }
+  assert_true(checked > 2000);
+  assert_true(hits > 100);
+  fr_scene_release(s);
+  free(sd.pos);
+  free(sd.idx);
+}
+
+static void test_random_scene_origin(void **st) { (void)st; check_scene(v3(0, 0, 0), 1.0f, 11); }
+static void test_random_scene_far(void **st) { (void)st; check_scene(v3(1e4f, -2e4f, 5e3f), 50.0f, 12); }
+static void test_random_scene_tiny(void **st) { (void)st; check_scene(v3(0.1f, 0.2f, 0.3f), 1e-3f, 13); }
+
+/* Hostile rays: NaN, Inf, zero direction, tnear > tfar never hit, never NaN. */
+static void test_bad_rays(void **st) {
+  (void)st;
+  fr_scene *s;
+  assert_int_equal(fr_scene_builtin(&s), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  fr_ray bad[] = {
+      {{NAN, 1, 1}, 0, {0, -1, 0}, INFINITY}, {{0, 5, 0}, 0, {0, NAN, 0}, INFINITY},
+      {{0, 5, 0}, NAN, {0, -1, 0}, INFINITY}, {{0, 5, 0}, 0, {0, -1, 0}, NAN},
+      {{0, 5, 0}, 0, {0, 0, 0}, INFINITY},    {{0, 5, 0}, 10, {0, -1, 0}, 1},
+      {{INFINITY, 5, 0}, 0, {-1, -1, 0}, INFINITY}, {{0, 5, 0}, 0, {0, -INFINITY, 0}, INFINITY},
+  };
+  for (int isa = FR_ISA_SCALAR; isa <= FR_ISA_AVX512; isa++) {
+    if (!fr_isa_supported((fr_isa)isa)) continue;
+    fr_set_isa((fr_isa)isa);
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+      fr_hit h;
+      fr_intersect1(s, &bad[i], &h);
+      assert_int_equal(h.prim, FR_INVALID_ID);
+      assert_true(isinf(h.t));
+      assert_int_equal(fr_occluded1(s, &bad[i]), 0);
+    }
+    /* and a good one still hits the floor */
+    fr_ray good = {{0.3f, 5, 0.2f}, 0, {0, -1, 0}, INFINITY};
+    fr_hit h;
+    fr_intersect1(s, &good, &h);
+    assert_int_not_equal(h.prim, FR_INVALID_ID);
+  }
+  fr_scene_release(s);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_random_scene_origin),
+      cmocka_unit_test(test_random_scene_far),
+      cmocka_unit_test(test_random_scene_tiny),
+      cmocka_unit_test(test_bad_rays),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,63 @@
+/* Helpers shared by the tests: random numbers, scenes, a brute-force
+ * double-precision oracle. */
+#ifndef FR_TEST_UTIL_H
+#define FR_TEST_UTIL_H
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include "base/rng.h"
+#include "base/vec3.h"
+#include "frusta.h"
+
+static inline float urand(fr_rng *r, float lo, float hi) { return lo + (hi - lo) * fr_rng_float(r); }
+
+/* Closest hit by testing every triangle in double precision (Möller–Trumbore).
+ * Returns t (INFINITY for a miss) and the triangle's distance to the nearest
+ * edge in barycentric units, so callers can skip rays too close to an edge for
+ * float and double to be expected to agree. */
+static inline double brute_force(const float *pos, const uint32_t *idx, size_t ntris, const fr_ray *r,
+                                 uint32_t *prim, double *edge_margin, int skip_degenerate) {
+  double best = INFINITY;
+  *prim = FR_INVALID_ID;
+  *edge_margin = 1.0;
+  double o[3] = {r->org[0], r->org[1], r->org[2]}, d[3] = {r->dir[0], r->dir[1], r->dir[2]};
+  for (size_t t = 0; t < ntris; t++) {
+    const float *a = pos + 3 * (size_t)idx[3 * t], *b = pos + 3 * (size_t)idx[3 * t + 1], *c = pos + 3 * (size_t)idx[3 * t + 2];
+    double e1[3], e2[3], s[3];
+    for (int k = 0; k < 3; k++) { e1[k] = (double)b[k] - a[k]; e2[k] = (double)c[k] - a[k]; s[k] = o[k] - a[k]; }
+    double p[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2], d[0] * e2[1] - d[1] * e2[0]};
+    double det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
+    double nx = e1[1] * e2[2] - e1[2] * e2[1], ny = e1[2] * e2[0] - e1[0] * e2[2], nz = e1[0] * e2[1] - e1[1] * e2[0];
+    if (skip_degenerate && nx == 0 && ny == 0 && nz == 0) continue;
+    double nl = sqrt(nx * nx + ny * ny + nz * nz), dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (fabs(det) <= 1e-6 * nl * dl) {
+      /* ray (nearly) parallel to the plane: if it lies in the plane, any answer is right */
+      double sl = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+      if (fabs(s[0] * nx + s[1] * ny + s[2] * nz) <= 1e-5 * nl * (sl + 1e-30)) *edge_margin = 0.0;
+      continue;
+    }
+    double u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) / det;
+    double q[3] = {s[1] * e1[2] - s[2] * e1[1], s[2] * e1[0] - s[0] * e1[2], s[0] * e1[1] - s[1] * e1[0]};
+    double v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) / det;
+    double tt = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) / det;
+    double m = fmin(fmin(u, v), 1.0 - u - v);
+    if (m < -1e-3 || !(tt > r->tnear && tt < r->tfar)) continue;
+    /* near misses count as "close to an edge" too */
+    if (tt < best) {
+      if (m >= 0.0) { best = tt; *prim = (uint32_t)t; }
+    }
+    if (fabs(m) < *edge_margin && (m >= 0.0 || m > -1e-3)) *edge_margin = fabs(m);
+  }
+  return best;
+}
+/* Zero-area test on raw arrays, as the library's (double precision). */
+static inline int fr_mesh_degenerate_prim(const float *pos, const uint32_t *idx, uint32_t t) {
+  const float *a = pos + 3 * (size_t)idx[3 * t], *b = pos + 3 * (size_t)idx[3 * t + 1], *c = pos + 3 * (size_t)idx[3 * t + 2];
+  double e1[3], e2[3];
+  for (int k = 0; k < 3; k++) { e1[k] = (double)b[k] - a[k]; e2[k] = (double)c[k] - a[k]; }
+  return e1[1] * e2[2] - e1[2] * e2[1] == 0 && e1[2] * e2[0] - e1[0] * e2[2] == 0 && e1[0] * e2[1] - e1[1] * e2[0] == 0;
+}
+#endif
