@@ -130,7 +130,7 @@ void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, si
 void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occluded, size_t n);
 
 /* ---- reference paths (for tests and measurement, not speed) ---------------- */
-/* Plain scalar traversal of the binary BVH with the scalar Plücker test. */
+/* Plain scalar traversal of the binary BVH with the scalar watertight test. */
 void fr_intersect1_reference(const fr_scene *s, const fr_ray *ray, fr_hit *hit);
 int fr_occluded1_reference(const fr_scene *s, const fr_ray *ray);
 

@@ -2,7 +2,7 @@
  * 4-wide BVH (the MIC paper's layout): a node holds its four children's boxes
  * as structure of arrays, so one SIMD instruction tests all four slabs of an
  * axis. Leaves hold at most four triangles in one fr_tri4 block, vertices as
- * structure of arrays, tested four at once with the watertight Plücker test.
+ * structure of arrays, tested four at once with the watertight test (geom/tri_watertight.h).
  */
 #ifndef FR_ACCEL_BVH4_H
 #define FR_ACCEL_BVH4_H

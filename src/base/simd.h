@@ -69,6 +69,7 @@ FR_INLINE vmask4 vf4_le(vfloat4 a, vfloat4 b) { vmask4 r = FR_CMP4(a, b, _CMP_LE
 FR_INLINE vmask4 vf4_gt(vfloat4 a, vfloat4 b) { vmask4 r = FR_CMP4(a, b, _CMP_GT_OQ); return r; }
 FR_INLINE vmask4 vf4_ge(vfloat4 a, vfloat4 b) { vmask4 r = FR_CMP4(a, b, _CMP_GE_OQ); return r; }
 FR_INLINE vmask4 vf4_ne(vfloat4 a, vfloat4 b) { vmask4 r = FR_CMP4(a, b, _CMP_NEQ_UQ); return r; }
+FR_INLINE vmask4 vf4_eq(vfloat4 a, vfloat4 b) { vmask4 r = FR_CMP4(a, b, _CMP_EQ_OQ); return r; }
 
 #else /* FR_ISA_SCALAR: plain C, one lane at a time */
 
@@ -92,6 +93,7 @@ FR_INLINE vmask4 vf4_le(vfloat4 a, vfloat4 b) FR_MASK4(a.f[i] <= b.f[i])
 FR_INLINE vmask4 vf4_gt(vfloat4 a, vfloat4 b) FR_MASK4(a.f[i] > b.f[i])
 FR_INLINE vmask4 vf4_ge(vfloat4 a, vfloat4 b) FR_MASK4(a.f[i] >= b.f[i])
 FR_INLINE vmask4 vf4_ne(vfloat4 a, vfloat4 b) FR_MASK4(!(a.f[i] == b.f[i]))
+FR_INLINE vmask4 vf4_eq(vfloat4 a, vfloat4 b) FR_MASK4(a.f[i] == b.f[i])
 FR_INLINE vmask4 vm4_and(vmask4 a, vmask4 b) { vmask4 r = {a.m & b.m}; return r; }
 FR_INLINE vmask4 vm4_or(vmask4 a, vmask4 b) { vmask4 r = {a.m | b.m}; return r; }
 FR_INLINE int vm4_bits(vmask4 a) { return (int)a.m; }

@@ -8,7 +8,7 @@
  *
  * It is fast for packets, since the record is compact and the test branch-free
  * per lane, but not watertight: the hit point is recomputed per triangle, so a
- * ray through a shared edge can miss both. The BVH4 leaves use the Plücker test.
+ * ray through a shared edge can miss both. The BVH4 leaves use the watertight test (tri_watertight.h).
  */
 #ifndef FR_GEOM_TRI_SHEVTSOV_H
 #define FR_GEOM_TRI_SHEVTSOV_H

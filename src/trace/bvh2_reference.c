@@ -1,6 +1,6 @@
 #include "bvh2_reference.h"
 #include <math.h>
-#include "geom/tri_pluecker.h"
+#include "geom/tri_watertight.h"
 #include "trace/kernels.h"
 
 /* same widening as the SIMD kernels (see bvh4_single.c) */
@@ -32,6 +32,7 @@ static int traverse(const fr_bvh2 *b, const fr_mesh *m, const fr_ray *ray, fr_hi
   if (fr_ray_invalid(ray)) return 0;
   vec3 o = v3_load(ray->org), d = v3_load(ray->dir);
   vec3 rd = v3(rcp(d.x), rcp(d.y), rcp(d.z));
+  fr_wt_ray w = fr_wt_setup(d);
   float tfar = ray->tfar;
   uint32_t stack[256];
   int sp = 0, found = 0;
@@ -44,7 +45,7 @@ static int traverse(const fr_bvh2 *b, const fr_mesh *m, const fr_ray *ray, fr_hi
         uint32_t prim = b->prims[i];
         vec3 p0 = vertex(m, prim, 0), p1 = vertex(m, prim, 1), p2 = vertex(m, prim, 2);
         float t, u, v;
-        if (!fr_tri_pluecker(o, d, ray->tnear, tfar, p0, p1, p2, &t, &u, &v)) continue;
+        if (!fr_tri_watertight(&w, o, ray->tnear, tfar, p0, p1, p2, &t, &u, &v)) continue;
         if (any_hit) return 1;
         found = 1;
         tfar = t;

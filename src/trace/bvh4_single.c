@@ -1,12 +1,13 @@
 /*
  * Single-ray traversal of the 4-wide BVH (Benthin et al., MIC paper §IV):
  * one ray, four child boxes per SIMD test, nearest child first, and four
- * triangles per SIMD test in the leaves (watertight Plücker, see
- * geom/tri_pluecker.h). Compiled once per ISA through base/simd.h.
+ * triangles per SIMD test in the leaves (watertight, see
+ * geom/tri_watertight.h). Compiled once per ISA through base/simd.h.
  */
 #include <math.h>
 #include <string.h>
 #include "base/simd.h"
+#include "geom/tri_watertight.h"
 #include "trace/kernels.h"
 
 /* Conservative slab test (Ize, "Robust BVH Ray Traversal"): widen each box
@@ -21,7 +22,10 @@
 #define STACK_SIZE (3 * (FR_BUILD_MAX_DEPTH + 32) + 4)
 
 typedef struct ray4 {
-  vfloat4 ox, oy, oz, dx, dy, dz, rx, ry, rz;
+  vfloat4 ox, oy, oz, rx, ry, rz;
+  vfloat4 o_k[3];             /* origin in the shear frame: kx, ky, kz */
+  vfloat4 sx, sy, sz;         /* the watertight test's shear */
+  int kx, ky, kz;
   int near_x, near_y, near_z; /* float offsets of the near planes in a node */
   float tnear;
 } ray4;
@@ -35,7 +39,10 @@ static inline float safe_rcp(float d) {
 static inline void ray4_setup(ray4 *r, const fr_ray *ray) {
   float rx = safe_rcp(ray->dir[0]), ry = safe_rcp(ray->dir[1]), rz = safe_rcp(ray->dir[2]);
   r->ox = vf4(ray->org[0]); r->oy = vf4(ray->org[1]); r->oz = vf4(ray->org[2]);
-  r->dx = vf4(ray->dir[0]); r->dy = vf4(ray->dir[1]); r->dz = vf4(ray->dir[2]);
+  fr_wt_ray w = fr_wt_setup(v3_load(ray->dir));
+  r->kx = w.kx; r->ky = w.ky; r->kz = w.kz;
+  r->o_k[0] = vf4(ray->org[w.kx]); r->o_k[1] = vf4(ray->org[w.ky]); r->o_k[2] = vf4(ray->org[w.kz]);
+  r->sx = vf4(w.sx); r->sy = vf4(w.sy); r->sz = vf4(w.sz);
   r->rx = vf4(rx); r->ry = vf4(ry); r->rz = vf4(rz);
   /* node layout: lo_x 0, hi_x 4, lo_y 8, hi_y 12, lo_z 16, hi_z 20 */
   r->near_x = rx >= 0.0f ? 0 : 4;
@@ -60,30 +67,53 @@ FR_INLINE int box4(const fr_bvh4_node *n, const ray4 *r, float tfar, vfloat4 *di
   return vm4_bits(vf4_le(tn, vf4_mul(tf, vf4(ROUND_UP))));
 }
 
-typedef struct tri4_result { vfloat4 t, w1, w2, inv; vec3f4 ng; int mask; } tri4_result;
+typedef struct tri4_result { vfloat4 t, e1, e2, inv; int mask; } tri4_result;
 
-/* Four triangles against one ray; mask of lanes hit in (tnear, tfar). */
+/* Edge values of exactly zero are recomputed in double, lane by lane (rare). */
+static void exact_edges(vfloat4 *e0, vfloat4 *e1, vfloat4 *e2, vfloat4 ax, vfloat4 ay, vfloat4 bx, vfloat4 by,
+                        vfloat4 cx, vfloat4 cy, int lanes) {
+  float E0[4] __attribute__((aligned(16))), E1[4] __attribute__((aligned(16))), E2[4] __attribute__((aligned(16)));
+  float AX[4] __attribute__((aligned(16))), AY[4] __attribute__((aligned(16))), BX[4] __attribute__((aligned(16)));
+  float BY[4] __attribute__((aligned(16))), CX[4] __attribute__((aligned(16))), CY[4] __attribute__((aligned(16)));
+  vf4_store(E0, *e0); vf4_store(E1, *e1); vf4_store(E2, *e2);
+  vf4_store(AX, ax); vf4_store(AY, ay); vf4_store(BX, bx); vf4_store(BY, by); vf4_store(CX, cx); vf4_store(CY, cy);
+  for (int i = 0; i < 4; i++) {
+    if (!((lanes >> i) & 1)) continue;
+    E0[i] = (float)((double)CX[i] * BY[i] - (double)CY[i] * BX[i]);
+    E1[i] = (float)((double)AX[i] * CY[i] - (double)AY[i] * CX[i]);
+    E2[i] = (float)((double)BX[i] * AY[i] - (double)BY[i] * AX[i]);
+  }
+  *e0 = vf4_load(E0); *e1 = vf4_load(E1); *e2 = vf4_load(E2);
+}
+
+/* Four triangles against one ray; mask of lanes hit in (tnear, tfar). The
+ * same operations as fr_tri_watertight, lane by lane. */
 FR_INLINE void tri4_test(const fr_tri4 *tr, const ray4 *r, float tfar, tri4_result *res) {
-  vec3f4 o = {r->ox, r->oy, r->oz}, d = {r->dx, r->dy, r->dz};
-  vec3f4 p0 = {vf4_load(tr->v0[0]), vf4_load(tr->v0[1]), vf4_load(tr->v0[2])};
-  vec3f4 p1 = {vf4_load(tr->v1[0]), vf4_load(tr->v1[1]), vf4_load(tr->v1[2])};
-  vec3f4 p2 = {vf4_load(tr->v2[0]), vf4_load(tr->v2[1]), vf4_load(tr->v2[2])};
-  vec3f4 v0 = v3f4_sub(p0, o), v1 = v3f4_sub(p1, o), v2 = v3f4_sub(p2, o);
-  vfloat4 w0 = v3f4_dot(d, v3f4_cross(v3f4_sub(v1, v2), v3f4_add(v1, v2)));
-  vfloat4 w1 = v3f4_dot(d, v3f4_cross(v3f4_sub(v2, v0), v3f4_add(v2, v0)));
-  vfloat4 w2 = v3f4_dot(d, v3f4_cross(v3f4_sub(v0, v1), v3f4_add(v0, v1)));
+  vfloat4 az = vf4_sub(vf4_load(tr->v0[r->kz]), r->o_k[2]);
+  vfloat4 bz = vf4_sub(vf4_load(tr->v1[r->kz]), r->o_k[2]);
+  vfloat4 cz = vf4_sub(vf4_load(tr->v2[r->kz]), r->o_k[2]);
+  vfloat4 ax = vf4_sub(vf4_sub(vf4_load(tr->v0[r->kx]), r->o_k[0]), vf4_mul(r->sx, az));
+  vfloat4 ay = vf4_sub(vf4_sub(vf4_load(tr->v0[r->ky]), r->o_k[1]), vf4_mul(r->sy, az));
+  vfloat4 bx = vf4_sub(vf4_sub(vf4_load(tr->v1[r->kx]), r->o_k[0]), vf4_mul(r->sx, bz));
+  vfloat4 by = vf4_sub(vf4_sub(vf4_load(tr->v1[r->ky]), r->o_k[1]), vf4_mul(r->sy, bz));
+  vfloat4 cx = vf4_sub(vf4_sub(vf4_load(tr->v2[r->kx]), r->o_k[0]), vf4_mul(r->sx, cz));
+  vfloat4 cy = vf4_sub(vf4_sub(vf4_load(tr->v2[r->ky]), r->o_k[1]), vf4_mul(r->sy, cz));
+  vfloat4 e0 = vf4_sub(vf4_mul(cx, by), vf4_mul(cy, bx));
+  vfloat4 e1 = vf4_sub(vf4_mul(ax, cy), vf4_mul(ay, cx));
+  vfloat4 e2 = vf4_sub(vf4_mul(bx, ay), vf4_mul(by, ax));
   vfloat4 zero = vf4(0.0f);
-  vfloat4 lo = vf4_min(w0, vf4_min(w1, w2)), hi = vf4_max(w0, vf4_max(w1, w2));
+  int zeros = vm4_bits(vm4_or(vm4_or(vf4_eq(e0, zero), vf4_eq(e1, zero)), vf4_eq(e2, zero)));
+  if (__builtin_expect(zeros != 0, 0)) exact_edges(&e0, &e1, &e2, ax, ay, bx, by, cx, cy, zeros);
+  vfloat4 lo = vf4_min(e0, vf4_min(e1, e2)), hi = vf4_max(e0, vf4_max(e1, e2));
   vmask4 inside = vm4_or(vf4_ge(lo, zero), vf4_le(hi, zero));
-  vfloat4 den = vf4_add(vf4_add(w0, w1), w2);
-  vec3f4 ng = v3f4_cross(v3f4_sub(v1, v0), v3f4_sub(v2, v0));
-  vfloat4 tpl = v3f4_dot(v0, ng);
-  vfloat4 inv = vf4_div(vf4(1.0f), den);
-  vfloat4 t = vf4_mul(vf4_add(tpl, tpl), inv);
-  /* NaN (unused lanes, den == 0) fails the ordered compares on t */
-  vmask4 ok = vm4_and(vm4_and(inside, vf4_ne(den, zero)),
+  vfloat4 det = vf4_add(vf4_add(e0, e1), e2);
+  vfloat4 inv = vf4_div(vf4(1.0f), det);
+  vfloat4 tz = vf4_add(vf4_add(vf4_mul(e0, vf4_mul(r->sz, az)), vf4_mul(e1, vf4_mul(r->sz, bz))), vf4_mul(e2, vf4_mul(r->sz, cz)));
+  vfloat4 t = vf4_mul(tz, inv);
+  /* NaN (unused lanes, det == 0) fails the ordered compares on t */
+  vmask4 ok = vm4_and(vm4_and(inside, vf4_ne(det, zero)),
                       vm4_and(vf4_gt(t, vf4(r->tnear)), vf4_lt(t, vf4(tfar))));
-  res->t = t; res->w1 = w1; res->w2 = w2; res->inv = inv; res->ng = ng;
+  res->t = t; res->e1 = e1; res->e2 = e2; res->inv = inv;
   res->mask = vm4_bits(ok);
 }
 
@@ -173,12 +203,14 @@ static void intersect1(const fr_bvh4 *b, const fr_ray *ray, fr_hit *hit) {
   if (best_blk) {
     float inv = lane(best.inv, best_lane);
     hit->t = tfar;
-    hit->u = lane(best.w1, best_lane) * inv;
-    hit->v = lane(best.w2, best_lane) * inv;
+    hit->u = lane(best.e1, best_lane) * inv;
+    hit->v = lane(best.e2, best_lane) * inv;
     hit->prim = best_blk->prim[best_lane];
-    hit->ng[0] = lane(best.ng.x, best_lane);
-    hit->ng[1] = lane(best.ng.y, best_lane);
-    hit->ng[2] = lane(best.ng.z, best_lane);
+    vec3 p0 = v3(best_blk->v0[0][best_lane], best_blk->v0[1][best_lane], best_blk->v0[2][best_lane]);
+    vec3 p1 = v3(best_blk->v1[0][best_lane], best_blk->v1[1][best_lane], best_blk->v1[2][best_lane]);
+    vec3 p2 = v3(best_blk->v2[0][best_lane], best_blk->v2[1][best_lane], best_blk->v2[2][best_lane]);
+    vec3 ng = v3_cross(v3_sub(p1, p0), v3_sub(p2, p0));
+    hit->ng[0] = ng.x; hit->ng[1] = ng.y; hit->ng[2] = ng.z;
   }
 }
 

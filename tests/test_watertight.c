@@ -1,0 +1,121 @@
+/*
+ * Watertightness: from inside a closed mesh every ray must hit, including rays
+ * aimed exactly at shared vertices and along shared edges' midpoints, at every
+ * ISA level. A test that is not watertight lets a few of these slip through.
+ */
+#include <stdlib.h>
+#include "test_util.h"
+
+#define ST 24
+#define SL 48
+
+/* An irregular closed sphere: lat-long grid, one vertex per pole, radii jittered. */
+static fr_scene *closed_sphere(fr_rng *r, vec3 c, float radius, float **pos_out, size_t *nv_out) {
+  size_t nv = 2 + (ST - 1) * SL, nt = 2 * SL + 2 * SL * (ST - 2), v = 0, t = 0;
+  float *pos = malloc(nv * 3 * sizeof(float));
+  uint32_t *idx = malloc(nt * 3 * sizeof(uint32_t));
+#define PUT(x, y, z) (pos[3 * v] = (x), pos[3 * v + 1] = (y), pos[3 * v + 2] = (z), v++)
+  PUT(c.x, c.y + radius, c.z);
+  for (int i = 1; i < ST; i++)
+    for (int j = 0; j < SL; j++) {
+      float th = (float)M_PI * (float)i / ST, ph = 2.0f * (float)M_PI * (float)j / SL, rr = radius * urand(r, 0.8f, 1.2f);
+      PUT(c.x + rr * sinf(th) * cosf(ph), c.y + rr * cosf(th), c.z + rr * sinf(th) * sinf(ph));
+    }
+  PUT(c.x, c.y - radius, c.z);
+#define RING(i, j) (uint32_t)(1 + ((i) - 1) * SL + ((j) % SL))
+#define TRI(a, b, cc) (idx[3 * t] = (a), idx[3 * t + 1] = (b), idx[3 * t + 2] = (cc), t++)
+  for (int j = 0; j < SL; j++) TRI(0, RING(1, j + 1), RING(1, j));
+  for (int i = 1; i < ST - 1; i++)
+    for (int j = 0; j < SL; j++) {
+      TRI(RING(i, j), RING(i, j + 1), RING(i + 1, j + 1));
+      TRI(RING(i, j), RING(i + 1, j + 1), RING(i + 1, j));
+    }
+  for (int j = 0; j < SL; j++) TRI((uint32_t)(nv - 1), RING(ST - 1, j), RING(ST - 1, j + 1));
+  fr_scene *s;
+  assert_int_equal(fr_scene_from_arrays(pos, nv, idx, nt, &s), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  free(idx);
+  *pos_out = pos;
+  *nv_out = nv;
+  return s;
+}
+
+static void shoot_from_inside(vec3 center, float radius) {
+  fr_rng r = fr_rng_seed(99, (uint64_t)(radius * 1000));
+  float *pos;
+  size_t nv;
+  fr_scene *s = closed_sphere(&r, center, radius, &pos, &nv);
+  const uint32_t *idx = fr_scene_indices(s);
+  size_t nt = fr_scene_triangle_count(s);
+  long missed[3] = {0, 0, 0}, shot = 0;
+  for (int k = 0; k < 20000; k++) {
+    vec3 o = v3_add(center, v3(urand(&r, -0.3f, 0.3f) * radius, urand(&r, -0.3f, 0.3f) * radius, urand(&r, -0.3f, 0.3f) * radius));
+    vec3 target;
+    int mode = k % 3;
+    if (mode == 0) target = v3_load(pos + 3 * (fr_rng_u32(&r) % nv));           /* a vertex exactly */
+    else if (mode == 1) {                                                          /* an edge midpoint */
+      size_t t = fr_rng_u32(&r) % nt;
+      int e = (int)(fr_rng_u32(&r) % 3);
+      target = v3_scale(v3_add(v3_load(pos + 3 * idx[3 * t + e]), v3_load(pos + 3 * idx[3 * t + (e + 1) % 3])), 0.5f);
+    } else target = v3_add(o, v3(urand(&r, -1, 1), urand(&r, -1, 1), urand(&r, -1, 1)));
+    vec3 d = v3_sub(target, o);
+    if (v3_len(d) == 0.0f) continue;
+    fr_ray ray = {{o.x, o.y, o.z}, 0.0f, {d.x, d.y, d.z}, INFINITY};
+    shot++;
+    for (int isa = FR_ISA_SCALAR; isa <= FR_ISA_AVX512; isa++) {
+      if (!fr_isa_supported((fr_isa)isa)) continue;
+      fr_set_isa((fr_isa)isa);
+      fr_hit h;
+      fr_intersect1(s, &ray, &h);
+      missed[isa] += h.prim == FR_INVALID_ID;
+      missed[isa] += !fr_occluded1(s, &ray);
+    }
+  }
+  print_message("closed sphere r=%g at (%g,%g,%g): %ld rays, missed scalar=%ld avx2=%ld avx512=%ld\n", radius,
+                center.x, center.y, center.z, shot, missed[0], missed[1], missed[2]);
+  for (int i = 0; i < 3; i++) assert_int_equal(missed[i], 0);
+  fr_scene_release(s);
+  free(pos);
+}
+
+static void test_closed_unit(void **st) { (void)st; shoot_from_inside(v3(0, 0, 0), 1.0f); }
+static void test_closed_far(void **st) { (void)st; shoot_from_inside(v3(3e3f, -1e3f, 7e2f), 2.0f); }
+static void test_closed_small(void **st) { (void)st; shoot_from_inside(v3(0.01f, 0.02f, 0.0f), 1e-3f); }
+
+/* The built-in scene's spheres and boxes are closed too: from each object's
+ * centre, rays at every one of its vertices must hit. */
+static void test_builtin_objects_closed(void **st) {
+  (void)st;
+  fr_scene *s;
+  assert_int_equal(fr_scene_builtin(&s), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  const float *pos = fr_scene_vertices(s);
+  /* the sphere at grid (0,0) and the box at grid (0,1), see geom/builtin_scene.c */
+  vec3 centers[2] = {v3(-8.25f, 0.45f, -8.25f), v3(-8.25f, 0.3f, -6.75f)};
+  long missed = 0, shot = 0;
+  for (size_t v = 4; v < fr_scene_vertex_count(s); v++) {
+    vec3 p = v3_load(pos + 3 * v);
+    for (int c = 0; c < 2; c++) {
+      vec3 d = v3_sub(p, centers[c]);
+      if (v3_len(d) > 0.8f) continue;
+      fr_ray ray = {{centers[c].x, centers[c].y, centers[c].z}, 0, {d.x, d.y, d.z}, INFINITY};
+      fr_hit h;
+      fr_intersect1(s, &ray, &h);
+      shot++;
+      missed += h.prim == FR_INVALID_ID;
+    }
+  }
+  assert_true(shot > 1000);
+  assert_int_equal(missed, 0);
+  fr_scene_release(s);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_closed_unit),
+      cmocka_unit_test(test_closed_far),
+      cmocka_unit_test(test_closed_small),
+      cmocka_unit_test(test_builtin_objects_closed),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
