@@ -1,0 +1,191 @@
+/* Importers: the formats they must read, and the broken or hostile files they
+ * must refuse with a one-line message instead of crashing. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include <zstd.h>
+#include "test_util.h"
+
+static char tmpdir[256];
+
+static const char *write_file(const char *name, const void *data, size_t n) {
+  static char path[512];
+  snprintf(path, sizeof path, "%s/%s", tmpdir, name);
+  FILE *f = fopen(path, "wb");
+  assert_non_null(f);
+  assert_int_equal(fwrite(data, 1, n, f), n);
+  fclose(f);
+  return path;
+}
+
+static fr_error load(const char *name, const void *data, size_t n, fr_scene **s) {
+  return fr_scene_load(write_file(name, data, n), s);
+}
+
+static void expect_error(const char *name, const void *data, size_t n, fr_error want) {
+  fr_scene *s = (fr_scene *)1;
+  fr_error e = load(name, data, n, &s);
+  if (e != want) print_message("%s: got %d (%s), wanted %d\n", name, e, fr_last_error(), want);
+  assert_int_equal(e, want);
+  assert_null(s);
+  const char *msg = fr_last_error();
+  assert_true(strlen(msg) > 5);
+  assert_null(strchr(msg, '\n'));
+}
+
+static const char ply_ascii[] =
+    "ply\nformat ascii 1.0\ncomment test\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+    "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
+    "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n4 0 1 2 3\n3 0 1 4\n";
+
+static void test_ply_ascii_fan(void **st) {
+  (void)st;
+  fr_scene *s;
+  assert_int_equal(load("a.ply", ply_ascii, strlen(ply_ascii), &s), FR_OK);
+  assert_int_equal(fr_scene_triangle_count(s), 3);
+  const uint32_t *ix = fr_scene_indices(s);
+  uint32_t want[9] = {0, 1, 2, 0, 2, 3, 0, 1, 4}; /* fan order of rayfile.md */
+  assert_memory_equal(ix, want, sizeof want);
+  fr_scene_release(s);
+}
+
+static size_t binary_ply(unsigned char *buf, int big_endian, uint32_t nv_claim, uint32_t nf_claim, int bad_index, float nan_vertex) {
+  size_t n = (size_t)sprintf((char *)buf,
+                             "ply\nformat %s 1.0\nelement vertex %u\nproperty float x\nproperty float y\nproperty float z\n"
+                             "element face %u\nproperty list uchar int vertex_indices\nend_header\n",
+                             big_endian ? "binary_big_endian" : "binary_little_endian", nv_claim, nf_claim);
+  float v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  v[4] = nan_vertex;
+  for (int i = 0; i < 9; i++) {
+    unsigned char b[4];
+    memcpy(b, &v[i], 4);
+    for (int k = 0; k < 4; k++) buf[n++] = b[big_endian ? 3 - k : k];
+  }
+  buf[n++] = 3;
+  int32_t idx[3] = {0, 1, bad_index ? bad_index : 2};
+  for (int i = 0; i < 3; i++) {
+    unsigned char b[4];
+    memcpy(b, &idx[i], 4);
+    for (int k = 0; k < 4; k++) buf[n++] = b[big_endian ? 3 - k : k];
+  }
+  return n;
+}
+
+static void test_ply_binary(void **st) {
+  (void)st;
+  unsigned char buf[1024];
+  for (int be = 0; be < 2; be++) {
+    size_t n = binary_ply(buf, be, 3, 1, 0, 0.0f);
+    fr_scene *s;
+    assert_int_equal(load(be ? "be.ply" : "le.ply", buf, n, &s), FR_OK);
+    assert_int_equal(fr_scene_triangle_count(s), 1);
+    assert_true(fr_scene_vertices(s)[3] == 1.0f);
+    fr_scene_release(s);
+  }
+}
+
+static void test_ply_hostile(void **st) {
+  (void)st;
+  unsigned char buf[1024];
+  size_t n = binary_ply(buf, 0, 3, 1, 0, 0.0f);
+  expect_error("trunc.ply", buf, n - 5, FR_ERR_FORMAT);               /* truncated */
+  n = binary_ply(buf, 0, 4000000000u, 1, 0, 0.0f);
+  expect_error("liar.ply", buf, n, FR_ERR_FORMAT);                   /* lying vertex count */
+  n = binary_ply(buf, 0, 3, 1, 7, 0.0f);
+  expect_error("range.ply", buf, n, FR_ERR_FORMAT);                  /* index out of range */
+  n = binary_ply(buf, 0, 3, 1, -2, 0.0f);
+  expect_error("neg.ply", buf, n, FR_ERR_FORMAT);                    /* negative index */
+  n = binary_ply(buf, 0, 3, 1, 0, NAN);
+  expect_error("nan.ply", buf, n, FR_ERR_FORMAT);                    /* NaN vertex */
+  n = binary_ply(buf, 0, 3, 1, 0, INFINITY);
+  expect_error("inf.ply", buf, n, FR_ERR_FORMAT);                    /* Inf vertex */
+  n = binary_ply(buf, 0, 3, 0, 0, 0.0f);
+  expect_error("empty.ply", buf, n, FR_ERR_FORMAT);                  /* no triangles */
+  expect_error("garbage.ply", "\x01\x02garbage", 9, FR_ERR_FORMAT);
+  expect_error("zero.ply", "", 0, FR_ERR_FORMAT);
+  const char *hdr = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n";
+  expect_error("noend.ply", hdr, strlen(hdr), FR_ERR_FORMAT);
+  const char *bigpoly = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                        "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n200 0 1 2\n";
+  expect_error("shortpoly.ply", bigpoly, strlen(bigpoly), FR_ERR_FORMAT);
+  fr_scene *s = (fr_scene *)1;
+  assert_int_equal(fr_scene_load("/nonexistent/x.ply", &s), FR_ERR_IO);
+  assert_null(s);
+}
+
+static void test_obj_mtl_and_zst(void **st) {
+  (void)st;
+  const char *mtl = "newmtl glass\nKd 0.1 0.2 0.3\nKs 1 1 1\nNs 50\nNi 1.5\nd 0.25\n";
+  const char *obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl glass\nf 1/1/1 2/2/2 3/3/3 4/4/4\nusemtl other\nf -4 -3 -1\n";
+  /* the MTL only as .zst: found through the fallback */
+  size_t cap = ZSTD_compressBound(strlen(mtl));
+  char *z = malloc(cap);
+  size_t zn = ZSTD_compress(z, cap, mtl, strlen(mtl), 3);
+  write_file("m.mtl.zst", z, zn);
+  free(z);
+  fr_scene *s;
+  assert_int_equal(load("a.obj", obj, strlen(obj), &s), FR_OK);
+  assert_int_equal(fr_scene_triangle_count(s), 3);
+  uint32_t m0 = fr_scene_triangle_material(s, 0), m2 = fr_scene_triangle_material(s, 2);
+  const fr_material *g = fr_scene_material(s, m0);
+  assert_string_equal(g->name, "glass");
+  assert_true(g->diffuse[2] == 0.3f && g->ior == 1.5f && g->transmission[0] == 0.75f);
+  assert_string_equal(fr_scene_material(s, m2)->name, "other");
+  const uint32_t want[9] = {0, 1, 2, 0, 2, 3, 0, 1, 3};
+  assert_memory_equal(fr_scene_indices(s), want, sizeof want);
+  fr_scene_release(s);
+  /* the OBJ itself compressed */
+  cap = ZSTD_compressBound(strlen(obj));
+  z = malloc(cap);
+  zn = ZSTD_compress(z, cap, obj, strlen(obj), 3);
+  assert_int_equal(load("b.obj.zst", z, zn, &s), FR_OK);
+  assert_int_equal(fr_scene_triangle_count(s), 3);
+  fr_scene_release(s);
+  expect_error("trunc.obj.zst", z, zn / 2, FR_ERR_FORMAT);
+  free(z);
+  expect_error("bad.obj", "v 0 0 0\nf 1 2 3\n", 16, FR_ERR_FORMAT);
+  expect_error("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", 32, FR_ERR_FORMAT);
+  expect_error("nanv.obj", "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", 34, FR_ERR_FORMAT);
+  expect_error("empty.obj", "# nothing\n", 10, FR_ERR_FORMAT);
+}
+
+static void test_assimp_path(void **st) {
+  (void)st;
+  /* an STL (not PLY/OBJ) goes through Assimp */
+  const char *stl = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n";
+  fr_scene *s;
+  assert_int_equal(load("t.stl", stl, strlen(stl), &s), FR_OK);
+  assert_int_equal(fr_scene_triangle_count(s), 1);
+  fr_scene_release(s);
+  expect_error("bad.stl", "solid x\nfacet garbage", 21, FR_ERR_FORMAT);
+}
+
+static void test_degenerate_only(void **st) {
+  (void)st;
+  const float v[9] = {0, 0, 0, 1, 1, 1, 2, 2, 2};
+  const uint32_t ix[3] = {0, 1, 2};
+  fr_scene *s;
+  assert_int_equal(fr_scene_from_arrays(v, 3, ix, 1, &s), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_ERR_FORMAT);
+  fr_ray r = {{0.5f, 0.5f, -1}, 0, {0, 0, 1}, INFINITY};
+  fr_hit h;
+  fr_intersect1(s, &r, &h); /* not committed: a miss, not a crash */
+  assert_int_equal(h.prim, FR_INVALID_ID);
+  fr_scene_release(s);
+}
+
+int main(void) {
+  snprintf(tmpdir, sizeof tmpdir, "/tmp/frusta_test_import_%d", (int)getpid());
+  char cmd[300];
+  snprintf(cmd, sizeof cmd, "mkdir -p %s", tmpdir);
+  if (system(cmd) != 0) return 1;
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_ply_ascii_fan),  cmocka_unit_test(test_ply_binary),   cmocka_unit_test(test_ply_hostile),
+      cmocka_unit_test(test_obj_mtl_and_zst), cmocka_unit_test(test_assimp_path), cmocka_unit_test(test_degenerate_only),
+  };
+  int rc = cmocka_run_group_tests(tests, NULL, NULL);
+  snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
+  if (system(cmd) != 0) rc = 1;
+  return rc;
+}
