@@ -18,7 +18,7 @@ static void usage(FILE *f) {
 }
 
 int main(int argc, char **argv) {
-  if (argc < 2) { usage(stderr); return CLI_USAGE_ERROR; }
+  if (argc < 2) return cli_error(CLI_USAGE_ERROR, "no command given (render, bench, trace or stats; see frusta --help)");
   const char *cmd = argv[1];
   if (strcmp(cmd, "-h") == 0 || strcmp(cmd, "--help") == 0 || strcmp(cmd, "help") == 0) { usage(stdout); return 0; }
   const char *isa = getenv("FRUSTA_ISA");

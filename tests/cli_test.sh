@@ -1,0 +1,86 @@
+#!/bin/sh
+# The command line as a user meets it: exit codes, one-line errors, whole
+# outputs or none. usage: cli_test.sh FRUSTA SHARED_DIR
+set -u
+F="$1"; SHARED="$2"
+T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
+fails=0; passes=0
+ok() { passes=$((passes+1)); }
+bad() { echo "FAIL: $*"; fails=$((fails+1)); }
+
+# expect CODE CMD...: exit code CODE, and on failure exactly one line on stderr starting "frusta: "
+expect() {
+  want=$1; shift
+  "$@" >"$T/out" 2>"$T/err"; got=$?
+  if [ "$got" -ne "$want" ]; then bad "exit $got, wanted $want: $*"; cat "$T/err"; return; fi
+  if [ "$want" -ne 0 ]; then
+    lines=$(wc -l <"$T/err")
+    if [ "$lines" -ne 1 ] || ! grep -q '^frusta: ' "$T/err"; then bad "not a one-line error ($lines lines): $*"; cat "$T/err"; return; fi
+  fi
+  ok
+}
+
+expect 2 "$F"
+expect 2 "$F" frobnicate
+expect 2 "$F" render --builtin
+expect 2 "$F" render --builtin --out "$T/a.png" --size 0x0
+expect 2 "$F" render --builtin --out "$T/a.png" --size 10
+expect 2 "$F" render --builtin --out "$T/a.png" --fov 200
+expect 2 "$F" render --builtin --out "$T/a.png" --eye 1,2
+expect 2 "$F" render --builtin --out "$T/a.png" --shade fancy
+expect 2 "$F" render --builtin --out "$T/a.bmp"
+expect 2 "$F" render --builtin --out "$T/a.png" --bogus
+expect 1 "$F" render "$T/missing.ply" --out "$T/a.png"
+printf 'ply\nformat binary_little_endian 1.0\nelement vertex 99999999\nproperty float x\nproperty float y\nproperty float z\nend_header\n' >"$T/liar.ply"
+expect 1 "$F" render "$T/liar.ply" --out "$T/a.png"
+printf 'garbage' >"$T/g.ply.zst"
+expect 1 "$F" stats "$T/g.ply.zst"
+[ ! -e "$T/a.png" ] && ok || bad "a failed render left an output file"
+expect 1 "$F" render --builtin --size 32x24 --out "$T/nodir/a.png"
+[ -z "$(ls "$T" | grep tmp)" ] && ok || bad "temporary file left behind"
+
+for ext in png exr pfm; do
+  expect 0 "$F" render --builtin --size 64x48 --shade shadows --out "$T/b.$ext"
+  [ -s "$T/b.$ext" ] && ok || bad "no $ext written"
+done
+head -c 4 "$T/b.png" | od -c | grep -q 'P   N   G' && ok || bad "not a PNG"
+head -c 2 "$T/b.pfm" | grep -q PF && ok || bad "not a PFM"
+
+expect 2 "$F" bench --builtin --workload primary
+expect 2 "$F" bench --builtin --workload nope --mode single
+expect 2 "$F" bench --builtin --workload primary --mode packet16 --tracer frusta
+expect 2 "$F" bench --builtin --workload primary --mode single --threads 0
+expect 0 "$F" bench --builtin --workload shadow --mode single --tracer both --size 64x64 --repeat 1
+grep -q '^scene=builtin tris=[0-9]* workload=shadow tracer=frusta mode=single threads=[0-9]* rays=[0-9]* seconds=' "$T/out" && ok || bad "bench line format"
+grep -q 'tracer=embree mode=single' "$T/out" && ok || bad "no embree line"
+
+# ray files: a small one written with perl (part of every Debian system)
+perl -e 'my @r; for my $i (0..99) { push @r, pack("f<8", -0.5+$i*0.01, 5, 0.1, 0, -1, 0.001*$i, 0, 9**9**9) } print "RAYS0001", pack("Q<", 100), @r;' >"$T/r.rays"
+expect 0 "$F" trace --builtin "$T/r.rays" --query closest --out "$T/f.hits"
+expect 0 "$F" trace --builtin "$T/r.rays" --query closest --out "$T/e.hits" --tracer embree
+expect 0 "$F" trace --builtin "$T/r.rays" --query any --out "$T/f.occl"
+[ "$(head -c 8 "$T/f.hits")" = "HITS0001" ] && ok || bad "hits magic"
+[ "$(stat -c %s "$T/f.hits")" -eq $((16 + 16 * 100)) ] && ok || bad "hits size"
+[ "$(stat -c %s "$T/f.occl")" -eq $((16 + 100)) ] && ok || bad "occl size"
+perl -e 'open(A,"<",$ARGV[0]); open(B,"<",$ARGV[1]); binmode A; binmode B; read(A,$a,1e7); read(B,$b,1e7);
+  my $n = unpack("Q<", substr($a,8,8)); my $bad = 0; my $hits = 0;
+  for my $i (0..$n-1) { my ($t1) = unpack("f<", substr($a,16+16*$i,4)); my ($t2) = unpack("f<", substr($b,16+16*$i,4));
+    my $m1 = $t1 > 1e38; my $m2 = $t2 > 1e38; $hits++ unless $m1;
+    if ($m1 || $m2) { $bad++ unless $m1 && $m2; next }
+    my $s = abs($t1) > 1 ? abs($t1) : 1; $bad++ if abs($t1-$t2) > 1e-4*$s; }
+  exit($bad == 0 && $hits > 50 ? 0 : 1);' "$T/f.hits" "$T/e.hits" && ok || bad "frusta and embree hit files disagree"
+head -c 100 "$T/r.rays" >"$T/trunc.rays"
+expect 1 "$F" trace --builtin "$T/trunc.rays" --query closest --out "$T/t.hits"
+[ ! -e "$T/t.hits" ] && ok || bad "partial hit file"
+expect 2 "$F" trace --builtin "$T/r.rays" --query nearest --out "$T/x.hits"
+expect 1 "$F" trace --builtin "$T/none.rays" --query any --out "$T/x.occl"
+expect 0 "$F" stats --builtin
+
+# every ISA level runs the command
+for isa in scalar avx2 avx512; do
+  FRUSTA_ISA=$isa "$F" trace --builtin "$T/r.rays" --query closest --out "$T/$isa.hits" && ok || bad "FRUSTA_ISA=$isa"
+done
+cmp -s "$T/scalar.hits" "$T/avx512.hits" && cmp -s "$T/avx2.hits" "$T/avx512.hits" && ok || bad "ISA levels differ"
+
+echo "cli: $passes passed, $fails failed"
+[ "$fails" -eq 0 ]
