@@ -5,6 +5,7 @@
 #include <string.h>
 #include "base/rng.h"
 #include "base/timer.h"
+#include "trace/counters.h"
 
 #define TILE 8
 #define TILE_PIX (TILE * TILE)
@@ -224,6 +225,9 @@ fr_workload_result fr_workload_run(const fr_workload *w, const fr_tracer *t) {
       }
     }
     free(B);
+#ifdef FRUSTA_COUNTERS
+    fr_counters_flush();
+#endif
   }
   fr_workload_result r = {total, fr_seconds() - t0};
   if (w->progress && last_pct >= 0) fprintf(stderr, "\n");

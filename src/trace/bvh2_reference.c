@@ -4,8 +4,7 @@
 #include "trace/kernels.h"
 
 /* same widening as the SIMD kernels (see bvh4_single.c) */
-#define ROUND_DOWN (1.0f - 0x1p-21f)
-#define ROUND_UP (1.0f + 0x1p-21f)
+#define ROUND_UP (1.0f + 0x1p-20f)
 
 static int box_hit(const fr_bvh2_node *n, int k, vec3 o, vec3 rd, float tnear, float tfar) {
   float lo[3] = {n->lo_x[k], n->lo_y[k], n->lo_z[k]}, hi[3] = {n->hi_x[k], n->hi_y[k], n->hi_z[k]};
@@ -17,7 +16,7 @@ static int box_hit(const fr_bvh2_node *n, int k, vec3 o, vec3 rd, float tnear, f
     tn = t0 > tn ? t0 : tn;
     tf = t1 < tf ? t1 : tf;
   }
-  return tn * ROUND_DOWN <= tf * ROUND_UP;
+  return tn <= tf * ROUND_UP;
 }
 
 static vec3 vertex(const fr_mesh *m, uint32_t prim, int k) { return v3_load(m->pos + 3 * (size_t)m->idx[3 * (size_t)prim + k]); }

@@ -8,14 +8,14 @@
 #include <string.h>
 #include "base/simd.h"
 #include "geom/tri_watertight.h"
+#include "trace/counters.h"
 #include "trace/kernels.h"
 
 /* Conservative slab test (Ize, "Robust BVH Ray Traversal"): widen each box
  * interval by a few ulps so that rounding in (plane - org) * rdir never culls a
  * box a triangle hit lies in; this keeps the traversal as watertight as the
  * triangle test. */
-#define ROUND_DOWN (1.0f - 0x1p-21f)
-#define ROUND_UP (1.0f + 0x1p-21f)
+#define ROUND_UP (1.0f + 0x1p-20f)
 
 /* Entries a traversal can have pending: three per level, and the builder caps
  * the depth (FR_BUILD_MAX_DEPTH plus median splits of at most 2^27 triangles). */
@@ -62,7 +62,6 @@ FR_INLINE int box4(const fr_bvh4_node *n, const ray4 *r, float tfar, vfloat4 *di
   vfloat4 tfz = vf4_mul(vf4_sub(vf4_load(f + (r->near_z ^ 4)), r->oz), r->rz);
   vfloat4 tn = vf4_max(vf4_max(tnx, tny), vf4_max(tnz, vf4(r->tnear)));
   vfloat4 tf = vf4_min(vf4_min(tfx, tfy), vf4_min(tfz, vf4(tfar)));
-  tn = vf4_mul(tn, vf4(ROUND_DOWN));
   *dist = tn;
   return vm4_bits(vf4_le(tn, vf4_mul(tf, vf4(ROUND_UP))));
 }
@@ -106,6 +105,8 @@ FR_INLINE void tri4_test(const fr_tri4 *tr, const ray4 *r, float tfar, tri4_resu
   if (__builtin_expect(zeros != 0, 0)) exact_edges(&e0, &e1, &e2, ax, ay, bx, by, cx, cy, zeros);
   vfloat4 lo = vf4_min(e0, vf4_min(e1, e2)), hi = vf4_max(e0, vf4_max(e1, e2));
   vmask4 inside = vm4_or(vf4_ge(lo, zero), vf4_le(hi, zero));
+  res->mask = 0;
+  if (!vm4_bits(inside)) return; /* most leaf tests end here, before the division */
   vfloat4 det = vf4_add(vf4_add(e0, e1), e2);
   vfloat4 inv = vf4_div(vf4(1.0f), det);
   vfloat4 tz = vf4_add(vf4_add(vf4_mul(e0, vf4_mul(r->sz, az)), vf4_mul(e1, vf4_mul(r->sz, bz))), vf4_mul(e2, vf4_mul(r->sz, cz)));
@@ -158,6 +159,7 @@ FR_INLINE uint32_t order_children(const fr_bvh4_node *n, int mask, vfloat4 dist4
 
 static void intersect1(const fr_bvh4 *b, const fr_ray *ray, fr_hit *hit) {
   fr_hit_miss(hit);
+  FR_COUNT(rays, 1);
   if (fr_ray_invalid(ray)) return;
   ray4 r;
   ray4_setup(&r, ray);
@@ -177,10 +179,14 @@ static void intersect1(const fr_bvh4 *b, const fr_ray *ray, fr_hit *hit) {
       const fr_bvh4_node *n = &b->nodes[ref];
       vfloat4 dist;
       int mask = box4(n, &r, tfar, &dist);
+      FR_COUNT(nodes, 1);
+      FR_COUNT(box_tests, n->nchildren);
       if (!mask) goto next;
       ref = order_children(n, mask, dist, stack, &sp);
     }
     {
+      FR_COUNT(leaves, 1);
+      FR_COUNT(tri_tests, 4);
       const fr_tri4 *blk = &b->tris[ref & ~FR_BVH4_LEAF];
       tri4_result res;
       tri4_test(blk, &r, tfar, &res);
@@ -215,6 +221,7 @@ static void intersect1(const fr_bvh4 *b, const fr_ray *ray, fr_hit *hit) {
 }
 
 static int occluded1(const fr_bvh4 *b, const fr_ray *ray) {
+  FR_COUNT(rays, 1);
   if (fr_ray_invalid(ray)) return 0;
   ray4 r;
   ray4_setup(&r, ray);
@@ -228,12 +235,16 @@ static int occluded1(const fr_bvh4 *b, const fr_ray *ray) {
       const fr_bvh4_node *n = &b->nodes[ref];
       vfloat4 dist;
       int mask = box4(n, &r, tfar, &dist);
+      FR_COUNT(nodes, 1);
+      FR_COUNT(box_tests, n->nchildren);
       if (!mask) goto next;
       /* any hit ends the search, so order matters less; nearest first still
        * finds occluders sooner in closed scenes */
       ref = order_children(n, mask, dist, stack, &sp);
     }
     {
+      FR_COUNT(leaves, 1);
+      FR_COUNT(tri_tests, 4);
       tri4_result res;
       tri4_test(&b->tris[ref & ~FR_BVH4_LEAF], &r, tfar, &res);
       if (res.mask) return 1;

@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "embree_tracer.h"
 #include "render/workload.h"
+#include "trace/counters.h"
 
 static const char *frusta_modes[] = {"single"};
 #define N_FRUSTA_MODES 1
@@ -25,6 +26,7 @@ static void run(const fr_workload *w0, const fr_tracer *t, const char *scene, si
                 const char *mode, int repeat) {
   double secs[64];
   uint64_t rays = 0;
+  fr_counters_reset();
   for (int k = 0; k < repeat; k++) {
     fr_workload_result r = fr_workload_run(w0, t);
     secs[k] = r.seconds;
@@ -35,6 +37,11 @@ static void run(const fr_workload *w0, const fr_tracer *t, const char *scene, si
   printf("scene=%s tris=%zu workload=%s tracer=%s mode=%s threads=%d rays=%llu seconds=%.4f mrays=%.2f median_seconds=%.4f median_mrays=%.2f\n",
          scene, tris, fr_workload_name(w0->kind), tracer, mode, w0->threads, (unsigned long long)rays, best,
          (double)rays / best * 1e-6, med, (double)rays / med * 1e-6);
+  fr_counters c = fr_counters_read();
+  if (fr_counters_enabled() && c.rays)
+    printf("counters tracer=%s mode=%s workload=%s per_ray nodes=%.2f box_tests=%.2f leaves=%.2f tri_tests=%.2f\n", tracer, mode,
+           fr_workload_name(w0->kind), (double)c.nodes / c.rays, (double)c.box_tests / c.rays, (double)c.leaves / c.rays,
+           (double)c.tri_tests / c.rays);
   fflush(stdout);
 }
 
@@ -103,7 +110,7 @@ int cmd_bench(int argc, char **argv) {
          (double)(st.bvh4_bytes + st.tri_bytes) / (double)tris);
   ebr_scene *e = NULL;
   if (use_embree) {
-    ebr_options o = {threads, 2, 0}; /* high quality, not robust: Embree's fastest tracing */
+    ebr_options o = {threads, getenv("EBR_Q") ? atoi(getenv("EBR_Q")) : 2, 0};
     if (ebr_create(s, o, &e)) { fr_scene_release(s); return cli_error(1, "embree: cannot build the scene"); }
     printf("build_seconds=%.3f tracer=embree scene=%s tris=%zu threads=%d quality=high bytes_per_tri=%.1f\n",
            ebr_build_seconds(e), s->name, tris, threads, (double)ebr_bytes(e) / (double)tris);

@@ -1,0 +1,26 @@
+#include "counters.h"
+#include <string.h>
+
+#ifdef FRUSTA_COUNTERS
+_Thread_local fr_counters fr_tls_counters;
+static fr_counters total;
+
+void fr_counters_flush(void) {
+#pragma omp critical(fr_counters)
+  {
+    total.rays += fr_tls_counters.rays;
+    total.nodes += fr_tls_counters.nodes;
+    total.box_tests += fr_tls_counters.box_tests;
+    total.leaves += fr_tls_counters.leaves;
+    total.tri_tests += fr_tls_counters.tri_tests;
+  }
+  memset(&fr_tls_counters, 0, sizeof fr_tls_counters);
+}
+int fr_counters_enabled(void) { return 1; }
+void fr_counters_reset(void) { memset(&total, 0, sizeof total); memset(&fr_tls_counters, 0, sizeof fr_tls_counters); }
+fr_counters fr_counters_read(void) { return total; }
+#else
+int fr_counters_enabled(void) { return 0; }
+void fr_counters_reset(void) {}
+fr_counters fr_counters_read(void) { fr_counters c; memset(&c, 0, sizeof c); return c; }
+#endif
