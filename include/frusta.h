@@ -91,19 +91,31 @@ uint32_t fr_scene_triangle_material(const fr_scene *s, uint32_t prim); /* FR_INV
 /* Triangles dropped from the BVH because they are degenerate or not finite. */
 size_t fr_scene_skipped_triangles(const fr_scene *s);
 
+/* SAH costs count a node visit (one SIMD test of all its boxes) and a
+ * triangle test as 1, relative to the root's surface area. */
+typedef struct fr_wide_stats {
+  size_t inner, leaves;
+  size_t node_bytes, tri_bytes;  /* nodes, leaf triangle blocks */
+  double sah;
+  double node_fill;              /* mean children per inner node */
+  double leaf_fill;              /* mean triangles per leaf (of 4) */
+  int depth;
+} fr_wide_stats;
+
 typedef struct fr_bvh_stats {
-  /* binary BVH */
   size_t bvh2_inner, bvh2_leaves;
-  double bvh2_sah, bvh2_leaf_fill;   /* mean triangles per leaf */
-  /* 4-wide BVH */
-  size_t bvh4_inner, bvh4_leaves;
-  double bvh4_sah, bvh4_node_fill;   /* mean children per inner node (of 4) */
-  double bvh4_leaf_fill;             /* mean triangles per leaf (of 4) */
-  size_t bvh4_bytes, tri_bytes;      /* nodes, leaf triangle blocks */
-  double build_seconds;              /* BVH2 + BVH4 + triangle records */
-  int depth4;
+  double bvh2_sah, bvh2_leaf_fill;
+  size_t bvh2_bytes;
+  fr_wide_stats bvh4, bvh8;
+  double build_seconds;          /* SAH build + every layout */
+  int single_width;              /* the BVH fr_intersect1 uses: 4 or 8 */
 } fr_bvh_stats;
 fr_error fr_scene_stats(const fr_scene *s, fr_bvh_stats *out);
+
+/* Which BVH the single-ray calls traverse: 8-wide (default, fastest on AVX2
+ * and AVX-512) or 4-wide (the MIC paper's). FRUSTA_BVH_WIDTH=4|8 sets the
+ * default. Both are always built. */
+fr_error fr_scene_set_bvh_width(fr_scene *s, int width);
 
 /* ---- single rays ----------------------------------------------------------- */
 typedef struct fr_ray {

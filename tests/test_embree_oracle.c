@@ -57,15 +57,16 @@ static void check_scene(const char *path) {
   size_t cap = 4 * SIDE * SIDE;
   fr_ray *rays = malloc(cap * sizeof *rays);
   size_t n = make_rays(s, rays, cap);
-  long bad_hit[3] = {0}, bad_occ[3] = {0}, hits = 0;
+  long bad_hit[6] = {0}, bad_occ[6] = {0}, hits = 0;
   for (size_t i = 0; i < n; i++) {
     fr_hit eh;
     ebr_intersect1(eb, &rays[i], &eh);
     int eo = ebr_occluded1(eb, &rays[i]);
     hits += eh.prim != FR_INVALID_ID;
-    for (int isa = FR_ISA_SCALAR; isa <= FR_ISA_AVX512; isa++) {
-      if (!fr_isa_supported((fr_isa)isa)) continue;
-      fr_set_isa((fr_isa)isa);
+    for (int isa = 0; isa < 6; isa++) { /* ISA x BVH width */
+      if (!fr_isa_supported((fr_isa)(isa % 3))) continue;
+      fr_set_isa((fr_isa)(isa % 3));
+      fr_scene_set_bvh_width(s, isa < 3 ? 4 : 8);
       fr_hit h;
       fr_intersect1(s, &rays[i], &h);
       if (!fr_hits_agree(h.t, eh.t)) bad_hit[isa]++;
@@ -73,11 +74,12 @@ static void check_scene(const char *path) {
       if (fo != eo && !fr_occlusion_near_boundary(&rays[i], h.t) && !fr_occlusion_near_boundary(&rays[i], eh.t)) bad_occ[isa]++;
     }
   }
-  print_message("%-12s tris=%8zu rays=%zu hits=%ld disagree closest %ld/%ld/%ld any %ld/%ld/%ld (scalar/avx2/avx512)\n",
-                s->name, fr_scene_triangle_count(s), n, hits, bad_hit[0], bad_hit[1], bad_hit[2], bad_occ[0], bad_occ[1], bad_occ[2]);
+  print_message("%-12s tris=%8zu rays=%zu hits=%ld disagree closest %ld/%ld/%ld|%ld/%ld/%ld any %ld/%ld/%ld|%ld/%ld/%ld"
+                " (bvh4|bvh8, scalar/avx2/avx512)\n", s->name, fr_scene_triangle_count(s), n, hits, bad_hit[0], bad_hit[1],
+                bad_hit[2], bad_hit[3], bad_hit[4], bad_hit[5], bad_occ[0], bad_occ[1], bad_occ[2], bad_occ[3], bad_occ[4], bad_occ[5]);
   /* Rays within float rounding of a silhouette edge may land differently in
    * two correct tracers; allow at most 1 in 10^4, and no systematic error. */
-  for (int i = 0; i < 3; i++) {
+  for (int i = 0; i < 6; i++) {
     assert_true(bad_hit[i] * 10000 <= (long)n);
     assert_true(bad_occ[i] * 10000 <= (long)n);
   }

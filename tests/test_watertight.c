@@ -47,7 +47,7 @@ static void shoot_from_inside(vec3 center, float radius) {
   fr_scene *s = closed_sphere(&r, center, radius, &pos, &nv);
   const uint32_t *idx = fr_scene_indices(s);
   size_t nt = fr_scene_triangle_count(s);
-  long missed[3] = {0, 0, 0}, shot = 0;
+  long missed[6] = {0}, shot = 0;
   for (int k = 0; k < 20000; k++) {
     vec3 o = v3_add(center, v3(urand(&r, -0.3f, 0.3f) * radius, urand(&r, -0.3f, 0.3f) * radius, urand(&r, -0.3f, 0.3f) * radius));
     vec3 target;
@@ -62,18 +62,19 @@ static void shoot_from_inside(vec3 center, float radius) {
     if (v3_len(d) == 0.0f) continue;
     fr_ray ray = {{o.x, o.y, o.z}, 0.0f, {d.x, d.y, d.z}, INFINITY};
     shot++;
-    for (int isa = FR_ISA_SCALAR; isa <= FR_ISA_AVX512; isa++) {
-      if (!fr_isa_supported((fr_isa)isa)) continue;
-      fr_set_isa((fr_isa)isa);
+    for (int k = 0; k < 6; k++) { /* ISA x BVH width */
+      if (!fr_isa_supported((fr_isa)(k % 3))) continue;
+      fr_set_isa((fr_isa)(k % 3));
+      fr_scene_set_bvh_width(s, k < 3 ? 4 : 8);
       fr_hit h;
       fr_intersect1(s, &ray, &h);
-      missed[isa] += h.prim == FR_INVALID_ID;
-      missed[isa] += !fr_occluded1(s, &ray);
+      missed[k] += h.prim == FR_INVALID_ID;
+      missed[k] += !fr_occluded1(s, &ray);
     }
   }
-  print_message("closed sphere r=%g at (%g,%g,%g): %ld rays, missed scalar=%ld avx2=%ld avx512=%ld\n", radius,
-                center.x, center.y, center.z, shot, missed[0], missed[1], missed[2]);
-  for (int i = 0; i < 3; i++) assert_int_equal(missed[i], 0);
+  print_message("closed sphere r=%g at (%g,%g,%g): %ld rays, missed bvh4 %ld/%ld/%ld bvh8 %ld/%ld/%ld (scalar/avx2/avx512)\n",
+                radius, center.x, center.y, center.z, shot, missed[0], missed[1], missed[2], missed[3], missed[4], missed[5]);
+  for (int i = 0; i < 6; i++) assert_int_equal(missed[i], 0);
   fr_scene_release(s);
   free(pos);
 }

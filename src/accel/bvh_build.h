@@ -3,7 +3,7 @@
  * nodes), parallel with OpenMP: large nodes are binned by all threads
  * together, smaller subtrees are built as independent jobs. The result is a
  * binary tree split down to single primitives, each node knowing its range of
- * primitives, so bvh2.c and bvh4.c can each choose their own leaves (the BVH4
+ * primitives, so bvh2.c and bvhn.c can each choose their own leaves (the wide
  * collapse opens small leaves to fill empty child slots, as Embree does).
  */
 #ifndef FR_ACCEL_BVH_BUILD_H

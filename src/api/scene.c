@@ -13,8 +13,25 @@
 
 static fr_scene *scene_new(void) {
   fr_scene *s = calloc(1, sizeof *s);
-  if (s) fr_mesh_init(&s->mesh);
+  if (!s) return NULL;
+  fr_mesh_init(&s->mesh);
+  const char *w = getenv("FRUSTA_BVH_WIDTH");
+  s->single_width = (w && strcmp(w, "4") == 0) ? 4 : 8;
   return s;
+}
+
+fr_error fr_scene_set_bvh_width(fr_scene *s, int width) {
+  if (!s || (width != 4 && width != 8)) return fr_fail(FR_ERR_ARG, "BVH width must be 4 or 8");
+  s->single_width = width;
+  return FR_OK;
+}
+
+/* The single-ray kernels and BVH of the chosen width. */
+static inline const fr_trace_fns *single_fns(const fr_scene *s, const fr_bvhn **b) {
+  const fr_kernels *k = fr_kernels_active();
+  if (s->single_width == 4) { *b = &s->bvh4; return k->w4; }
+  *b = &s->bvh8;
+  return k->w8;
 }
 
 /* The scene's name: its folder for files in a folder named after it
@@ -81,7 +98,8 @@ void fr_scene_release(fr_scene *s) {
   if (!s) return;
   fr_mesh_free(&s->mesh);
   fr_bvh2_free(&s->bvh2);
-  fr_bvh4_free(&s->bvh4);
+  fr_bvhn_free(&s->bvh4);
+  fr_bvhn_free(&s->bvh8);
   free(s);
 }
 
@@ -111,9 +129,10 @@ fr_error fr_scene_commit(fr_scene *s) {
   free(ids);
   if (e) return e;
   e = fr_bvh2_from_build(&tree, &s->bvh2);
-  if (!e) e = fr_bvh4_from_build(&tree, m, &s->bvh4);
+  if (!e) e = fr_bvhn_from_build(&tree, m, 4, &s->bvh4);
+  if (!e) e = fr_bvhn_from_build(&tree, m, 8, &s->bvh8);
   fr_build_tree_free(&tree);
-  if (e) { fr_bvh2_free(&s->bvh2); fr_bvh4_free(&s->bvh4); return e; }
+  if (e) { fr_bvh2_free(&s->bvh2); fr_bvhn_free(&s->bvh4); fr_bvhn_free(&s->bvh8); return e; }
   s->build_seconds = fr_seconds() - t0;
   s->committed = 1;
   return FR_OK;
@@ -149,34 +168,42 @@ fr_error fr_scene_stats(const fr_scene *s, fr_bvh_stats *st) {
   st->bvh2_leaves = s->bvh2.nleaves;
   st->bvh2_sah = fr_bvh2_sah(&s->bvh2);
   st->bvh2_leaf_fill = s->bvh2.nleaves ? (double)s->bvh2.nprims / (double)s->bvh2.nleaves : 0.0;
-  st->bvh4_inner = s->bvh4.nnodes;
-  st->bvh4_leaves = s->bvh4.nleaves;
-  st->bvh4_sah = fr_bvh4_sah(&s->bvh4, &st->bvh4_node_fill, &st->bvh4_leaf_fill);
-  st->bvh4_bytes = s->bvh4.nnodes * sizeof(fr_bvh4_node);
-  st->tri_bytes = s->bvh4.nleaves * sizeof(fr_tri4);
+  st->bvh2_bytes = s->bvh2.nnodes * sizeof(fr_bvh2_node);
+  const fr_bvhn *src[2] = {&s->bvh4, &s->bvh8};
+  fr_wide_stats *dst[2] = {&st->bvh4, &st->bvh8};
+  for (int i = 0; i < 2; i++) {
+    fr_bvhn_stats b;
+    fr_bvhn_stats_get(src[i], &b);
+    *dst[i] = (fr_wide_stats){b.inner, b.leaves, b.node_bytes, b.tri_bytes, b.sah, b.node_fill, b.leaf_fill, b.depth};
+  }
   st->build_seconds = s->build_seconds;
-  st->depth4 = s->bvh4.depth;
+  st->single_width = s->single_width;
   return FR_OK;
 }
 
 /* Tracing on an uncommitted scene finds nothing rather than crashing. */
 void fr_intersect1(const fr_scene *s, const fr_ray *ray, fr_hit *hit) {
   if (!s->committed) { fr_hit_miss(hit); return; }
-  fr_kernels_active()->intersect1(&s->bvh4, ray, hit);
+  const fr_bvhn *b;
+  single_fns(s, &b)->intersect1(b, ray, hit);
 }
 
 int fr_occluded1(const fr_scene *s, const fr_ray *ray) {
-  return s->committed ? fr_kernels_active()->occluded1(&s->bvh4, ray) : 0;
+  if (!s->committed) return 0;
+  const fr_bvhn *b;
+  return single_fns(s, &b)->occluded1(b, ray);
 }
 
 void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
   if (!s->committed) { for (size_t i = 0; i < n; i++) fr_hit_miss(&hits[i]); return; }
-  fr_kernels_active()->intersect_stream(&s->bvh4, rays, hits, n);
+  const fr_bvhn *b;
+  single_fns(s, &b)->intersect_stream(b, rays, hits, n);
 }
 
 void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
   if (!s->committed) { memset(occ, 0, n); return; }
-  fr_kernels_active()->occluded_stream(&s->bvh4, rays, occ, n);
+  const fr_bvhn *b;
+  single_fns(s, &b)->occluded_stream(b, rays, occ, n);
 }
 
 void fr_intersect1_reference(const fr_scene *s, const fr_ray *ray, fr_hit *hit) {

@@ -3,13 +3,14 @@
 #ifndef FR_API_SCENE_H
 #define FR_API_SCENE_H
 #include "accel/bvh2.h"
-#include "accel/bvh4.h"
+#include "accel/bvhn.h"
 #include "geom/mesh.h"
 
 struct fr_scene {
   fr_mesh mesh;
   fr_bvh2 bvh2;
-  fr_bvh4 bvh4;
+  fr_bvhn bvh4, bvh8;
+  int single_width;     /* 4 or 8: the BVH fr_intersect1 traverses */
   int committed;
   size_t skipped;       /* degenerate triangles left out of the BVH */
   aabb bounds;

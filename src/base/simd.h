@@ -8,7 +8,8 @@
  * level contracts a*b+c into an FMA, so all three give bit-identical answers;
  * the tests hold them to that.
  *
- *   vfloat4 / vmask4   four lanes: single-ray BVH4 traversal, 4-triangle leaves
+ *   vfloat4 / vmask4   four lanes: BVH4 node tests, 4-triangle leaves
+ *   vfloat8            eight lanes: BVH8 node tests (comparisons give bit masks)
  */
 #ifndef FR_BASE_SIMD_H
 #define FR_BASE_SIMD_H
@@ -71,6 +72,22 @@ FR_INLINE vmask4 vf4_ge(vfloat4 a, vfloat4 b) { vmask4 r = FR_CMP4(a, b, _CMP_GE
 FR_INLINE vmask4 vf4_ne(vfloat4 a, vfloat4 b) { vmask4 r = FR_CMP4(a, b, _CMP_NEQ_UQ); return r; }
 FR_INLINE vmask4 vf4_eq(vfloat4 a, vfloat4 b) { vmask4 r = FR_CMP4(a, b, _CMP_EQ_OQ); return r; }
 
+
+/* eight lanes: 8-wide BVH node tests */
+typedef struct vfloat8 { __m256 v; } vfloat8;
+FR_INLINE vfloat8 vf8(float a) { vfloat8 r = {_mm256_set1_ps(a)}; return r; }
+FR_INLINE vfloat8 vf8_load(const float *p) { vfloat8 r = {_mm256_load_ps(p)}; return r; }
+FR_INLINE void vf8_store(float *p, vfloat8 a) { _mm256_store_ps(p, a.v); }
+FR_INLINE vfloat8 vf8_sub(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_sub_ps(a.v, b.v)}; return r; }
+FR_INLINE vfloat8 vf8_mul(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_mul_ps(a.v, b.v)}; return r; }
+FR_INLINE vfloat8 vf8_min(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_min_ps(a.v, b.v)}; return r; }
+FR_INLINE vfloat8 vf8_max(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_max_ps(a.v, b.v)}; return r; }
+#if defined(FR_BUILD_ISA_AVX512)
+FR_INLINE int vf8_le_bits(vfloat8 a, vfloat8 b) { return _mm256_cmp_ps_mask(a.v, b.v, _CMP_LE_OQ); }
+#else
+FR_INLINE int vf8_le_bits(vfloat8 a, vfloat8 b) { return _mm256_movemask_ps(_mm256_cmp_ps(a.v, b.v, _CMP_LE_OQ)); }
+#endif
+
 #else /* FR_ISA_SCALAR: plain C, one lane at a time */
 
 typedef struct vfloat4 { float f[4]; } vfloat4;
@@ -98,6 +115,17 @@ FR_INLINE vmask4 vm4_and(vmask4 a, vmask4 b) { vmask4 r = {a.m & b.m}; return r;
 FR_INLINE vmask4 vm4_or(vmask4 a, vmask4 b) { vmask4 r = {a.m | b.m}; return r; }
 FR_INLINE int vm4_bits(vmask4 a) { return (int)a.m; }
 FR_INLINE vfloat4 vf4_select(vmask4 m, vfloat4 t, vfloat4 f) FR_LANES4(((m.m >> i) & 1) ? t.f[i] : f.f[i])
+
+typedef struct vfloat8 { float f[8]; } vfloat8;
+#define FR_LANES8(expr) { vfloat8 r; for (int i = 0; i < 8; i++) r.f[i] = (expr); return r; }
+FR_INLINE vfloat8 vf8(float a) FR_LANES8(a)
+FR_INLINE vfloat8 vf8_load(const float *p) FR_LANES8(p[i])
+FR_INLINE void vf8_store(float *p, vfloat8 a) { for (int i = 0; i < 8; i++) p[i] = a.f[i]; }
+FR_INLINE vfloat8 vf8_sub(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] - b.f[i])
+FR_INLINE vfloat8 vf8_mul(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] * b.f[i])
+FR_INLINE vfloat8 vf8_min(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] < b.f[i] ? a.f[i] : b.f[i])
+FR_INLINE vfloat8 vf8_max(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] > b.f[i] ? a.f[i] : b.f[i])
+FR_INLINE int vf8_le_bits(vfloat8 a, vfloat8 b) { int m = 0; for (int i = 0; i < 8; i++) m |= (a.f[i] <= b.f[i]) << i; return m; }
 #endif
 
 /* cross and dot of 3-vectors held as three vfloat4 (structure of arrays) */

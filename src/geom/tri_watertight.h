@@ -1,7 +1,7 @@
 /*
  * Watertight ray-triangle test (Woop, Benthin, Wald, "Watertight Ray/Triangle
  * Intersection", JCGT 2013), scalar form. The 4-wide form in the traversal
- * kernel (trace/bvh4_single.c) performs exactly the same operations, so both
+ * kernel (trace/bvhn_single.c) performs exactly the same operations, so both
  * give bit-identical answers.
  *
  * Vertices are moved into the ray's frame and sheared so the ray becomes the

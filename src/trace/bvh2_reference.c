@@ -3,7 +3,7 @@
 #include "geom/tri_watertight.h"
 #include "trace/kernels.h"
 
-/* same widening as the SIMD kernels (see bvh4_single.c) */
+/* same widening as the SIMD kernels (see bvhn_single.c) */
 #define ROUND_UP (1.0f + 0x1p-20f)
 
 static int box_hit(const fr_bvh2_node *n, int k, vec3 o, vec3 rd, float tnear, float tfar) {

@@ -26,8 +26,12 @@ const char *fr_isa_name(fr_isa isa) {
   return "unknown";
 }
 
+static const fr_kernels kernels_avx512 = {FR_ISA_AVX512, &fr_trace_w4_avx512, &fr_trace_w8_avx512};
+static const fr_kernels kernels_avx2 = {FR_ISA_AVX2, &fr_trace_w4_avx2, &fr_trace_w8_avx2};
+static const fr_kernels kernels_scalar = {FR_ISA_SCALAR, &fr_trace_w4_scalar, &fr_trace_w8_scalar};
+
 static const fr_kernels *table(fr_isa isa) {
-  return isa == FR_ISA_AVX512 ? &fr_kernels_avx512 : isa == FR_ISA_AVX2 ? &fr_kernels_avx2 : &fr_kernels_scalar;
+  return isa == FR_ISA_AVX512 ? &kernels_avx512 : isa == FR_ISA_AVX2 ? &kernels_avx2 : &kernels_scalar;
 }
 
 static const fr_kernels *choose(void) {
@@ -39,7 +43,7 @@ static const fr_kernels *choose(void) {
   }
   for (int i = FR_ISA_AVX512; i >= FR_ISA_SCALAR; i--)
     if (fr_isa_supported((fr_isa)i)) return table((fr_isa)i);
-  return &fr_kernels_scalar;
+  return &kernels_scalar;
 }
 
 const fr_kernels *fr_kernels_active(void) {

@@ -3,18 +3,24 @@
 #define FR_TRACE_KERNELS_H
 #include <stddef.h>
 #include <stdint.h>
-#include "accel/bvh4.h"
+#include "accel/bvhn.h"
 #include "frusta.h"
+
+/* Single-ray kernels for one BVH width. */
+typedef struct fr_trace_fns {
+  void (*intersect1)(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit);
+  int (*occluded1)(const fr_bvhn *b, const fr_ray *ray);
+  void (*intersect_stream)(const fr_bvhn *b, const fr_ray *rays, fr_hit *hits, size_t n);
+  void (*occluded_stream)(const fr_bvhn *b, const fr_ray *rays, uint8_t *occ, size_t n);
+} fr_trace_fns;
 
 typedef struct fr_kernels {
   fr_isa isa;
-  void (*intersect1)(const fr_bvh4 *b, const fr_ray *ray, fr_hit *hit);
-  int (*occluded1)(const fr_bvh4 *b, const fr_ray *ray);
-  void (*intersect_stream)(const fr_bvh4 *b, const fr_ray *rays, fr_hit *hits, size_t n);
-  void (*occluded_stream)(const fr_bvh4 *b, const fr_ray *rays, uint8_t *occ, size_t n);
+  const fr_trace_fns *w4, *w8;
 } fr_kernels;
 
-extern const fr_kernels fr_kernels_avx512, fr_kernels_avx2, fr_kernels_scalar;
+extern const fr_trace_fns fr_trace_w4_avx512, fr_trace_w4_avx2, fr_trace_w4_scalar;
+extern const fr_trace_fns fr_trace_w8_avx512, fr_trace_w8_avx2, fr_trace_w8_scalar;
 
 /* The kernels in use: the best the CPU has, unless FRUSTA_ISA or fr_set_isa
  * chose another. */

@@ -14,8 +14,9 @@
 #include "render/workload.h"
 #include "trace/counters.h"
 
-static const char *frusta_modes[] = {"single"};
-#define N_FRUSTA_MODES 1
+/* single: the default single-ray BVH (8-wide); single4: the MIC paper's BVH4 */
+static const char *frusta_modes[] = {"single", "single4"};
+#define N_FRUSTA_MODES 2
 
 static int cmp_double(const void *a, const void *b) {
   double x = *(const double *)a, y = *(const double *)b;
@@ -81,10 +82,10 @@ int cmd_bench(int argc, char **argv) {
     return cli_error(CLI_USAGE_ERROR, "unknown workload '%s' (primary, shadow, soft16, ao16, diffuse8, specular8, all)", workload);
   int all_modes = !strcmp(mode, "all");
   ebr_mode em = EBR_SINGLE;
-  int frusta_has_mode = all_modes || !strcmp(mode, "single");
+  int frusta_has_mode = all_modes || !strcmp(mode, "single") || !strcmp(mode, "single4");
   int embree_has_mode = all_modes || ebr_mode_parse(mode, &em);
   if (use_frusta && !frusta_has_mode && !(use_embree && embree_has_mode))
-    return cli_error(CLI_USAGE_ERROR, "frusta has no mode '%s' (single, or all)", mode);
+    return cli_error(CLI_USAGE_ERROR, "frusta has no mode '%s' (single, single4, or all)", mode);
   if (use_embree && !embree_has_mode && !(use_frusta && frusta_has_mode))
     return cli_error(CLI_USAGE_ERROR, "embree has no mode '%s' (single, packet4, packet8, packet16, stream, all)", mode);
 
@@ -105,9 +106,10 @@ int cmd_bench(int argc, char **argv) {
   size_t tris = fr_scene_triangle_count(s);
   fr_bvh_stats st;
   fr_scene_stats(s, &st);
-  printf("build_seconds=%.3f tracer=frusta scene=%s tris=%zu threads=%d isa=%s sah=%.2f bytes_per_tri=%.1f\n",
-         st.build_seconds, s->name, tris, threads, fr_isa_name(fr_get_isa()), st.bvh4_sah,
-         (double)(st.bvh4_bytes + st.tri_bytes) / (double)tris);
+  const fr_wide_stats *ws = st.single_width == 4 ? &st.bvh4 : &st.bvh8;
+  printf("build_seconds=%.3f tracer=frusta scene=%s tris=%zu threads=%d isa=%s bvh_width=%d sah=%.2f bytes_per_tri=%.1f\n",
+         st.build_seconds, s->name, tris, threads, fr_isa_name(fr_get_isa()), st.single_width, ws->sah,
+         (double)(ws->node_bytes + ws->tri_bytes) / (double)tris);
   ebr_scene *e = NULL;
   if (use_embree) {
     ebr_options o = {threads, getenv("EBR_Q") ? atoi(getenv("EBR_Q")) : 2, 0};
@@ -119,8 +121,13 @@ int cmd_bench(int argc, char **argv) {
     w.kind = (fr_workload_kind)k;
     if (use_frusta && frusta_has_mode) {
       fr_tracer t = fr_tracer_frusta(s);
+      int width = st.single_width;
       for (int m = 0; m < N_FRUSTA_MODES; m++)
-        if (all_modes || !strcmp(mode, frusta_modes[m])) run(&w, &t, s->name, tris, "frusta", frusta_modes[m], repeat);
+        if (all_modes || !strcmp(mode, frusta_modes[m])) {
+          fr_scene_set_bvh_width(s, m == 1 ? 4 : 8);
+          run(&w, &t, s->name, tris, "frusta", frusta_modes[m], repeat);
+        }
+      fr_scene_set_bvh_width(s, width);
     }
     if (e && embree_has_mode)
       for (int m = 0; m < EBR_MODE_COUNT; m++)

@@ -30,16 +30,17 @@ int cmd_stats(int argc, char **argv) {
   printf("scene=%s tris=%zu skipped_degenerate=%zu threads=%d build_seconds=%.3f\n", s->name, nt,
          fr_scene_skipped_triangles(s), threads, st.build_seconds);
   printf("bvh2 inner=%zu leaves=%zu sah=%.2f leaf_fill=%.2f\n", st.bvh2_inner, st.bvh2_leaves, st.bvh2_sah, st.bvh2_leaf_fill);
-  printf("bvh4 inner=%zu leaves=%zu sah=%.2f node_fill=%.2f/4 leaf_fill=%.2f/4 depth=%d\n", st.bvh4_inner,
-         st.bvh4_leaves, st.bvh4_sah, st.bvh4_node_fill, st.bvh4_leaf_fill, st.depth4);
-  printf("memory bvh4_nodes=%zu tri4=%zu bytes_per_tri=%.1f\n", st.bvh4_bytes, st.tri_bytes,
-         (double)(st.bvh4_bytes + st.tri_bytes) / (double)nt);
+  const fr_wide_stats *w[2] = {&st.bvh4, &st.bvh8};
+  for (int i = 0; i < 2; i++)
+    printf("bvh%d inner=%zu leaves=%zu sah=%.2f node_fill=%.2f/%d leaf_fill=%.2f/4 depth=%d node_bytes=%zu tri_bytes=%zu bytes_per_tri=%.1f\n",
+           4 << i, w[i]->inner, w[i]->leaves, w[i]->sah, w[i]->node_fill, 4 << i, w[i]->leaf_fill, w[i]->depth,
+           w[i]->node_bytes, w[i]->tri_bytes, (double)(w[i]->node_bytes + w[i]->tri_bytes) / (double)nt);
   if (embree) {
     for (int q = 1; q <= 2; q++) {
       double sah, sec;
       if (ebr_builder_sah(s, threads, q, &sah, &sec) == FR_OK)
-        printf("embree_builder quality=%s sah=%.2f seconds=%.3f sah_ratio_frusta_over_embree=%.3f\n",
-               q == 2 ? "high" : "medium", sah, sec, st.bvh4_sah / sah);
+        printf("embree_builder width=4 quality=%s sah=%.2f seconds=%.3f sah_ratio_frusta_bvh4_over_embree=%.3f\n",
+               q == 2 ? "high" : "medium", sah, sec, st.bvh4.sah / sah);
     }
     ebr_scene *e;
     ebr_options o = {threads, 2, 0};

@@ -1,0 +1,61 @@
+/*
+ * N-wide BVHs, N = 4 or 8. A node holds its children's boxes as structure of
+ * arrays, so one SIMD instruction tests one slab of all children: 4-wide is
+ * the MIC paper's layout (and what the packet kernels use), 8-wide is what
+ * single rays are fastest with on AVX2/AVX-512 (half the node visits, one
+ * 256-bit test each). Leaves hold at most four triangles in one fr_tri4 block,
+ * vertices as structure of arrays, tested four at once with the watertight
+ * test (geom/tri_watertight.h).
+ */
+#ifndef FR_ACCEL_BVHN_H
+#define FR_ACCEL_BVHN_H
+#include <stddef.h>
+#include <stdint.h>
+#include "accel/bvh_build.h"
+#include "geom/mesh.h"
+
+#define FR_BVHN_LEAF 0x80000000u   /* child ref: FR_BVHN_LEAF | tri4 block index */
+#define FR_BVHN_EMPTY 0x7FFFFFFFu  /* unused slot; its box is inverted and never hit */
+
+/* Node of width W: boxes at float offsets lo_x 0, hi_x W, lo_y 2W, hi_y 3W,
+ * lo_z 4W, hi_z 5W, so a ray's near plane on an axis is at base or base ^ W. */
+#define FR_BVHN_NODE(W)                                                        \
+  struct {                                                                     \
+    float lo_x[W], hi_x[W], lo_y[W], hi_y[W], lo_z[W], hi_z[W];                \
+    uint32_t child[W];                                                         \
+    uint32_t nchildren, pad[(W) == 4 ? 3 : 7];                                 \
+  } __attribute__((aligned(64)))
+
+typedef FR_BVHN_NODE(4) fr_bvh4_node;
+typedef FR_BVHN_NODE(8) fr_bvh8_node;
+_Static_assert(sizeof(fr_bvh4_node) == 128, "BVH4 node is two cache lines");
+_Static_assert(sizeof(fr_bvh8_node) == 256, "BVH8 node is four cache lines");
+
+/* Four triangles; unused lanes hold NaN vertices, which fail every test. */
+typedef struct fr_tri4 {
+  float v0[3][4], v1[3][4], v2[3][4];
+  uint32_t prim[4];
+} __attribute__((aligned(16))) fr_tri4;
+
+typedef struct fr_bvhn {
+  int width;          /* 4 or 8 */
+  void *nodes;        /* fr_bvh4_node or fr_bvh8_node */
+  size_t nnodes;
+  fr_tri4 *tris;      /* one block per leaf */
+  size_t nleaves;
+  uint32_t root;
+  aabb bounds;
+  int depth;
+} fr_bvhn;
+
+typedef struct fr_bvhn_stats {
+  size_t inner, leaves, node_bytes, tri_bytes;
+  double sah, node_fill, leaf_fill; /* fills: mean children per node, triangles per leaf */
+  int depth;
+} fr_bvhn_stats;
+
+fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width, fr_bvhn *out);
+void fr_bvhn_free(fr_bvhn *b);
+/* SAH with a node visit (one SIMD box test) and a triangle test both costing 1. */
+void fr_bvhn_stats_get(const fr_bvhn *b, fr_bvhn_stats *st);
+#endif
