@@ -1,0 +1,109 @@
+/*
+ * Triangle kernels against each other on random triangles and rays: the
+ * watertight test and Shevtsov's record against Möller–Trumbore (float) and a
+ * double-precision reference; the axis-aligned fast path against the general
+ * path; degenerate triangles never hit; nothing returns NaN.
+ */
+#include <string.h>
+#include "geom/tri_moller.h"
+#include "geom/tri_shevtsov.h"
+#include "geom/tri_watertight.h"
+#include "test_util.h"
+
+static vec3 rnd3(fr_rng *r, float s) { return v3(urand(r, -s, s), urand(r, -s, s), urand(r, -s, s)); }
+
+/* Barycentric distance to the nearest edge, in double (negative: outside). */
+static double margin_of(vec3 o, vec3 d, vec3 a, vec3 b, vec3 c, double *t) {
+  float pos[9] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z};
+  uint32_t idx[3] = {0, 1, 2}, prim;
+  double m;
+  fr_ray ray = {{o.x, o.y, o.z}, 0.0f, {d.x, d.y, d.z}, INFINITY};
+  *t = brute_force(pos, idx, 1, &ray, &prim, &m, 1);
+  return prim == 0 ? m : -m;
+}
+
+static void test_agreement(void **st) {
+  (void)st;
+  fr_rng r = fr_rng_seed(3, 3);
+  int compared = 0, hits = 0, fast_path = 0;
+  for (int i = 0; i < 200000; i++) {
+    vec3 a = rnd3(&r, 1), b = rnd3(&r, 1), c = rnd3(&r, 1);
+    if (i % 3 == 0) { b.y = a.y; c.y = a.y; } /* axis-aligned: Shevtsov's fast path */
+    vec3 o = rnd3(&r, 3), tgt = rnd3(&r, 0.7f), d = v3_sub(tgt, o);
+    double tref;
+    double m = margin_of(o, d, a, b, c, &tref);
+    fr_tri_shevtsov rec;
+    assert_true(fr_tri_shevtsov_make(&rec, a, b, c, 7));
+    fast_path += rec.axis_aligned;
+    fr_wt_ray w = fr_wt_setup(d);
+    float t1 = 0, u1 = 0, v1 = 0, t2 = 0, u2 = 0, v2 = 0, t3 = 0, u3 = 0, v3 = 0;
+    int h1 = fr_tri_moller(o, d, 0.0f, INFINITY, a, b, c, &t1, &u1, &v1);
+    int h2 = fr_tri_shevtsov_test(&rec, o, d, 0.0f, INFINITY, &t2, &u2, &v2);
+    int h3 = fr_tri_watertight(&w, o, 0.0f, INFINITY, a, b, c, &t3, &u3, &v3);
+    if (fabs(m) < 1e-4) continue; /* within rounding of an edge */
+    compared++;
+    int want = m > 0 && isfinite(tref);
+    assert_int_equal(h1, want);
+    assert_int_equal(h2, want);
+    assert_int_equal(h3, want);
+    if (!want) continue;
+    hits++;
+    double tol = 1e-4 * fmax(1.0, tref);
+    assert_true(fabs(t1 - tref) <= tol && fabs(t2 - tref) <= tol && fabs(t3 - tref) <= tol);
+    assert_true(fabsf(u1 - u2) < 1e-3f && fabsf(v1 - v2) < 1e-3f);
+    assert_true(fabsf(u1 - u3) < 1e-3f && fabsf(v1 - v3) < 1e-3f);
+  }
+  print_message("compared %d, hits %d, axis-aligned records %d\n", compared, hits, fast_path);
+  assert_true(compared > 190000 && hits > 10000 && fast_path >= 60000);
+}
+
+/* The fast path computes what the general path computes for such a triangle. */
+static void test_axis_aligned_fast_path(void **st) {
+  (void)st;
+  fr_rng r = fr_rng_seed(4, 4);
+  for (int i = 0; i < 50000; i++) {
+    vec3 a = rnd3(&r, 1), b = rnd3(&r, 1), c = rnd3(&r, 1);
+    a.z = b.z = c.z = 0.25f;
+    fr_tri_shevtsov rec;
+    if (!fr_tri_shevtsov_make(&rec, a, b, c, 0)) continue;
+    assert_true(rec.axis_aligned);
+    fr_tri_shevtsov slow = rec;
+    slow.axis_aligned = 0;
+    vec3 o = rnd3(&r, 3), d = v3_sub(rnd3(&r, 1), o);
+    float t1 = 0, u1 = 0, v1 = 0, t2 = 0, u2 = 0, v2 = 0;
+    int h1 = fr_tri_shevtsov_test(&rec, o, d, 0.0f, INFINITY, &t1, &u1, &v1);
+    int h2 = fr_tri_shevtsov_test(&slow, o, d, 0.0f, INFINITY, &t2, &u2, &v2);
+    assert_int_equal(h1, h2); /* n_u = n_v = 0: both paths do the same arithmetic */
+    if (h1) assert_true(t1 == t2 && u1 == u2 && v1 == v2);
+  }
+}
+
+static void test_degenerate_and_nan(void **st) {
+  (void)st;
+  vec3 a = v3(0, 0, 0), b = v3(1, 1, 1), c = v3(2, 2, 2); /* collinear */
+  fr_tri_shevtsov rec;
+  assert_false(fr_tri_shevtsov_make(&rec, a, b, c, 0));
+  assert_false(fr_tri_shevtsov_make(&rec, a, a, a, 0));
+  fr_rng r = fr_rng_seed(5, 5);
+  for (int i = 0; i < 10000; i++) {
+    vec3 o = rnd3(&r, 3), d = v3_sub(rnd3(&r, 2), o);
+    float t = NAN, u = NAN, v = NAN;
+    fr_wt_ray w = fr_wt_setup(d);
+    assert_false(fr_tri_moller(o, d, 0.0f, INFINITY, a, b, c, &t, &u, &v));
+    assert_false(fr_tri_watertight(&w, o, 0.0f, INFINITY, a, b, c, &t, &u, &v));
+    /* NaN anywhere: no hit */
+    vec3 bad = v3(NAN, 0, 0);
+    assert_false(fr_tri_moller(bad, d, 0.0f, INFINITY, v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0), &t, &u, &v));
+    fr_wt_ray wn = fr_wt_setup(v3(NAN, 1, 0));
+    assert_false(fr_tri_watertight(&wn, o, 0.0f, INFINITY, v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0), &t, &u, &v));
+  }
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_agreement),
+      cmocka_unit_test(test_axis_aligned_fast_path),
+      cmocka_unit_test(test_degenerate_and_nan),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
