@@ -3,9 +3,10 @@
  * arrays, so one SIMD instruction tests one slab of all children: 4-wide is
  * the MIC paper's layout (and what the packet kernels use), 8-wide is what
  * single rays are fastest with on AVX2/AVX-512 (half the node visits, one
- * 256-bit test each). Leaves hold at most four triangles in one fr_tri4 block,
- * vertices as structure of arrays, tested four at once with the watertight
- * test (geom/tri_watertight.h).
+ * 256-bit test each). Leaves hold one or more fr_tri4 blocks of four
+ * triangles, vertices as structure of arrays, each block tested at once with
+ * the watertight test (geom/tri_watertight.h). The BVH4 keeps the MIC paper's
+ * one block per leaf; the BVH8 allows two (see fr_bvhn_from_build).
  */
 #ifndef FR_ACCEL_BVHN_H
 #define FR_ACCEL_BVHN_H
@@ -14,7 +15,10 @@
 #include "accel/bvh_build.h"
 #include "geom/mesh.h"
 
-#define FR_BVHN_LEAF 0x80000000u   /* child ref: FR_BVHN_LEAF | tri4 block index */
+/* child ref of a leaf: FR_BVHN_LEAF | (blocks - 1) << FR_BVHN_BLOCKS_SHIFT | first tri4 block */
+#define FR_BVHN_LEAF 0x80000000u
+#define FR_BVHN_BLOCKS_SHIFT 28
+#define FR_BVHN_INDEX_MASK ((1u << FR_BVHN_BLOCKS_SHIFT) - 1)
 #define FR_BVHN_EMPTY 0x7FFFFFFFu  /* unused slot; its box is inverted and never hit */
 
 /* Node of width W: boxes at float offsets lo_x 0, hi_x W, lo_y 2W, hi_y 3W,
@@ -41,8 +45,9 @@ typedef struct fr_bvhn {
   int width;          /* 4 or 8 */
   void *nodes;        /* fr_bvh4_node or fr_bvh8_node */
   size_t nnodes;
-  fr_tri4 *tris;      /* one block per leaf */
-  size_t nleaves;
+  fr_tri4 *tris;      /* leaf blocks, each leaf's contiguous */
+  size_t nleaves, nblocks;
+  uint32_t max_leaf;  /* triangles per leaf: 4 per block */
   uint32_t root;
   aabb bounds;
   int depth;
@@ -50,11 +55,12 @@ typedef struct fr_bvhn {
 
 typedef struct fr_bvhn_stats {
   size_t inner, leaves, node_bytes, tri_bytes;
-  double sah, node_fill, leaf_fill; /* fills: mean children per node, triangles per leaf */
+  double sah, node_fill, leaf_fill; /* fills: mean children per node, triangles per block */
   int depth;
 } fr_bvhn_stats;
 
-fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width, fr_bvhn *out);
+/* max_leaf: at most this many triangles per leaf, a multiple of 4. */
+fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width, uint32_t max_leaf, fr_bvhn *out);
 void fr_bvhn_free(fr_bvhn *b);
 /* SAH with a node visit (one SIMD box test) and a triangle test both costing 1. */
 void fr_bvhn_stats_get(const fr_bvhn *b, fr_bvhn_stats *st);
