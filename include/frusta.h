@@ -91,12 +91,13 @@ uint32_t fr_scene_triangle_material(const fr_scene *s, uint32_t prim); /* FR_INV
 /* Triangles dropped from the BVH because they are degenerate or not finite. */
 size_t fr_scene_skipped_triangles(const fr_scene *s);
 
-/* SAH costs count a node visit (one SIMD test of all its boxes) and a
- * triangle test as 1, relative to the root's surface area. */
+/* SAH costs count a node visit (one SIMD test of all its boxes) as 1, and
+ * a triangle test (sah) or a 4-triangle block test (sah_blocks, what the
+ * 4-wide leaf test really costs) as 1, relative to the root's surface area. */
 typedef struct fr_wide_stats {
   size_t inner, leaves;
   size_t node_bytes, tri_bytes;  /* nodes, leaf triangle blocks */
-  double sah;
+  double sah, sah_blocks;
   double node_fill;              /* mean children per inner node */
   double leaf_fill;              /* mean triangles per leaf (of 4) */
   int depth;

@@ -122,6 +122,7 @@ void fr_bvhn_stats_get(const fr_bvhn *b, fr_bvhn_stats *st) {
   double root = aabb_half_area(b->bounds);
   size_t kids = 0, tris = 0;
   double cost = (b->root & FR_BVHN_LEAF) ? leaf_count(b, b->root) : 1.0;
+  double cost_blocks = (b->root & FR_BVHN_LEAF) ? (double)((leaf_count(b, b->root) + 3) / 4) : 1.0;
   if (b->root & FR_BVHN_LEAF) tris += (size_t)leaf_count(b, b->root);
   for (size_t i = 0; i < b->nnodes; i++) {
     const float *f = (const float *)((const char *)b->nodes + i * node_bytes);
@@ -135,8 +136,10 @@ void fr_bvhn_stats_get(const fr_bvhn *b, fr_bvhn_stats *st) {
         int cnt = leaf_count(b, child[k]);
         tris += (size_t)cnt;
         cost += w * cnt;
+        cost_blocks += w * ((cnt + 3) / 4);
       } else {
         cost += w;
+        cost_blocks += w;
       }
     }
   }
@@ -145,6 +148,7 @@ void fr_bvhn_stats_get(const fr_bvhn *b, fr_bvhn_stats *st) {
   st->node_bytes = b->nnodes * node_bytes;
   st->tri_bytes = b->nblocks * sizeof(fr_tri4);
   st->sah = cost;
+  st->sah_blocks = cost_blocks;
   st->node_fill = b->nnodes ? (double)kids / (double)b->nnodes : 0.0;
   st->leaf_fill = b->nblocks ? (double)tris / (double)b->nblocks : 0.0;
   st->depth = b->depth;

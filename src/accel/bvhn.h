@@ -55,13 +55,15 @@ typedef struct fr_bvhn {
 
 typedef struct fr_bvhn_stats {
   size_t inner, leaves, node_bytes, tri_bytes;
-  double sah, node_fill, leaf_fill; /* fills: mean children per node, triangles per block */
+  double sah, sah_blocks;           /* per triangle test, per 4-wide block test */
+  double node_fill, leaf_fill;      /* mean children per node, triangles per block */
   int depth;
 } fr_bvhn_stats;
 
 /* max_leaf: at most this many triangles per leaf, a multiple of 4. */
 fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width, uint32_t max_leaf, fr_bvhn *out);
 void fr_bvhn_free(fr_bvhn *b);
-/* SAH with a node visit (one SIMD box test) and a triangle test both costing 1. */
+/* SAH with a node visit (one SIMD box test) costing 1, and a triangle test or
+ * a block test costing 1. */
 void fr_bvhn_stats_get(const fr_bvhn *b, fr_bvhn_stats *st);
 #endif

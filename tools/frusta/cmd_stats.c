@@ -32,15 +32,15 @@ int cmd_stats(int argc, char **argv) {
   printf("bvh2 inner=%zu leaves=%zu sah=%.2f leaf_fill=%.2f\n", st.bvh2_inner, st.bvh2_leaves, st.bvh2_sah, st.bvh2_leaf_fill);
   const fr_wide_stats *w[2] = {&st.bvh4, &st.bvh8};
   for (int i = 0; i < 2; i++)
-    printf("bvh%d inner=%zu leaves=%zu sah=%.2f node_fill=%.2f/%d leaf_fill=%.2f/4 depth=%d node_bytes=%zu tri_bytes=%zu bytes_per_tri=%.1f\n",
-           4 << i, w[i]->inner, w[i]->leaves, w[i]->sah, w[i]->node_fill, 4 << i, w[i]->leaf_fill, w[i]->depth,
+    printf("bvh%d inner=%zu leaves=%zu sah=%.2f sah_blocks=%.2f node_fill=%.2f/%d leaf_fill=%.2f/4 depth=%d node_bytes=%zu tri_bytes=%zu bytes_per_tri=%.1f\n",
+           4 << i, w[i]->inner, w[i]->leaves, w[i]->sah, w[i]->sah_blocks, w[i]->node_fill, 4 << i, w[i]->leaf_fill, w[i]->depth,
            w[i]->node_bytes, w[i]->tri_bytes, (double)(w[i]->node_bytes + w[i]->tri_bytes) / (double)nt);
   if (embree) {
     for (int q = 1; q <= 2; q++) {
-      double sah, sec;
-      if (ebr_builder_sah(s, threads, q, &sah, &sec) == FR_OK)
-        printf("embree_builder width=4 quality=%s sah=%.2f seconds=%.3f sah_ratio_frusta_bvh4_over_embree=%.3f\n",
-               q == 2 ? "high" : "medium", sah, sec, st.bvh4.sah / sah);
+      double sah, sahb, sec;
+      if (ebr_builder_sah(s, threads, q, &sah, &sahb, &sec) == FR_OK)
+        printf("embree_builder width=4 quality=%s sah=%.2f sah_blocks=%.2f seconds=%.3f frusta_bvh4_over_embree sah=%.3f sah_blocks=%.3f\n",
+               q == 2 ? "high" : "medium", sah, sahb, sec, st.bvh4.sah / sah, st.bvh4.sah_blocks / sahb);
     }
     ebr_scene *e;
     ebr_options o = {threads, 2, 0};

@@ -277,14 +277,15 @@ static double area(const struct RTCBounds *b) {
   return dx * dy + dy * dz + dz * dx;
 }
 
-static double sah_rec(const bnode *n, double node_area, double root) {
-  if (n->leaf) return node_area / root * n->n;
+/* cost of a leaf: per triangle (blocks == 0) or per 4-triangle block */
+static double sah_rec(const bnode *n, double node_area, double root, int blocks) {
+  if (n->leaf) return node_area / root * (blocks ? (n->n + 3) / 4 : n->n);
   double c = node_area / root;
-  for (unsigned i = 0; i < n->n; i++) c += sah_rec(n->kids[i], area(&n->box[i]), root);
+  for (unsigned i = 0; i < n->n; i++) c += sah_rec(n->kids[i], area(&n->box[i]), root, blocks);
   return c;
 }
 
-fr_error ebr_builder_sah(const fr_scene *s, int threads, int quality, double *sah, double *seconds) {
+fr_error ebr_builder_sah(const fr_scene *s, int threads, int quality, double *sah, double *sah_blocks, double *seconds) {
   char cfg[64];
   snprintf(cfg, sizeof cfg, "threads=%d", threads > 0 ? threads : 0);
   RTCDevice dev = rtcNewDevice(cfg);
@@ -326,7 +327,8 @@ fr_error ebr_builder_sah(const fr_scene *s, int threads, int quality, double *sa
   *seconds = fr_seconds() - t0;
   struct RTCBounds rb = {root.lo.x, root.lo.y, root.lo.z, 0, root.hi.x, root.hi.y, root.hi.z, 0};
   double ra = area(&rb);
-  *sah = r ? sah_rec(r, ra, ra) : 0.0;
+  *sah = r ? sah_rec(r, ra, ra, 0) : 0.0;
+  *sah_blocks = r ? sah_rec(r, ra, ra, 1) : 0.0;
   rtcReleaseBVH(bvh);
   free(prims);
   rtcReleaseDevice(dev);

@@ -28,7 +28,8 @@ fr_tracer ebr_tracer(ebr_scene *e, ebr_mode m);
 void ebr_intersect1(ebr_scene *e, const fr_ray *r, fr_hit *h);
 int ebr_occluded1(ebr_scene *e, const fr_ray *r);
 
-/* SAH cost and seconds of Embree's own BVH builder (rtcBuildBVH, 4-wide, leaves
- * of at most 4) on the scene's triangles, by the cost formula of fr_bvh4_sah. */
-fr_error ebr_builder_sah(const fr_scene *s, int threads, int quality, double *sah, double *seconds);
+/* SAH costs (per triangle and per 4-wide block, as fr_wide_stats) and seconds
+ * of Embree's own BVH builder (rtcBuildBVH: 4-wide, leaves of at most 4, SAH
+ * block size 4; quality 2 adds spatial splits) on the scene's triangles. */
+fr_error ebr_builder_sah(const fr_scene *s, int threads, int quality, double *sah, double *sah_blocks, double *seconds);
 #endif
