@@ -112,6 +112,13 @@ static void test_ply_hostile(void **st) {
   fr_scene *s = (fr_scene *)1;
   assert_int_equal(fr_scene_load("/nonexistent/x.ply", &s), FR_ERR_IO);
   assert_null(s);
+  /* an element of 2^64-1 records with no properties holds no bytes: loads at once (was a hang) */
+  const char *empty_elem = "ply\nformat ascii 1.0\nelement junk 18446744073709551615\nelement vertex 3\nproperty float x\n"
+                           "property float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                           "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  assert_int_equal(load("junk.ply", empty_elem, strlen(empty_elem), &s), FR_OK);
+  assert_int_equal(fr_scene_triangle_count(s), 1);
+  fr_scene_release(s);
 }
 
 static void test_obj_mtl_and_zst(void **st) {

@@ -200,6 +200,7 @@ static fr_error read_faces(cursor *c, const elem *e, fr_mesh *m) {
 }
 
 static fr_error skip_element(cursor *c, const elem *e) {
+  if (e->nprops == 0) return FR_OK; /* records of nothing: no bytes, whatever the count (found by fuzzing) */
   for (uint64_t i = 0; i < e->count; i++)
     for (int k = 0; k < e->nprops; k++) {
       const prop *pr = &e->props[k];
