@@ -153,16 +153,14 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
         vec3 d = v3_load(cur[i].dir), p = hit_point(&cur[i], &ch[i]), nn = facing_normal(w->scene, &ch[i], d);
         vec3 nd = w->kind == FR_WL_DIFFUSE8 ? cosine_dir(nn, fr_rng_float(&rng[i]), fr_rng_float(&rng[i]))
                                             : v3_sub(d, v3_scale(nn, 2.0f * v3_dot(d, nn)));
-        B->rays[a] = make_ray(p, nd, w->eps, INFINITY);
-        cur[i] = B->rays[a];
+        cur[i] = make_ray(p, nd, w->eps, INFINITY);
+        B->rays[a] = cur[i]; /* the tracer may overwrite its copy */
       }
       rays += (uint64_t)na;
       t->intersect(t->ctx, B->rays, B->hits, (size_t)na, 0);
       int nn2 = 0;
       for (int a = 0; a < na; a++) {
         int i = alive[a];
-        cur[i] = B->rays[a]; /* a tracer may have written to the array */
-        cur[i].tfar = INFINITY;
         if (B->hits[a].prim == FR_INVALID_ID) continue;
         ch[i] = B->hits[a];
         alive[nn2++] = i;

@@ -112,7 +112,7 @@ int cmd_bench(int argc, char **argv) {
          (double)(ws->node_bytes + ws->tri_bytes) / (double)tris);
   ebr_scene *e = NULL;
   if (use_embree) {
-    ebr_options o = {threads, getenv("EBR_Q") ? atoi(getenv("EBR_Q")) : 2, 0};
+    ebr_options o = {threads, 2, 0}; /* high quality, not robust: Embree's fastest tracing */
     if (ebr_create(s, o, &e)) { fr_scene_release(s); return cli_error(1, "embree: cannot build the scene"); }
     printf("build_seconds=%.3f tracer=embree scene=%s tris=%zu threads=%d quality=high bytes_per_tri=%.1f\n",
            ebr_build_seconds(e), s->name, tris, threads, (double)ebr_bytes(e) / (double)tris);
