@@ -264,9 +264,16 @@ static int occluded1(const fr_bvhn *b, const fr_ray *ray) {
       FR_COUNT(nodes, 1);
       FR_COUNT(box_tests, n->nchildren);
       if (!mask) goto next;
-      /* any hit ends the search: no ordering (nearest first measured no faster) */
-      ref = n->child[__builtin_ctz(mask)];
-      for (int m = mask & (mask - 1); m; m &= m - 1) stack[sp++] = (entry){n->child[__builtin_ctz(m)], 0.0f};
+      /* Any hit ends the search, so no sorting: descend into the last hit
+       * slot, push the others. Last-first is not arbitrary: the collapse puts
+       * the left child of the original split in slot 0, and going there first
+       * measured up to 2x slower for hemisphere rays leaving a surface
+       * (kitchen ao16: 7.9 -> 13.0 Mrays/s); nearest-first was no faster. */
+      {
+        int last = 31 - __builtin_clz((unsigned)mask);
+        ref = n->child[last];
+        for (int m = mask & ~(1 << last); m; m &= m - 1) stack[sp++] = (entry){n->child[__builtin_ctz(m)], 0.0f};
+      }
     }
     for (uint32_t k = 0, nb = ((ref & ~FR_BVHN_LEAF) >> FR_BVHN_BLOCKS_SHIFT) + 1; k < nb; k++) {
       FR_COUNT(leaves, k == 0);
