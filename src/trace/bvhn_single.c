@@ -94,6 +94,12 @@ FR_INLINE int box_test(const node_t *n, const ray4 *r, float tfar, float *dist) 
   return VN_LE_BITS(tn, VN_MUL(tf, VN(ROUND_UP)));
 }
 
+FR_INLINE int visit_node(const node_t *n, const ray4 *r, float tfar, float *dist) {
+  FR_COUNT(nodes, 1);
+  FR_COUNT(box_tests, n->nchildren);
+  return box_test(n, r, tfar, dist);
+}
+
 typedef struct tri4_result { vfloat4 t, e1, e2, inv; int mask; } tri4_result;
 
 /* Edge values of exactly zero are recomputed in double, lane by lane (rare). */
@@ -204,9 +210,7 @@ static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
     while (!(ref & FR_BVHN_LEAF)) {
       const node_t *n = (const node_t *)b->nodes + ref;
       float dist[W] __attribute__((aligned(32)));
-      int mask = box_test(n, &r, tfar, dist);
-      FR_COUNT(nodes, 1);
-      FR_COUNT(box_tests, n->nchildren);
+      int mask = visit_node(n, &r, tfar, dist);
       if (!mask) goto next;
       ref = order_children(n, mask, dist, stack, &sp);
     }
@@ -260,9 +264,7 @@ static int occluded1(const fr_bvhn *b, const fr_ray *ray) {
     while (!(ref & FR_BVHN_LEAF)) {
       const node_t *n = (const node_t *)b->nodes + ref;
       float dist[W] __attribute__((aligned(32)));
-      int mask = box_test(n, &r, tfar, dist);
-      FR_COUNT(nodes, 1);
-      FR_COUNT(box_tests, n->nchildren);
+      int mask = visit_node(n, &r, tfar, dist);
       if (!mask) goto next;
       /* Any hit ends the search, so no sorting: descend into the last hit
        * slot, push the others. Last-first is not arbitrary: the collapse puts

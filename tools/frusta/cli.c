@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "api/scene.h"
+#include "render/workload.h"
 
 int cli_error(int code, const char *fmt, ...) {
   char msg[1024];
@@ -147,3 +148,17 @@ int cli_set_isa(const char *name) {
 
 float cli_scene_eps(const fr_scene *s) { return 1e-4f * v3_len(v3_sub(s->bounds.hi, s->bounds.lo)); }
 const char *cli_scene_name(const fr_scene *s) { return s->name; }
+
+int cli_workload_setup(const char *scene, const cli_view *v, int threads, fr_scene **s, fr_workload *w) {
+  if (cli_load_scene(scene, s)) return 1;
+  w->view = cli_resolve_view(*s, v);
+  if (fr_camera_setup(&w->cam, w->view.eye, w->view.at, w->view.up, w->view.fov, v->width, v->height)) {
+    fr_scene_release(*s);
+    *s = NULL;
+    return cli_error(CLI_USAGE_ERROR, "%s", fr_last_error());
+  }
+  w->scene = *s;
+  w->eps = cli_scene_eps(*s);
+  w->threads = threads;
+  return 0;
+}

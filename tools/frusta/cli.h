@@ -34,5 +34,10 @@ int cli_load_scene(const char *arg, fr_scene **s);
 /* Applies FRUSTA_ISA / --isa; reports errors itself. */
 int cli_set_isa(const char *name);
 float cli_scene_eps(const fr_scene *s);
+
+struct fr_workload;
+/* Loads and commits the scene and fills w's view, camera, eps and threads
+ * from the flags; reports errors itself (returns the exit code). */
+int cli_workload_setup(const char *scene, const cli_view *v, int threads, fr_scene **s, struct fr_workload *w);
 const char *cli_scene_name(const fr_scene *s);
 #endif

@@ -91,17 +91,10 @@ int cmd_bench(int argc, char **argv) {
 
   omp_set_num_threads(threads);
   fr_scene *s;
-  if (cli_load_scene(scene, &s)) return 1;
   fr_workload w;
   memset(&w, 0, sizeof w);
-  w.view = cli_resolve_view(s, &v);
-  if (fr_camera_setup(&w.cam, w.view.eye, w.view.at, w.view.up, w.view.fov, v.width, v.height)) {
-    fr_scene_release(s);
-    return cli_error(CLI_USAGE_ERROR, "%s", fr_last_error());
-  }
-  w.scene = s;
-  w.eps = cli_scene_eps(s);
-  w.threads = threads;
+  int rc = cli_workload_setup(scene, &v, threads, &s, &w);
+  if (rc) return rc;
   w.seed = 7;
   size_t tris = fr_scene_triangle_count(s);
   fr_bvh_stats st;

@@ -41,22 +41,14 @@ int cmd_render(int argc, char **argv) {
   else return cli_error(CLI_USAGE_ERROR, "--shade is eyelight, normals or shadows, not '%s'", shade);
 
   fr_scene *s;
-  if (cli_load_scene(scene, &s)) return 1;
-  w.view = cli_resolve_view(s, &v);
-  if (fr_camera_setup(&w.cam, w.view.eye, w.view.at, w.view.up, w.view.fov, v.width, v.height)) {
-    fr_scene_release(s);
-    return cli_error(CLI_USAGE_ERROR, "%s", fr_last_error());
-  }
-  w.scene = s;
-  w.eps = cli_scene_eps(s);
-  w.threads = threads;
+  int rc = cli_workload_setup(scene, &v, threads, &s, &w);
+  if (rc) return rc;
   w.seed = 1;
   w.progress = 1;
   w.image = calloc((size_t)v.width * (size_t)v.height * 3, sizeof(float));
   if (!w.image) { fr_scene_release(s); return cli_error(1, "out of memory for a %dx%d image", v.width, v.height); }
   fr_tracer t = fr_tracer_frusta(s);
   fr_workload_result r = fr_workload_run(&w, &t);
-  int rc = 0;
   if (fr_image_write(out, v.width, v.height, w.image)) rc = cli_error(1, "%s", fr_last_error());
   else
     printf("rendered scene=%s tris=%zu size=%dx%d shade=%s isa=%s threads=%d build_seconds=%.3f rays=%llu seconds=%.3f mrays=%.2f -> %s\n",

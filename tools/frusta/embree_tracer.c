@@ -13,7 +13,6 @@ struct ebr_scene {
   RTCScene scene;
   double build_seconds;
   _Atomic long long bytes;
-  ebr_mode mode; /* used by tracer contexts */
   struct ebr_ctx { struct ebr_scene *e; ebr_mode mode; } ctx[EBR_MODE_COUNT];
 };
 
@@ -151,12 +150,17 @@ PACKET_FUNCS(4)
 PACKET_FUNCS(8)
 PACKET_FUNCS(16)
 
-static void ebr_intersect(void *c, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
-  struct ebr_ctx *x = c;
-  ebr_scene *e = x->e;
+static struct RTCIntersectContext make_context(int coherent) {
   struct RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   ctx.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  return ctx;
+}
+
+static void ebr_intersect(void *c, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
+  struct ebr_ctx *x = c;
+  ebr_scene *e = x->e;
+  struct RTCIntersectContext ctx = make_context(coherent);
   switch (x->mode) {
   case EBR_PACKET4: intersect_p4(e, &ctx, rays, hits, n); return;
   case EBR_PACKET8: intersect_p8(e, &ctx, rays, hits, n); return;
@@ -185,17 +189,13 @@ static void ebr_intersect(void *c, fr_ray *rays, fr_hit *hits, size_t n, int coh
 static void ebr_occluded(void *c, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
   struct ebr_ctx *x = c;
   ebr_scene *e = x->e;
-  struct RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  ctx.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  struct RTCIntersectContext ctx = make_context(coherent);
   switch (x->mode) {
   case EBR_PACKET4: occluded_p4(e, &ctx, rays, occ, n); return;
   case EBR_PACKET8: occluded_p8(e, &ctx, rays, occ, n); return;
   case EBR_PACKET16: occluded_p16(e, &ctx, rays, occ, n); return;
   case EBR_STREAM: {
-    struct RTCRayHit rh[64];
     struct RTCRay r[64];
-    (void)rh;
     for (size_t b = 0; b < n; b += 64) {
       size_t m = n - b < 64 ? n - b : 64;
       for (size_t i = 0; i < m; i++) { struct RTCRayHit t; to_rayhit1(&rays[b + i], &t); r[i] = t.ray; }
