@@ -1,7 +1,7 @@
 /*
  * Single-ray traversal of an N-wide BVH (Benthin et al., MIC paper §IV, with
  * N = 4 as there or N = 8): one ray, all N child boxes in one SIMD test,
- * nearest child first, and four triangles per SIMD test in the leaves
+ * nearest child first for closest hits, and four triangles per SIMD test in the leaves
  * (watertight, see geom/tri_watertight.h). Compiled once per ISA and width
  * (FR_WIDTH) through base/simd.h.
  */
@@ -49,14 +49,15 @@ typedef vfloat4 vnode;
  * the depth (FR_BUILD_MAX_DEPTH plus median splits of at most 2^27 triangles). */
 #define STACK_SIZE ((W - 1) * (FR_BUILD_MAX_DEPTH + 32) + 4)
 
-typedef struct ray4 {
+/* What a ray precomputes once for all its node and triangle tests. */
+typedef struct ray_pre {
   vnode ox, oy, oz, rx, ry, rz; /* for the node tests */
   vfloat4 o_k[3];             /* origin in the shear frame: kx, ky, kz */
   vfloat4 sx, sy, sz;         /* the watertight test's shear */
   int kx, ky, kz;
   int near_x, near_y, near_z; /* float offsets of the near planes in a node */
   float tnear;
-} ray4;
+} ray_pre;
 
 static inline float safe_rcp(float d) {
   /* a zero direction component would give inf * 0 = NaN at a box plane */
@@ -64,7 +65,7 @@ static inline float safe_rcp(float d) {
   return 1.0f / d;
 }
 
-static inline void ray4_setup(ray4 *r, const fr_ray *ray) {
+static inline void ray_setup(ray_pre *r, const fr_ray *ray) {
   float rx = safe_rcp(ray->dir[0]), ry = safe_rcp(ray->dir[1]), rz = safe_rcp(ray->dir[2]);
   r->ox = VN(ray->org[0]); r->oy = VN(ray->org[1]); r->oz = VN(ray->org[2]);
   fr_wt_ray w = fr_wt_setup(v3_load(ray->dir));
@@ -80,7 +81,7 @@ static inline void ray4_setup(ray4 *r, const fr_ray *ray) {
 }
 
 /* Returns the mask of children hit within [tnear, tfar]; dist gets their entry distances. */
-FR_INLINE int box_test(const node_t *n, const ray4 *r, float tfar, float *dist) {
+FR_INLINE int box_test(const node_t *n, const ray_pre *r, float tfar, float *dist) {
   const float *f = (const float *)n;
   vnode tnx = VN_MUL(VN_SUB(VN_LOAD(f + r->near_x), r->ox), r->rx);
   vnode tny = VN_MUL(VN_SUB(VN_LOAD(f + r->near_y), r->oy), r->ry);
@@ -94,7 +95,7 @@ FR_INLINE int box_test(const node_t *n, const ray4 *r, float tfar, float *dist) 
   return VN_LE_BITS(tn, VN_MUL(tf, VN(ROUND_UP)));
 }
 
-FR_INLINE int visit_node(const node_t *n, const ray4 *r, float tfar, float *dist) {
+FR_INLINE int visit_node(const node_t *n, const ray_pre *r, float tfar, float *dist) {
   FR_COUNT(nodes, 1);
   FR_COUNT(box_tests, n->nchildren);
   return box_test(n, r, tfar, dist);
@@ -121,7 +122,7 @@ static void exact_edges(vfloat4 *e0, vfloat4 *e1, vfloat4 *e2, vfloat4 ax, vfloa
 
 /* Four triangles against one ray; mask of lanes hit in (tnear, tfar). The
  * same operations as fr_tri_watertight, lane by lane. */
-FR_INLINE void tri4_test(const fr_tri4 *tr, const ray4 *r, float tfar, tri4_result *res) {
+FR_INLINE void tri4_test(const fr_tri4 *tr, const ray_pre *r, float tfar, tri4_result *res) {
   vfloat4 az = vf4_sub(vf4_load(tr->v0[r->kz]), r->o_k[2]);
   vfloat4 bz = vf4_sub(vf4_load(tr->v1[r->kz]), r->o_k[2]);
   vfloat4 cz = vf4_sub(vf4_load(tr->v2[r->kz]), r->o_k[2]);
@@ -193,8 +194,8 @@ static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
   fr_hit_miss(hit);
   FR_COUNT(rays, 1);
   if (fr_ray_invalid(ray)) return;
-  ray4 r;
-  ray4_setup(&r, ray);
+  ray_pre r;
+  ray_setup(&r, ray);
   float tfar = ray->tfar;
   entry stack[STACK_SIZE];
   int sp = 0;
@@ -253,8 +254,8 @@ static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
 static int occluded1(const fr_bvhn *b, const fr_ray *ray) {
   FR_COUNT(rays, 1);
   if (fr_ray_invalid(ray)) return 0;
-  ray4 r;
-  ray4_setup(&r, ray);
+  ray_pre r;
+  ray_setup(&r, ray);
   const float tfar = ray->tfar;
   entry stack[STACK_SIZE];
   int sp = 0;
