@@ -77,11 +77,14 @@ static void check_scene(const char *path) {
   print_message("%-12s tris=%8zu rays=%zu hits=%ld disagree closest %ld/%ld/%ld|%ld/%ld/%ld any %ld/%ld/%ld|%ld/%ld/%ld"
                 " (bvh4|bvh8, scalar/avx2/avx512)\n", s->name, fr_scene_triangle_count(s), n, hits, bad_hit[0], bad_hit[1],
                 bad_hit[2], bad_hit[3], bad_hit[4], bad_hit[5], bad_occ[0], bad_occ[1], bad_occ[2], bad_occ[3], bad_occ[4], bad_occ[5]);
-  /* Rays within float rounding of a silhouette edge may land differently in
-   * two correct tracers; allow at most 1 in 10^4, and no systematic error. */
+  /* Every scene agrees on every ray today; a ray within float rounding of a
+   * silhouette edge may one day land differently in two correct tracers (or on
+   * another CPU, where Embree picks other kernels), so one per scene is let
+   * pass. Before the closest hit's t was refined (fr_tri_refine_t) conference
+   * and sibenik had 3 such rays, all frusta's error. */
   for (int i = 0; i < 6; i++) {
-    assert_true(bad_hit[i] * 10000 <= (long)n);
-    assert_true(bad_occ[i] * 10000 <= (long)n);
+    assert_true(bad_hit[i] <= 1);
+    assert_true(bad_occ[i] <= 1);
   }
   assert_true(hits > (long)n / 10);
   free(rays);

@@ -48,7 +48,7 @@ static int traverse(const fr_bvh2 *b, const fr_mesh *m, const fr_ray *ray, fr_hi
         if (any_hit) return 1;
         found = 1;
         tfar = t;
-        hit->t = t; hit->u = u; hit->v = v; hit->prim = prim;
+        hit->t = t; hit->u = u; hit->v = v; hit->prim = prim; /* t refined below, once */
         vec3 ng = v3_cross(v3_sub(p1, p0), v3_sub(p2, p0));
         hit->ng[0] = ng.x; hit->ng[1] = ng.y; hit->ng[2] = ng.z;
       }
@@ -63,7 +63,9 @@ static int traverse(const fr_bvh2 *b, const fr_mesh *m, const fr_ray *ray, fr_hi
 
 void fr_bvh2_intersect_reference(const fr_bvh2 *b, const fr_mesh *m, const fr_ray *ray, fr_hit *hit) {
   fr_hit_miss(hit);
-  traverse(b, m, ray, hit, 0);
+  if (!traverse(b, m, ray, hit, 0)) return;
+  hit->t = fr_tri_refine_t(v3_load(ray->org), v3_load(ray->dir), ray->tnear, ray->tfar, vertex(m, hit->prim, 0),
+                           vertex(m, hit->prim, 1), vertex(m, hit->prim, 2), hit->t);
 }
 
 int fr_bvh2_occluded_reference(const fr_bvh2 *b, const fr_mesh *m, const fr_ray *ray) {

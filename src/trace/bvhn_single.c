@@ -239,7 +239,6 @@ static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
   }
   if (best_blk) {
     float inv = lane(best.inv, best_lane);
-    hit->t = tfar;
     hit->u = lane(best.e1, best_lane) * inv;
     hit->v = lane(best.e2, best_lane) * inv;
     hit->prim = best_blk->prim[best_lane];
@@ -248,6 +247,7 @@ static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
     vec3 p2 = v3(best_blk->v2[0][best_lane], best_blk->v2[1][best_lane], best_blk->v2[2][best_lane]);
     vec3 ng = v3_cross(v3_sub(p1, p0), v3_sub(p2, p0));
     hit->ng[0] = ng.x; hit->ng[1] = ng.y; hit->ng[2] = ng.z;
+    hit->t = fr_tri_refine_t(v3_load(ray->org), v3_load(ray->dir), ray->tnear, ray->tfar, p0, p1, p2, tfar);
   }
 }
 
