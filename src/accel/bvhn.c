@@ -25,14 +25,9 @@ static void fill_block(conv *c, fr_tri4 *blk, uint32_t first, uint32_t count) {
 }
 
 static uint32_t make_leaf(conv *c, const fr_build_node *n) {
-  uint32_t nb = (n->count + 3) / 4, first = (uint32_t)c->b->nblocks;
-  for (uint32_t k = 0; k < nb; k++) {
-    uint32_t cnt = n->count - 4 * k < 4 ? n->count - 4 * k : 4;
-    fill_block(c, &c->b->tris[first + k], n->first + 4 * k, cnt);
-  }
-  c->b->nblocks += nb;
-  c->b->nleaves++;
-  return FR_BVHN_LEAF | (nb - 1) << FR_BVHN_BLOCKS_SHIFT | first;
+  uint32_t li = (uint32_t)c->b->nleaves++;
+  fill_block(c, &c->b->tris[li], n->first, n->count);
+  return FR_BVHN_LEAF | li;
 }
 
 /* Node i's float arrays (generic over the width). */
@@ -49,7 +44,7 @@ static uint32_t convert(conv *c, int32_t bi, int depth) {
   const fr_build_node *n = &c->t->nodes[bi];
   const int W = c->b->width;
   if (depth > c->b->depth) c->b->depth = depth;
-  if (n->count <= c->b->max_leaf) return make_leaf(c, n);
+  if (n->count <= FR_BUILD_MAX_LEAF) return make_leaf(c, n);
   int32_t kids[8] = {n->left, n->right};
   int nk = 2;
   while (nk < W) {
@@ -57,7 +52,7 @@ static uint32_t convert(conv *c, int32_t bi, int depth) {
     float area = -1.0f;
     for (int k = 0; k < nk; k++) {
       const fr_build_node *ch = &c->t->nodes[kids[k]];
-      if (ch->count > c->b->max_leaf && aabb_half_area(ch->box) > area) { area = aabb_half_area(ch->box); best = k; }
+      if (ch->count > FR_BUILD_MAX_LEAF && aabb_half_area(ch->box) > area) { area = aabb_half_area(ch->box); best = k; }
     }
     if (best < 0) break;
     const fr_build_node *ch = &c->t->nodes[kids[best]];
@@ -82,13 +77,10 @@ static uint32_t convert(conv *c, int32_t bi, int depth) {
   return self;
 }
 
-fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width, uint32_t max_leaf, fr_bvhn *out) {
+fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width, fr_bvhn *out) {
   memset(out, 0, sizeof *out);
   if (width != 4 && width != 8) return fr_fail(FR_ERR_ARG, "BVH width %d (4 or 8)", width);
-  if (max_leaf < 4 || max_leaf % 4 || max_leaf > 4u << (31 - FR_BVHN_BLOCKS_SHIFT))
-    return fr_fail(FR_ERR_ARG, "BVH leaf size %u", max_leaf);
   out->width = width;
-  out->max_leaf = max_leaf;
   size_t node_bytes = width == 4 ? sizeof(fr_bvh4_node) : sizeof(fr_bvh8_node);
   out->nodes = fr_alloc_aligned(fr_mul_size(t->nprims, node_bytes), 64);
   out->tris = fr_alloc_aligned(fr_mul_size(t->nprims, sizeof(fr_tri4)), 64);
@@ -109,10 +101,9 @@ void fr_bvhn_free(fr_bvhn *b) {
 }
 
 static int leaf_count(const fr_bvhn *b, uint32_t ref) {
-  const fr_tri4 *t = &b->tris[ref & FR_BVHN_INDEX_MASK];
-  int n = 0, nb = (int)((ref & ~FR_BVHN_LEAF) >> FR_BVHN_BLOCKS_SHIFT) + 1;
-  for (int k = 0; k < nb; k++)
-    for (int l = 0; l < 4; l++) n += t[k].prim[l] != FR_INVALID_ID;
+  const fr_tri4 *t = &b->tris[ref & ~FR_BVHN_LEAF];
+  int n = 0;
+  for (int l = 0; l < 4; l++) n += t->prim[l] != FR_INVALID_ID;
   return n;
 }
 
@@ -146,10 +137,10 @@ void fr_bvhn_stats_get(const fr_bvhn *b, fr_bvhn_stats *st) {
   st->inner = b->nnodes;
   st->leaves = b->nleaves;
   st->node_bytes = b->nnodes * node_bytes;
-  st->tri_bytes = b->nblocks * sizeof(fr_tri4);
+  st->tri_bytes = b->nleaves * sizeof(fr_tri4);
   st->sah = cost;
   st->sah_blocks = cost_blocks;
   st->node_fill = b->nnodes ? (double)kids / (double)b->nnodes : 0.0;
-  st->leaf_fill = b->nblocks ? (double)tris / (double)b->nblocks : 0.0;
+  st->leaf_fill = b->nleaves ? (double)tris / (double)b->nleaves : 0.0;
   st->depth = b->depth;
 }

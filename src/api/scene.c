@@ -129,9 +129,8 @@ fr_error fr_scene_commit(fr_scene *s) {
   free(ids);
   if (e) return e;
   e = fr_bvh2_from_build(&tree, &s->bvh2);
-  if (!e) e = fr_bvhn_from_build(&tree, m, 4, 4, &s->bvh4);
-  /* leaves of up to 8 triangles (two blocks) measured no faster in the BVH8 */
-  if (!e) e = fr_bvhn_from_build(&tree, m, 8, 4, &s->bvh8);
+  if (!e) e = fr_bvhn_from_build(&tree, m, 4, &s->bvh4);
+  if (!e) e = fr_bvhn_from_build(&tree, m, 8, &s->bvh8);
   fr_build_tree_free(&tree);
   if (e) { fr_bvh2_free(&s->bvh2); fr_bvhn_free(&s->bvh4); fr_bvhn_free(&s->bvh8); return e; }
   s->build_seconds = fr_seconds() - t0;

@@ -215,10 +215,10 @@ static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
       if (!mask) goto next;
       ref = order_children(n, mask, dist, stack, &sp);
     }
-    for (uint32_t k = 0, nb = ((ref & ~FR_BVHN_LEAF) >> FR_BVHN_BLOCKS_SHIFT) + 1; k < nb; k++) {
-      FR_COUNT(leaves, k == 0);
+    {
+      FR_COUNT(leaves, 1);
       FR_COUNT(tri_tests, 4);
-      const fr_tri4 *blk = &b->tris[(ref & FR_BVHN_INDEX_MASK) + k];
+      const fr_tri4 *blk = &b->tris[ref & ~FR_BVHN_LEAF];
       tri4_result res;
       tri4_test(blk, &r, tfar, &res);
       if (res.mask) {
@@ -278,11 +278,11 @@ static int occluded1(const fr_bvhn *b, const fr_ray *ray) {
         for (int m = mask & ~(1 << last); m; m &= m - 1) stack[sp++] = (entry){n->child[__builtin_ctz(m)], 0.0f};
       }
     }
-    for (uint32_t k = 0, nb = ((ref & ~FR_BVHN_LEAF) >> FR_BVHN_BLOCKS_SHIFT) + 1; k < nb; k++) {
-      FR_COUNT(leaves, k == 0);
+    {
+      FR_COUNT(leaves, 1);
       FR_COUNT(tri_tests, 4);
       tri4_result res;
-      tri4_test(&b->tris[(ref & FR_BVHN_INDEX_MASK) + k], &r, tfar, &res);
+      tri4_test(&b->tris[ref & ~FR_BVHN_LEAF], &r, tfar, &res);
       if (res.mask) return 1;
     }
   next:;
