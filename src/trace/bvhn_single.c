@@ -6,7 +6,6 @@
  * (FR_WIDTH) through base/simd.h.
  */
 #include <math.h>
-#include <string.h>
 #include "base/simd.h"
 #include "geom/tri_watertight.h"
 #include "trace/counters.h"
@@ -201,8 +200,7 @@ static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
   int sp = 0;
   stack[sp++] = (entry){b->root, -INFINITY};
   const fr_tri4 *best_blk = 0;
-  tri4_result best;
-  memset(&best, 0, sizeof best);
+  float best_u = 0.0f, best_v = 0.0f;
   int best_lane = 0;
   while (sp) {
     entry top = stack[--sp];
@@ -230,7 +228,9 @@ static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
           if (ti < bt) { bt = ti; bl = i; }
         }
         tfar = bt;
-        best = res;
+        float inv = lane(res.inv, bl);
+        best_u = lane(res.e1, bl) * inv;
+        best_v = lane(res.e2, bl) * inv;
         best_lane = bl;
         best_blk = blk;
       }
@@ -238,9 +238,8 @@ static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
   next:;
   }
   if (best_blk) {
-    float inv = lane(best.inv, best_lane);
-    hit->u = lane(best.e1, best_lane) * inv;
-    hit->v = lane(best.e2, best_lane) * inv;
+    hit->u = best_u;
+    hit->v = best_v;
     hit->prim = best_blk->prim[best_lane];
     vec3 p0 = v3(best_blk->v0[0][best_lane], best_blk->v0[1][best_lane], best_blk->v0[2][best_lane]);
     vec3 p1 = v3(best_blk->v1[0][best_lane], best_blk->v1[1][best_lane], best_blk->v1[2][best_lane]);
