@@ -36,23 +36,21 @@ fr_error fr_mesh_add_vertex(fr_mesh *m, float x, float y, float z) {
 }
 
 fr_error fr_mesh_add_triangle(fr_mesh *m, uint32_t a, uint32_t b, uint32_t c, uint32_t mat) {
-  size_t cap = m->cap_tris;
-  if (!grow((void **)&m->idx, &cap, m->ntris, 3 * sizeof(uint32_t)))
+  size_t old_cap = m->cap_tris;
+  if (!grow((void **)&m->idx, &m->cap_tris, m->ntris, 3 * sizeof(uint32_t)))
     return fr_fail(FR_ERR_NOMEM, "out of memory at triangle %zu", m->ntris);
-  if (mat != FR_INVALID_ID || m->mat) {
-    size_t mcap = m->cap_tris;
-    if (!m->mat) { /* first material: earlier triangles have none */
-      m->mat = malloc(fr_mul_size(cap, sizeof(uint32_t)));
-      if (!m->mat) return fr_fail(FR_ERR_NOMEM, "out of memory at triangle %zu", m->ntris);
-      for (size_t i = 0; i < m->ntris; i++) m->mat[i] = FR_INVALID_ID;
-    } else if (cap != mcap) {
-      uint32_t *q = realloc(m->mat, fr_mul_size(cap, sizeof(uint32_t)));
-      if (!q) return fr_fail(FR_ERR_NOMEM, "out of memory at triangle %zu", m->ntris);
-      m->mat = q;
-    }
-    m->mat[m->ntris] = mat;
+  /* Per-triangle materials exist from the first triangle that has one on,
+   * with the same capacity as the indices; earlier triangles get none. */
+  if (m->mat && m->cap_tris != old_cap) {
+    uint32_t *q = realloc(m->mat, fr_mul_size(m->cap_tris, sizeof(uint32_t)));
+    if (!q) return fr_fail(FR_ERR_NOMEM, "out of memory at triangle %zu", m->ntris);
+    m->mat = q;
+  } else if (!m->mat && mat != FR_INVALID_ID) {
+    m->mat = malloc(fr_mul_size(m->cap_tris, sizeof(uint32_t)));
+    if (!m->mat) return fr_fail(FR_ERR_NOMEM, "out of memory at triangle %zu", m->ntris);
+    for (size_t i = 0; i < m->ntris; i++) m->mat[i] = FR_INVALID_ID;
   }
-  m->cap_tris = cap;
+  if (m->mat) m->mat[m->ntris] = mat;
   uint32_t *t = m->idx + 3 * m->ntris++;
   t[0] = a; t[1] = b; t[2] = c;
   return FR_OK;
