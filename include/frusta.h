@@ -138,9 +138,60 @@ void fr_intersect1(const fr_scene *s, const fr_ray *ray, fr_hit *hit);
 /* 1 if anything lies in (tnear, tfar), else 0. */
 int fr_occluded1(const fr_scene *s, const fr_ray *ray);
 
-/* Streams of n independent rays (no coherence assumed). */
+/* ---- packets of 16 rays ------------------------------------------------------
+ * Structure of arrays, one lane per ray. valid has bit i set for each ray i
+ * to trace; lanes not in valid are neither read nor written. The packet
+ * traverses the 4-wide BVH together and, when few of its rays are left in a
+ * subtree, continues them one by one (the hybrid of Benthin et al.); the
+ * threshold is fr_trace_options.hybrid_threshold. Answers agree with
+ * fr_intersect1's ray by ray (same t; the packet's triangle test is not
+ * watertight, so a ray exactly through a shared edge may report either
+ * triangle, or, rarely, miss where fr_intersect1 hits). See
+ * examples/trace_packet.c. */
+typedef struct fr_ray16 {
+  float org_x[16], org_y[16], org_z[16], tnear[16];
+  float dir_x[16], dir_y[16], dir_z[16], tfar[16];
+} fr_ray16;
+
+typedef struct fr_hit16 {
+  float t[16], u[16], v[16];
+  uint32_t prim[16];
+  float ng_x[16], ng_y[16], ng_z[16];
+} fr_hit16;
+
+void fr_intersect16(const fr_scene *s, unsigned valid, const fr_ray16 *rays, fr_hit16 *hits);
+/* Returns the mask of valid rays with anything in (tnear, tfar). */
+unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays);
+
+/* ---- streams ------------------------------------------------------------------
+ * n independent rays. In FR_TRACE_AUTO mode each group of 16 consecutive rays
+ * is traced as a hybrid packet when its directions share an octant, else ray
+ * by ray; order rays so that neighbours are coherent to profit. */
 void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n);
 void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occluded, size_t n);
+
+/* How the stream and packet calls trace; for measurement and tuning. Set it
+ * while no thread traces the scene. */
+typedef enum fr_trace_mode {
+  FR_TRACE_AUTO,      /* per group of 16: hybrid packet if coherent, else single rays */
+  FR_TRACE_SINGLE,    /* every ray alone (BVH of fr_scene_set_bvh_width) */
+  FR_TRACE_PACKET8,   /* packets of 8 on the BVH4, no single-ray phase */
+  FR_TRACE_PACKET16,  /* packets of 16 on the BVH4, no single-ray phase */
+  FR_TRACE_HYBRID16   /* packets of 16 dropping to single rays (hybrid_threshold) */
+} fr_trace_mode;
+
+typedef struct fr_trace_options {
+  fr_trace_mode mode;     /* default FR_TRACE_AUTO */
+  int hybrid_threshold;   /* 0..16, default 7 (the MIC paper's) */
+  int packet_bvh_width;   /* 4 (default, the MIC paper's) or 8 */
+  int mailbox;            /* inverse mailboxing in packet leaves (default off, see README) */
+  int axis_aligned;       /* Shevtsov's axis-aligned fast path (default on) */
+  int ia_cull;            /* interval-arithmetic culling of nodes for whole packets (default on) */
+} fr_trace_options;
+
+void fr_trace_options_default(fr_trace_options *o);
+fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o);
+void fr_scene_get_trace_options(const fr_scene *s, fr_trace_options *o);
 
 /* ---- reference paths (for tests and measurement, not speed) ---------------- */
 /* Plain scalar traversal of the binary BVH with the scalar watertight test. */

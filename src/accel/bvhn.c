@@ -17,7 +17,23 @@ static void fill_block(conv *c, fr_tri4 *blk, uint32_t first, uint32_t count) {
         blk->v2[a][l] = c->m->pos[3 * (size_t)ix[2] + a];
       }
       blk->prim[l] = prim;
+      fr_tri_shevtsov *rec = &c->b->shev[4 * (size_t)(blk - c->b->tris) + (size_t)l];
+      vec3 p0 = v3(blk->v0[0][l], blk->v0[1][l], blk->v0[2][l]);
+      vec3 p1 = v3(blk->v1[0][l], blk->v1[1][l], blk->v1[2][l]);
+      vec3 p2 = v3(blk->v2[0][l], blk->v2[1][l], blk->v2[2][l]);
+      if (!fr_tri_shevtsov_make(rec, p0, p1, p2, prim)) {
+        /* NaN plane: t is NaN for every ray, which fails every compare */
+        memset(rec, 0, sizeof *rec);
+        rec->a_k = NAN;
+        rec->axis_aligned = 1;
+        rec->prim = prim;
+      }
     } else {
+      fr_tri_shevtsov *rec = &c->b->shev[4 * (size_t)(blk - c->b->tris) + (size_t)l];
+      memset(rec, 0, sizeof *rec);
+      rec->a_k = NAN;
+      rec->axis_aligned = 1;
+      rec->prim = FR_INVALID_ID;
       for (int a = 0; a < 3; a++) blk->v0[a][l] = blk->v1[a][l] = blk->v2[a][l] = NAN;
       blk->prim[l] = FR_INVALID_ID;
     }
@@ -84,7 +100,8 @@ fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width,
   size_t node_bytes = width == 4 ? sizeof(fr_bvh4_node) : sizeof(fr_bvh8_node);
   out->nodes = fr_alloc_aligned(fr_mul_size(t->nprims, node_bytes), 64);
   out->tris = fr_alloc_aligned(fr_mul_size(t->nprims, sizeof(fr_tri4)), 64);
-  if (!out->nodes || !out->tris) {
+  out->shev = fr_alloc_aligned(fr_mul_size(t->nprims, 4 * sizeof(fr_tri_shevtsov)), 64);
+  if (!out->nodes || !out->tris || !out->shev) {
     fr_bvhn_free(out);
     return fr_fail(FR_ERR_NOMEM, "BVH%d: out of memory", width);
   }
@@ -97,6 +114,7 @@ fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width,
 void fr_bvhn_free(fr_bvhn *b) {
   fr_free_aligned(b->nodes);
   fr_free_aligned(b->tris);
+  fr_free_aligned(b->shev);
   memset(b, 0, sizeof *b);
 }
 

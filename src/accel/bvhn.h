@@ -14,6 +14,7 @@
 #include <stdint.h>
 #include "accel/bvh_build.h"
 #include "geom/mesh.h"
+#include "geom/tri_shevtsov.h"
 
 #define FR_BVHN_LEAF 0x80000000u    /* child ref: FR_BVHN_LEAF | tri4 block index */
 #define FR_BVHN_EMPTY 0x7FFFFFFFu  /* unused slot; its box is inverted and never hit */
@@ -43,6 +44,10 @@ typedef struct fr_bvhn {
   void *nodes;        /* fr_bvh4_node or fr_bvh8_node */
   size_t nnodes;
   fr_tri4 *tris;      /* one block per leaf */
+  /* The same triangles as Shevtsov records, four per leaf (record 4 * leaf +
+   * lane), for the packet kernels. A lane without a triangle has prim
+   * FR_INVALID_ID; a triangle too thin for a float record never hits. */
+  fr_tri_shevtsov *shev;
   size_t nleaves;
   uint32_t root;
   aabb bounds;

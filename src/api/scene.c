@@ -17,6 +17,7 @@ static fr_scene *scene_new(void) {
   fr_mesh_init(&s->mesh);
   const char *w = getenv("FRUSTA_BVH_WIDTH");
   s->single_width = (w && strcmp(w, "4") == 0) ? 4 : 8;
+  fr_trace_options_default(&s->trace);
   return s;
 }
 
@@ -24,14 +25,6 @@ fr_error fr_scene_set_bvh_width(fr_scene *s, int width) {
   if (!s || (width != 4 && width != 8)) return fr_fail(FR_ERR_ARG, "BVH width must be 4 or 8");
   s->single_width = width;
   return FR_OK;
-}
-
-/* The single-ray kernels and BVH of the chosen width. */
-static inline const fr_trace_fns *single_fns(const fr_scene *s, const fr_bvhn **b) {
-  const fr_kernels *k = fr_kernels_active();
-  if (s->single_width == 4) { *b = &s->bvh4; return k->w4; }
-  *b = &s->bvh8;
-  return k->w8;
 }
 
 /* The scene's name: its folder for files in a folder named after it
@@ -179,31 +172,6 @@ fr_error fr_scene_stats(const fr_scene *s, fr_bvh_stats *st) {
   st->build_seconds = s->build_seconds;
   st->single_width = s->single_width;
   return FR_OK;
-}
-
-/* Tracing on an uncommitted scene finds nothing rather than crashing. */
-void fr_intersect1(const fr_scene *s, const fr_ray *ray, fr_hit *hit) {
-  if (!s->committed) { fr_hit_miss(hit); return; }
-  const fr_bvhn *b;
-  single_fns(s, &b)->intersect1(b, ray, hit);
-}
-
-int fr_occluded1(const fr_scene *s, const fr_ray *ray) {
-  if (!s->committed) return 0;
-  const fr_bvhn *b;
-  return single_fns(s, &b)->occluded1(b, ray);
-}
-
-void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
-  if (!s->committed) { for (size_t i = 0; i < n; i++) fr_hit_miss(&hits[i]); return; }
-  const fr_bvhn *b;
-  single_fns(s, &b)->intersect_stream(b, rays, hits, n);
-}
-
-void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
-  if (!s->committed) { memset(occ, 0, n); return; }
-  const fr_bvhn *b;
-  single_fns(s, &b)->occluded_stream(b, rays, occ, n);
 }
 
 void fr_intersect1_reference(const fr_scene *s, const fr_ray *ray, fr_hit *hit) {

@@ -11,6 +11,7 @@ struct fr_scene {
   fr_bvh2 bvh2;
   fr_bvhn bvh4, bvh8;
   int single_width;     /* 4 or 8: the BVH fr_intersect1 traverses */
+  fr_trace_options trace; /* how packets and streams are traced */
   int committed;
   size_t skipped;       /* degenerate triangles left out of the BVH */
   aabb bounds;

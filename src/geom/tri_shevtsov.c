@@ -16,15 +16,15 @@ int fr_tri_shevtsov_make(fr_tri_shevtsov *r, vec3 p0, vec3 p1, vec3 p2, uint32_t
   r->k = k;
   r->n_u = (float)(n[u] / n[k]);
   r->n_v = (float)(n[v] / n[k]);
-  r->n_d = (float)((n[0] * a[0] + n[1] * a[1] + n[2] * a[2]) / n[k]);
+  r->a_k = (float)a[k];
   r->axis_aligned = (n[u] == 0.0 && n[v] == 0.0);
   /* solve h - a = beta e1 + gamma e2 in the (u, v) projection */
   double det = e1[u] * e2[v] - e1[v] * e2[u];
   if (det == 0.0) return 0;
   double bu = e2[v] / det, bv = -e2[u] / det;
   double cu = -e1[v] / det, cv = e1[u] / det;
-  r->b_u = (float)bu; r->b_v = (float)bv; r->b_d = (float)(-(a[u] * bu + a[v] * bv));
-  r->c_u = (float)cu; r->c_v = (float)cv; r->c_d = (float)(-(a[u] * cu + a[v] * cv));
+  r->b_u = (float)bu; r->b_v = (float)bv; r->a_u = (float)a[u];
+  r->c_u = (float)cu; r->c_v = (float)cv; r->a_v = (float)a[v];
   r->prim = prim;
   return 1;
 }

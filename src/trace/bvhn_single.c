@@ -189,19 +189,11 @@ FR_INLINE uint32_t order_children(const node_t *n, int mask, const float *dist, 
   return e[k - 1].ref;
 }
 
-static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
-  fr_hit_miss(hit);
-  FR_COUNT(rays, 1);
-  if (fr_ray_invalid(ray)) return;
-  ray_pre r;
-  ray_setup(&r, ray);
-  float tfar = ray->tfar;
+/* Closest hit in the subtree at root before *tfar; fills *best on a hit. */
+FR_INLINE int closest(const fr_bvhn *b, const ray_pre *rp, uint32_t root, float tfar, fr_subtree_hit *best) {
   entry stack[STACK_SIZE];
-  int sp = 0;
-  stack[sp++] = (entry){b->root, -INFINITY};
-  const fr_tri4 *best_blk = 0;
-  float best_u = 0.0f, best_v = 0.0f;
-  int best_lane = 0;
+  int sp = 0, found = 0;
+  stack[sp++] = (entry){root, -INFINITY};
   while (sp) {
     entry top = stack[--sp];
     if (top.dist > tfar * ROUND_UP) continue;
@@ -209,16 +201,16 @@ static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
     while (!(ref & FR_BVHN_LEAF)) {
       const node_t *n = (const node_t *)b->nodes + ref;
       float dist[W] __attribute__((aligned(32)));
-      int mask = visit_node(n, &r, tfar, dist);
+      int mask = visit_node(n, rp, tfar, dist);
       if (!mask) goto next;
       ref = order_children(n, mask, dist, stack, &sp);
     }
     {
       FR_COUNT(leaves, 1);
       FR_COUNT(tri_tests, 4);
-      const fr_tri4 *blk = &b->tris[ref & ~FR_BVHN_LEAF];
+      uint32_t li = ref & ~FR_BVHN_LEAF;
       tri4_result res;
-      tri4_test(blk, &r, tfar, &res);
+      tri4_test(&b->tris[li], rp, tfar, &res);
       if (res.mask) {
         int m = res.mask, bl = __builtin_ctz(m);
         float bt = lane(res.t, bl);
@@ -229,42 +221,45 @@ static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
         }
         tfar = bt;
         float inv = lane(res.inv, bl);
-        best_u = lane(res.e1, bl) * inv;
-        best_v = lane(res.e2, bl) * inv;
-        best_lane = bl;
-        best_blk = blk;
+        best->t = bt;
+        best->u = lane(res.e1, bl) * inv;
+        best->v = lane(res.e2, bl) * inv;
+        best->id = 4 * li + (uint32_t)bl;
+        found = 1;
       }
     }
   next:;
   }
-  if (best_blk) {
-    hit->u = best_u;
-    hit->v = best_v;
-    hit->prim = best_blk->prim[best_lane];
-    vec3 p0 = v3(best_blk->v0[0][best_lane], best_blk->v0[1][best_lane], best_blk->v0[2][best_lane]);
-    vec3 p1 = v3(best_blk->v1[0][best_lane], best_blk->v1[1][best_lane], best_blk->v1[2][best_lane]);
-    vec3 p2 = v3(best_blk->v2[0][best_lane], best_blk->v2[1][best_lane], best_blk->v2[2][best_lane]);
-    vec3 ng = v3_cross(v3_sub(p1, p0), v3_sub(p2, p0));
-    hit->ng[0] = ng.x; hit->ng[1] = ng.y; hit->ng[2] = ng.z;
-    hit->t = fr_tri_refine_t(v3_load(ray->org), v3_load(ray->dir), ray->tnear, ray->tfar, p0, p1, p2, tfar);
-  }
+  return found;
 }
 
-static int occluded1(const fr_bvhn *b, const fr_ray *ray) {
+static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
+  fr_hit_miss(hit);
   FR_COUNT(rays, 1);
-  if (fr_ray_invalid(ray)) return 0;
+  if (fr_ray_invalid(ray)) return;
   ray_pre r;
   ray_setup(&r, ray);
-  const float tfar = ray->tfar;
+  fr_subtree_hit best = {0.0f, 0.0f, 0.0f, 0};
+  if (closest(b, &r, b->root, ray->tfar, &best))
+    fr_hit_finish(b, &best, v3_load(ray->org), v3_load(ray->dir), ray->tnear, ray->tfar, hit);
+}
+
+static int intersect_subtree(const fr_bvhn *b, uint32_t ref, const fr_ray *ray, fr_subtree_hit *best) {
+  ray_pre r;
+  ray_setup(&r, ray);
+  return closest(b, &r, ref, ray->tfar, best);
+}
+
+FR_INLINE int any_hit(const fr_bvhn *b, const ray_pre *rp, uint32_t root, const float tfar) {
   entry stack[STACK_SIZE];
   int sp = 0;
-  stack[sp++] = (entry){b->root, -INFINITY};
+  stack[sp++] = (entry){root, -INFINITY};
   while (sp) {
     uint32_t ref = stack[--sp].ref;
     while (!(ref & FR_BVHN_LEAF)) {
       const node_t *n = (const node_t *)b->nodes + ref;
       float dist[W] __attribute__((aligned(32)));
-      int mask = visit_node(n, &r, tfar, dist);
+      int mask = visit_node(n, rp, tfar, dist);
       if (!mask) goto next;
       /* Any hit ends the search, so no sorting: descend into the last hit
        * slot, push the others. Last-first is not arbitrary: the collapse puts
@@ -281,12 +276,26 @@ static int occluded1(const fr_bvhn *b, const fr_ray *ray) {
       FR_COUNT(leaves, 1);
       FR_COUNT(tri_tests, 4);
       tri4_result res;
-      tri4_test(&b->tris[ref & ~FR_BVHN_LEAF], &r, tfar, &res);
+      tri4_test(&b->tris[ref & ~FR_BVHN_LEAF], rp, tfar, &res);
       if (res.mask) return 1;
     }
   next:;
   }
   return 0;
+}
+
+static int occluded1(const fr_bvhn *b, const fr_ray *ray) {
+  FR_COUNT(rays, 1);
+  if (fr_ray_invalid(ray)) return 0;
+  ray_pre r;
+  ray_setup(&r, ray);
+  return any_hit(b, &r, b->root, ray->tfar);
+}
+
+static int occluded_subtree(const fr_bvhn *b, uint32_t ref, const fr_ray *ray) {
+  ray_pre r;
+  ray_setup(&r, ray);
+  return any_hit(b, &r, ref, ray->tfar);
 }
 
 static void intersect_stream(const fr_bvhn *b, const fr_ray *rays, fr_hit *hits, size_t n) {
@@ -300,4 +309,5 @@ static void occluded_stream(const fr_bvhn *b, const fr_ray *rays, uint8_t *occ, 
 #define TRACE_NAME2(w, isa) fr_trace_w##w##_##isa
 #define TRACE_NAME(w, isa) TRACE_NAME2(w, isa)
 #define TRACE_FNS TRACE_NAME(FR_WIDTH, FR_ISA_SUFFIX)
-const fr_trace_fns TRACE_FNS = {intersect1, occluded1, intersect_stream, occluded_stream};
+const fr_trace_fns TRACE_FNS = {intersect1, occluded1, intersect_stream, occluded_stream, intersect_subtree,
+                                occluded_subtree};

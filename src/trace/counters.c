@@ -8,11 +8,9 @@ static fr_counters total;
 void fr_counters_flush(void) {
 #pragma omp critical(fr_counters)
   {
-    total.rays += fr_tls_counters.rays;
-    total.nodes += fr_tls_counters.nodes;
-    total.box_tests += fr_tls_counters.box_tests;
-    total.leaves += fr_tls_counters.leaves;
-    total.tri_tests += fr_tls_counters.tri_tests;
+#define FR_COUNTER_ADD(f) total.f += fr_tls_counters.f;
+    FR_COUNTER_FIELDS(FR_COUNTER_ADD)
+#undef FR_COUNTER_ADD
   }
   memset(&fr_tls_counters, 0, sizeof fr_tls_counters);
 }

@@ -8,8 +8,18 @@
 #define FR_TRACE_COUNTERS_H
 #include <stdint.h>
 
+/* Single-ray work (also the hybrid's single-ray phase) counts one test per
+ * ray and box or triangle; packet work counts SIMD tests (pk_*) and the
+ * active rays in them (pk_*_lanes). */
+#define FR_COUNTER_FIELDS(X)                                                   \
+  X(rays) X(nodes) X(box_tests) X(leaves) X(tri_tests)                         \
+  X(packets) X(pk_nodes) X(pk_box_tests) X(pk_box_lanes) X(pk_tri_tests)       \
+  X(pk_tri_lanes) X(ia_culled) X(mailbox_hits) X(switches) X(switch_rays)
+
 typedef struct fr_counters {
-  uint64_t rays, nodes, box_tests, leaves, tri_tests;
+#define FR_COUNTER_DECL(f) uint64_t f;
+  FR_COUNTER_FIELDS(FR_COUNTER_DECL)
+#undef FR_COUNTER_DECL
 } fr_counters;
 
 #ifdef FRUSTA_COUNTERS

@@ -26,9 +26,13 @@ const char *fr_isa_name(fr_isa isa) {
   return "unknown";
 }
 
-static const fr_kernels kernels_avx512 = {FR_ISA_AVX512, &fr_trace_w4_avx512, &fr_trace_w8_avx512};
-static const fr_kernels kernels_avx2 = {FR_ISA_AVX2, &fr_trace_w4_avx2, &fr_trace_w8_avx2};
-static const fr_kernels kernels_scalar = {FR_ISA_SCALAR, &fr_trace_w4_scalar, &fr_trace_w8_scalar};
+#define FR_KERNELS(isa, ISA)                                                                            \
+  static const fr_kernels kernels_##isa = {ISA, &fr_trace_w4_##isa, &fr_trace_w8_##isa,              \
+                                           &fr_packet_p8_w4_##isa, &fr_packet_p16_w4_##isa,         \
+                                           &fr_packet_p8_w8_##isa, &fr_packet_p16_w8_##isa};
+FR_KERNELS(avx512, FR_ISA_AVX512)
+FR_KERNELS(avx2, FR_ISA_AVX2)
+FR_KERNELS(scalar, FR_ISA_SCALAR)
 
 static const fr_kernels *table(fr_isa isa) {
   return isa == FR_ISA_AVX512 ? &kernels_avx512 : isa == FR_ISA_AVX2 ? &kernels_avx2 : &kernels_scalar;

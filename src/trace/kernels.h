@@ -5,6 +5,11 @@
 #include <stdint.h>
 #include "accel/bvhn.h"
 #include "frusta.h"
+#include "geom/tri_watertight.h"
+
+/* A closest hit found inside a subtree, before it becomes an fr_hit: the
+ * triangle as 4 * leaf block + lane, t as the test computed it. */
+typedef struct fr_subtree_hit { float t, u, v; uint32_t id; } fr_subtree_hit;
 
 /* Single-ray kernels for one BVH width. */
 typedef struct fr_trace_fns {
@@ -12,15 +17,43 @@ typedef struct fr_trace_fns {
   int (*occluded1)(const fr_bvhn *b, const fr_ray *ray);
   void (*intersect_stream)(const fr_bvhn *b, const fr_ray *rays, fr_hit *hits, size_t n);
   void (*occluded_stream)(const fr_bvhn *b, const fr_ray *rays, uint8_t *occ, size_t n);
+  /* The hybrid's single-ray phase: one valid ray through the subtree at ref.
+   * intersect_subtree looks for hits before ray->tfar; on one it fills *best
+   * and returns 1. */
+  int (*intersect_subtree)(const fr_bvhn *b, uint32_t ref, const fr_ray *ray, fr_subtree_hit *best);
+  int (*occluded_subtree)(const fr_bvhn *b, uint32_t ref, const fr_ray *ray);
 } fr_trace_fns;
+
+/* How the packet kernels run (the switches exist for measurement). */
+typedef struct fr_packet_opts {
+  int hybrid_threshold;   /* trace a popped subtree ray by ray when at most this many rays are active; 0: never */
+  int mailbox;            /* inverse mailboxing: skip triangles this packet tested already */
+  int axis_aligned;       /* Shevtsov's fast path for axis-aligned triangles */
+  int ia_cull;            /* cull nodes for the whole packet by interval arithmetic first */
+  const fr_trace_fns *single; /* the single-ray kernels of the same ISA and width */
+} fr_packet_opts;
+
+/* Packet kernels for one ISA, packet size and BVH width. valid: bit i for ray i. */
+typedef struct fr_packet_fns {
+  int size;               /* 8 or 16 rays */
+  void (*intersect)(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const fr_ray16 *rays, fr_hit16 *hits);
+  unsigned (*occluded)(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const fr_ray16 *rays);
+} fr_packet_fns;
 
 typedef struct fr_kernels {
   fr_isa isa;
   const fr_trace_fns *w4, *w8;
+  const fr_packet_fns *p8w4, *p16w4, *p8w8, *p16w8;
 } fr_kernels;
 
 extern const fr_trace_fns fr_trace_w4_avx512, fr_trace_w4_avx2, fr_trace_w4_scalar;
 extern const fr_trace_fns fr_trace_w8_avx512, fr_trace_w8_avx2, fr_trace_w8_scalar;
+#define FR_DECLARE_PACKET(isa)                                                                    \
+  extern const fr_packet_fns fr_packet_p8_w4_##isa, fr_packet_p16_w4_##isa, fr_packet_p8_w8_##isa, \
+      fr_packet_p16_w8_##isa;
+FR_DECLARE_PACKET(avx512)
+FR_DECLARE_PACKET(avx2)
+FR_DECLARE_PACKET(scalar)
 
 /* The kernels in use: the best the CPU has, unless FRUSTA_ISA or fr_set_isa
  * chose another. */
@@ -32,6 +65,23 @@ static inline void fr_hit_miss(fr_hit *h) {
   h->u = h->v = 0.0f;
   h->prim = FR_INVALID_ID;
   h->ng[0] = h->ng[1] = h->ng[2] = 0.0f;
+}
+
+/* The fr_hit of a closest hit: barycentrics as found, t recomputed in double
+ * from the triangle's plane (see fr_tri_refine_t), the geometric normal. */
+static inline void fr_hit_finish(const fr_bvhn *b, const fr_subtree_hit *best, vec3 org, vec3 dir, float tnear,
+                                 float tfar, fr_hit *hit) {
+  const fr_tri4 *blk = &b->tris[best->id >> 2];
+  int l = (int)(best->id & 3);
+  vec3 p0 = v3(blk->v0[0][l], blk->v0[1][l], blk->v0[2][l]);
+  vec3 p1 = v3(blk->v1[0][l], blk->v1[1][l], blk->v1[2][l]);
+  vec3 p2 = v3(blk->v2[0][l], blk->v2[1][l], blk->v2[2][l]);
+  vec3 ng = v3_cross(v3_sub(p1, p0), v3_sub(p2, p0));
+  hit->u = best->u;
+  hit->v = best->v;
+  hit->prim = blk->prim[l];
+  hit->ng[0] = ng.x; hit->ng[1] = ng.y; hit->ng[2] = ng.z;
+  hit->t = fr_tri_refine_t(org, dir, tnear, tfar, p0, p1, p2, best->t);
 }
 
 /* Rays that cannot hit anything: NaN or Inf in origin or direction, a zero

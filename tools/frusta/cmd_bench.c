@@ -14,9 +14,27 @@
 #include "render/workload.h"
 #include "trace/counters.h"
 
-/* single: the default single-ray BVH (8-wide); single4: the MIC paper's BVH4 */
-static const char *frusta_modes[] = {"single", "single4"};
-#define N_FRUSTA_MODES 2
+/* single: the default single-ray BVH (8-wide); single4: the MIC paper's BVH4;
+ * packet8/packet16: packets alone; hybrid16: packets dropping to single rays;
+ * auto: what fr_intersect_stream does by default. */
+static const char *frusta_modes[] = {"single", "single4", "packet8", "packet16", "hybrid16", "auto"};
+#define N_FRUSTA_MODES 6
+
+static void set_frusta_mode(fr_scene *s, int m, const fr_trace_options *base, int single_width) {
+  static const fr_trace_mode modes[] = {FR_TRACE_SINGLE, FR_TRACE_SINGLE, FR_TRACE_PACKET8, FR_TRACE_PACKET16,
+                                        FR_TRACE_HYBRID16, FR_TRACE_AUTO};
+  fr_trace_options o = *base;
+  o.mode = modes[m];
+  fr_scene_set_trace_options(s, &o);
+  fr_scene_set_bvh_width(s, m == 0 ? 8 : m == 1 ? 4 : single_width);
+}
+
+static int parse_onoff(const char *flag, const char *val, int *out) {
+  if (!strcmp(val, "on")) *out = 1;
+  else if (!strcmp(val, "off")) *out = 0;
+  else return cli_error(CLI_USAGE_ERROR, "%s is on or off, not '%s'", flag, val);
+  return 0;
+}
 
 static int cmp_double(const void *a, const void *b) {
   double x = *(const double *)a, y = *(const double *)b;
@@ -43,6 +61,14 @@ static void run(const fr_workload *w0, const fr_tracer *t, const char *scene, si
     printf("counters tracer=%s mode=%s workload=%s per_ray nodes=%.2f box_tests=%.2f leaves=%.2f tri_tests=%.2f\n", tracer, mode,
            fr_workload_name(w0->kind), (double)c.nodes / c.rays, (double)c.box_tests / c.rays, (double)c.leaves / c.rays,
            (double)c.tri_tests / c.rays);
+  if (fr_counters_enabled() && c.packets)
+    printf("counters tracer=%s mode=%s workload=%s packets=%llu per_packet pk_nodes=%.2f pk_box_tests=%.2f "
+           "pk_tri_tests=%.2f ia_culled=%.2f mailbox_hits=%.2f switches=%.2f avg_active_box=%.2f avg_active_tri=%.2f\n",
+           tracer, mode, fr_workload_name(w0->kind), (unsigned long long)c.packets, (double)c.pk_nodes / c.packets,
+           (double)c.pk_box_tests / c.packets, (double)c.pk_tri_tests / c.packets, (double)c.ia_culled / c.packets,
+           (double)c.mailbox_hits / c.packets, (double)c.switches / c.packets,
+           c.pk_box_tests ? (double)c.pk_box_lanes / c.pk_box_tests : 0.0,
+           c.pk_tri_tests ? (double)c.pk_tri_lanes / c.pk_tri_tests : 0.0);
   fflush(stdout);
 }
 
@@ -52,11 +78,26 @@ int cmd_bench(int argc, char **argv) {
   memset(&v, 0, sizeof v);
   v.width = 1024; v.height = 1024;
   int threads = omp_get_num_procs(), repeat = 3;
+  fr_trace_options topt;
+  fr_trace_options_default(&topt);
   for (int i = 0; i < argc; i++) {
     int r = cli_view_flag(argc, argv, &i, &v);
     if (r < 0) return CLI_USAGE_ERROR;
     if (r > 0) continue;
     const char *a = argv[i];
+    if (!strcmp(a, "--threshold") || !strcmp(a, "--mailbox") || !strcmp(a, "--axis-aligned") || !strcmp(a, "--ia") ||
+        !strcmp(a, "--packet-width")) {
+      if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
+      const char *val = argv[++i];
+      if (!strcmp(a, "--threshold")) {
+        if (!cli_parse_int(val, 0, 16, &topt.hybrid_threshold)) return cli_error(CLI_USAGE_ERROR, "--threshold wants 0..16, got '%s'", val);
+      } else if (!strcmp(a, "--packet-width")) {
+        if (!cli_parse_int(val, 4, 8, &topt.packet_bvh_width) || (topt.packet_bvh_width != 4 && topt.packet_bvh_width != 8))
+          return cli_error(CLI_USAGE_ERROR, "--packet-width is 4 or 8, not '%s'", val);
+      } else if (parse_onoff(a, val, !strcmp(a, "--mailbox") ? &topt.mailbox : !strcmp(a, "--ia") ? &topt.ia_cull : &topt.axis_aligned))
+        return CLI_USAGE_ERROR;
+      continue;
+    }
     if (!strcmp(a, "--workload") || !strcmp(a, "--mode") || !strcmp(a, "--tracer") || !strcmp(a, "--threads") || !strcmp(a, "--repeat") || !strcmp(a, "--isa")) {
       if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
       const char *val = argv[++i];
@@ -82,10 +123,11 @@ int cmd_bench(int argc, char **argv) {
     return cli_error(CLI_USAGE_ERROR, "unknown workload '%s' (primary, shadow, soft16, ao16, diffuse8, specular8, all)", workload);
   int all_modes = !strcmp(mode, "all");
   ebr_mode em = EBR_SINGLE;
-  int frusta_has_mode = all_modes || !strcmp(mode, "single") || !strcmp(mode, "single4");
+  int frusta_has_mode = all_modes;
+  for (int m = 0; m < N_FRUSTA_MODES; m++) frusta_has_mode |= !strcmp(mode, frusta_modes[m]);
   int embree_has_mode = all_modes || ebr_mode_parse(mode, &em);
   if (use_frusta && !frusta_has_mode && !(use_embree && embree_has_mode))
-    return cli_error(CLI_USAGE_ERROR, "frusta has no mode '%s' (single, single4, or all)", mode);
+    return cli_error(CLI_USAGE_ERROR, "frusta has no mode '%s' (single, single4, packet8, packet16, hybrid16, auto, all)", mode);
   if (use_embree && !embree_has_mode && !(use_frusta && frusta_has_mode))
     return cli_error(CLI_USAGE_ERROR, "embree has no mode '%s' (single, packet4, packet8, packet16, stream, all)", mode);
 
@@ -117,10 +159,11 @@ int cmd_bench(int argc, char **argv) {
       int width = st.single_width;
       for (int m = 0; m < N_FRUSTA_MODES; m++)
         if (all_modes || !strcmp(mode, frusta_modes[m])) {
-          fr_scene_set_bvh_width(s, m == 1 ? 4 : 8);
+          set_frusta_mode(s, m, &topt, width);
           run(&w, &t, s->name, tris, "frusta", frusta_modes[m], repeat);
         }
       fr_scene_set_bvh_width(s, width);
+      fr_scene_set_trace_options(s, &topt);
     }
     if (e && embree_has_mode)
       for (int m = 0; m < EBR_MODE_COUNT; m++)

@@ -1,0 +1,169 @@
+/* The public tracing calls: single rays, packets of 16, streams, and the
+ * choice between the kernels (trace/kernels.h) they make. */
+#include <string.h>
+#include "base/error.h"
+#include "scene.h"
+#include "trace/kernels.h"
+
+void fr_trace_options_default(fr_trace_options *o) {
+  o->mode = FR_TRACE_AUTO;
+  o->hybrid_threshold = 7;
+  o->packet_bvh_width = 4;
+  o->mailbox = 0;
+  o->axis_aligned = 1;
+  o->ia_cull = 1;
+}
+
+fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o) {
+  if (!s || !o) return fr_fail(FR_ERR_ARG, "fr_scene_set_trace_options: NULL argument");
+  if (o->mode < FR_TRACE_AUTO || o->mode > FR_TRACE_HYBRID16) return fr_fail(FR_ERR_ARG, "unknown trace mode %d", (int)o->mode);
+  if (o->hybrid_threshold < 0 || o->hybrid_threshold > 16)
+    return fr_fail(FR_ERR_ARG, "hybrid threshold %d (0..16)", o->hybrid_threshold);
+  if (o->packet_bvh_width != 4 && o->packet_bvh_width != 8)
+    return fr_fail(FR_ERR_ARG, "packet BVH width %d (4 or 8)", o->packet_bvh_width);
+  s->trace = *o;
+  return FR_OK;
+}
+
+void fr_scene_get_trace_options(const fr_scene *s, fr_trace_options *o) { *o = s->trace; }
+
+/* The single-ray kernels and BVH of the chosen width. */
+static inline const fr_trace_fns *single_fns(const fr_scene *s, const fr_bvhn **b) {
+  const fr_kernels *k = fr_kernels_active();
+  if (s->single_width == 4) { *b = &s->bvh4; return k->w4; }
+  *b = &s->bvh8;
+  return k->w8;
+}
+
+/* The packet kernels of the given size on the packet BVH, with their options. */
+static const fr_packet_fns *packet_fns(const fr_scene *s, int size, int threshold, fr_packet_opts *po,
+                                       const fr_bvhn **b) {
+  const fr_kernels *k = fr_kernels_active();
+  int w8 = s->trace.packet_bvh_width == 8;
+  *b = w8 ? &s->bvh8 : &s->bvh4;
+  po->hybrid_threshold = threshold;
+  po->mailbox = s->trace.mailbox;
+  po->axis_aligned = s->trace.axis_aligned;
+  po->ia_cull = s->trace.ia_cull;
+  po->single = w8 ? k->w8 : k->w4;
+  if (size == 8) return w8 ? k->p8w8 : k->p8w4;
+  return w8 ? k->p16w8 : k->p16w4;
+}
+
+/* Tracing on an uncommitted scene finds nothing rather than crashing. */
+void fr_intersect1(const fr_scene *s, const fr_ray *ray, fr_hit *hit) {
+  if (!s->committed) { fr_hit_miss(hit); return; }
+  const fr_bvhn *b;
+  single_fns(s, &b)->intersect1(b, ray, hit);
+}
+
+int fr_occluded1(const fr_scene *s, const fr_ray *ray) {
+  if (!s->committed) return 0;
+  const fr_bvhn *b;
+  return single_fns(s, &b)->occluded1(b, ray);
+}
+
+static void hit16_miss(unsigned valid, fr_hit16 *h) {
+  for (unsigned m = valid & 0xFFFF; m; m &= m - 1) {
+    int i = __builtin_ctz(m);
+    h->t[i] = __builtin_inff();
+    h->u[i] = h->v[i] = 0.0f;
+    h->prim[i] = FR_INVALID_ID;
+    h->ng_x[i] = h->ng_y[i] = h->ng_z[i] = 0.0f;
+  }
+}
+
+void fr_intersect16(const fr_scene *s, unsigned valid, const fr_ray16 *rays, fr_hit16 *hits) {
+  if (!s->committed) { hit16_miss(valid, hits); return; }
+  fr_packet_opts po;
+  const fr_bvhn *b;
+  packet_fns(s, 16, s->trace.hybrid_threshold, &po, &b)->intersect(b, &po, valid & 0xFFFF, rays, hits);
+}
+
+unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays) {
+  if (!s->committed) return 0;
+  fr_packet_opts po;
+  const fr_bvhn *b;
+  return packet_fns(s, 16, s->trace.hybrid_threshold, &po, &b)->occluded(b, &po, valid & 0xFFFF, rays);
+}
+
+/* ---- streams: groups of up to 16 consecutive rays ---- */
+
+/* Packs rays[0..n) into r16; returns the valid mask. */
+static unsigned gather(const fr_ray *rays, size_t n, fr_ray16 *r16) {
+  for (size_t i = 0; i < n; i++) {
+    const fr_ray *r = &rays[i];
+    r16->org_x[i] = r->org[0]; r16->org_y[i] = r->org[1]; r16->org_z[i] = r->org[2]; r16->tnear[i] = r->tnear;
+    r16->dir_x[i] = r->dir[0]; r16->dir_y[i] = r->dir[1]; r16->dir_z[i] = r->dir[2]; r16->tfar[i] = r->tfar;
+  }
+  return (unsigned)((1u << n) - 1u);
+}
+
+/* 1 if the rays' directions all lie in one octant: the packet kernels then
+ * use one set of near planes and cull by interval arithmetic. */
+static int same_octant(const fr_ray *rays, size_t n) {
+  unsigned and_bits = 7, or_bits = 0;
+  for (size_t i = 0; i < n; i++) {
+    unsigned sg = (unsigned)(__builtin_signbit(rays[i].dir[0]) != 0) | (unsigned)(__builtin_signbit(rays[i].dir[1]) != 0) << 1 |
+                  (unsigned)(__builtin_signbit(rays[i].dir[2]) != 0) << 2;
+    and_bits &= sg;
+    or_bits |= sg;
+  }
+  return and_bits == or_bits;
+}
+
+/* How a group is traced: 0 single rays, else the packet size. */
+static int group_plan(const fr_scene *s, const fr_ray *rays, size_t n, int *threshold) {
+  switch (s->trace.mode) {
+  case FR_TRACE_SINGLE: return 0;
+  case FR_TRACE_PACKET8: *threshold = 0; return 8;
+  case FR_TRACE_PACKET16: *threshold = 0; return 16;
+  case FR_TRACE_HYBRID16: *threshold = s->trace.hybrid_threshold; return 16;
+  case FR_TRACE_AUTO: default:
+    *threshold = s->trace.hybrid_threshold;
+    return (n > (size_t)s->trace.hybrid_threshold && same_octant(rays, n)) ? 16 : 0;
+  }
+}
+
+void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
+  if (!s->committed) { for (size_t i = 0; i < n; i++) fr_hit_miss(&hits[i]); return; }
+  const fr_bvhn *sb;
+  const fr_trace_fns *single = single_fns(s, &sb);
+  if (s->trace.mode == FR_TRACE_SINGLE) { single->intersect_stream(sb, rays, hits, n); return; }
+  size_t group = s->trace.mode == FR_TRACE_PACKET8 ? 8 : 16;
+  fr_ray16 r16 __attribute__((aligned(64)));
+  fr_hit16 h16 __attribute__((aligned(64)));
+  for (size_t g = 0; g < n; g += group) {
+    size_t m = n - g < group ? n - g : group;
+    int threshold = 0, size = group_plan(s, rays + g, m, &threshold);
+    if (!size) { single->intersect_stream(sb, rays + g, hits + g, m); continue; }
+    fr_packet_opts po;
+    const fr_bvhn *pb;
+    const fr_packet_fns *pf = packet_fns(s, size, threshold, &po, &pb);
+    pf->intersect(pb, &po, gather(rays + g, m, &r16), &r16, &h16);
+    for (size_t i = 0; i < m; i++) {
+      fr_hit *h = &hits[g + i];
+      h->t = h16.t[i]; h->u = h16.u[i]; h->v = h16.v[i]; h->prim = h16.prim[i];
+      h->ng[0] = h16.ng_x[i]; h->ng[1] = h16.ng_y[i]; h->ng[2] = h16.ng_z[i];
+    }
+  }
+}
+
+void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
+  if (!s->committed) { memset(occ, 0, n); return; }
+  const fr_bvhn *sb;
+  const fr_trace_fns *single = single_fns(s, &sb);
+  if (s->trace.mode == FR_TRACE_SINGLE) { single->occluded_stream(sb, rays, occ, n); return; }
+  size_t group = s->trace.mode == FR_TRACE_PACKET8 ? 8 : 16;
+  fr_ray16 r16 __attribute__((aligned(64)));
+  for (size_t g = 0; g < n; g += group) {
+    size_t m = n - g < group ? n - g : group;
+    int threshold = 0, size = group_plan(s, rays + g, m, &threshold);
+    if (!size) { single->occluded_stream(sb, rays + g, occ + g, m); continue; }
+    fr_packet_opts po;
+    const fr_bvhn *pb;
+    const fr_packet_fns *pf = packet_fns(s, size, threshold, &po, &pb);
+    unsigned o = pf->occluded(pb, &po, gather(rays + g, m, &r16), &r16);
+    for (size_t i = 0; i < m; i++) occ[g + i] = (uint8_t)((o >> i) & 1);
+  }
+}

@@ -1,0 +1,134 @@
+/*
+ * Packet-wide SIMD: vpf holds one float per ray of a packet of FR_PACKET = 8
+ * or 16 rays, vpm a mask over them. Include after base/simd.h.
+ *
+ *   AVX-512  16 lanes in one zmm (8 in one ymm), masks in k registers
+ *   AVX2     8 lanes in one ymm; 16 lanes as two 8-wide halves
+ *   scalar   a loop over the lanes
+ *
+ * As in base/simd.h: no FMA contraction, min/max return the second operand
+ * on NaN, compares are ordered (NaN is false), so every level gives the same
+ * bits.
+ */
+#ifndef FR_BASE_SIMD_PACKET_H
+#define FR_BASE_SIMD_PACKET_H
+#include "base/simd.h"
+
+#ifndef FR_PACKET
+#error "define FR_PACKET (8 or 16)"
+#endif
+#define P FR_PACKET
+#define FR_PACKET_ALL ((unsigned)((1u << P) - 1u))
+
+#if defined(FR_BUILD_ISA_AVX512) && P == 16
+typedef struct vpf { __m512 v; } vpf;
+typedef struct vpm { __mmask16 m; } vpm;
+FR_INLINE vpf vp(float a) { vpf r = {_mm512_set1_ps(a)}; return r; }
+FR_INLINE vpf vp_load(const float *p) { vpf r = {_mm512_load_ps(p)}; return r; }
+FR_INLINE void vp_store(float *p, vpf a) { _mm512_store_ps(p, a.v); }
+#define FR_VP_BIN(name, in) FR_INLINE vpf name(vpf a, vpf b) { vpf r = {in(a.v, b.v)}; return r; }
+FR_VP_BIN(vp_add, _mm512_add_ps) FR_VP_BIN(vp_sub, _mm512_sub_ps) FR_VP_BIN(vp_mul, _mm512_mul_ps)
+FR_VP_BIN(vp_div, _mm512_div_ps) FR_VP_BIN(vp_min, _mm512_min_ps) FR_VP_BIN(vp_max, _mm512_max_ps)
+#define FR_VP_CMP(name, op) FR_INLINE vpm name(vpf a, vpf b) { vpm r = {_mm512_cmp_ps_mask(a.v, b.v, op)}; return r; }
+FR_INLINE vpm vpm_bits_to(unsigned b) { vpm r = {(__mmask16)b}; return r; }
+FR_INLINE unsigned vpm_bits(vpm a) { return a.m; }
+FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) { vpf r = {_mm512_mask_blend_ps(m.m, f.v, t.v)}; return r; }
+FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r = {(__mmask16)(a.m & b.m)}; return r; }
+FR_INLINE vpf vp_loadu(const float *p) { vpf r = {_mm512_loadu_ps(p)}; return r; }
+FR_INLINE float vp_reduce_min(vpf a) { return _mm512_reduce_min_ps(a.v); }
+FR_INLINE float vp_reduce_max(vpf a) { return _mm512_reduce_max_ps(a.v); }
+
+#elif defined(FR_BUILD_ISA_AVX512) && P == 8
+typedef struct vpf { __m256 v; } vpf;
+typedef struct vpm { __mmask8 m; } vpm;
+FR_INLINE vpf vp(float a) { vpf r = {_mm256_set1_ps(a)}; return r; }
+FR_INLINE vpf vp_load(const float *p) { vpf r = {_mm256_load_ps(p)}; return r; }
+FR_INLINE void vp_store(float *p, vpf a) { _mm256_store_ps(p, a.v); }
+#define FR_VP_BIN(name, in) FR_INLINE vpf name(vpf a, vpf b) { vpf r = {in(a.v, b.v)}; return r; }
+FR_VP_BIN(vp_add, _mm256_add_ps) FR_VP_BIN(vp_sub, _mm256_sub_ps) FR_VP_BIN(vp_mul, _mm256_mul_ps)
+FR_VP_BIN(vp_div, _mm256_div_ps) FR_VP_BIN(vp_min, _mm256_min_ps) FR_VP_BIN(vp_max, _mm256_max_ps)
+#define FR_VP_CMP(name, op) FR_INLINE vpm name(vpf a, vpf b) { vpm r = {_mm256_cmp_ps_mask(a.v, b.v, op)}; return r; }
+FR_INLINE vpm vpm_bits_to(unsigned b) { vpm r = {(__mmask8)b}; return r; }
+FR_INLINE unsigned vpm_bits(vpm a) { return a.m; }
+FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) { vpf r = {_mm256_mask_blend_ps(m.m, f.v, t.v)}; return r; }
+FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r = {(__mmask8)(a.m & b.m)}; return r; }
+FR_INLINE vpf vp_loadu(const float *p) { vpf r = {_mm256_loadu_ps(p)}; return r; }
+
+#elif defined(FR_BUILD_ISA_AVX2) || defined(FR_BUILD_ISA_AVX512)
+/* AVX2: P / 8 halves of 8 lanes, masks as vectors of all-ones lanes */
+#define FR_VP_HALVES (P / 8)
+typedef struct vpf { __m256 v[FR_VP_HALVES]; } vpf;
+typedef struct vpm { __m256 m[FR_VP_HALVES]; } vpm;
+FR_INLINE vpf vp(float a) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_set1_ps(a); return r; }
+FR_INLINE vpf vp_load(const float *p) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_load_ps(p + 8 * h); return r; }
+FR_INLINE void vp_store(float *p, vpf a) { for (int h = 0; h < FR_VP_HALVES; h++) _mm256_store_ps(p + 8 * h, a.v[h]); }
+#define FR_VP_BIN(name, in) FR_INLINE vpf name(vpf a, vpf b) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = in(a.v[h], b.v[h]); return r; }
+FR_VP_BIN(vp_add, _mm256_add_ps) FR_VP_BIN(vp_sub, _mm256_sub_ps) FR_VP_BIN(vp_mul, _mm256_mul_ps)
+FR_VP_BIN(vp_div, _mm256_div_ps) FR_VP_BIN(vp_min, _mm256_min_ps) FR_VP_BIN(vp_max, _mm256_max_ps)
+#define FR_VP_CMP(name, op) FR_INLINE vpm name(vpf a, vpf b) { vpm r; for (int h = 0; h < FR_VP_HALVES; h++) r.m[h] = _mm256_cmp_ps(a.v[h], b.v[h], op); return r; }
+FR_INLINE unsigned vpm_bits(vpm a) {
+  unsigned b = 0;
+  for (int h = 0; h < FR_VP_HALVES; h++) b |= (unsigned)_mm256_movemask_ps(a.m[h]) << (8 * h);
+  return b;
+}
+FR_INLINE vpm vpm_bits_to(unsigned b) {
+  const __m256i sel = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+  vpm r;
+  for (int h = 0; h < FR_VP_HALVES; h++) {
+    __m256i x = _mm256_and_si256(_mm256_set1_epi32((int)((b >> (8 * h)) & 0xFF)), sel);
+    r.m[h] = _mm256_castsi256_ps(_mm256_cmpeq_epi32(x, sel));
+  }
+  return r;
+}
+FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_blendv_ps(f.v[h], t.v[h], m.m[h]); return r; }
+FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r; for (int h = 0; h < FR_VP_HALVES; h++) r.m[h] = _mm256_and_ps(a.m[h], b.m[h]); return r; }
+FR_INLINE vpf vp_loadu(const float *p) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_loadu_ps(p + 8 * h); return r; }
+
+#else /* scalar */
+typedef struct vpf { float f[P]; } vpf;
+typedef struct vpm { unsigned m; } vpm;
+#define FR_VP_LANES(expr) { vpf r; for (int i = 0; i < P; i++) r.f[i] = (expr); return r; }
+FR_INLINE vpf vp(float a) FR_VP_LANES(a)
+FR_INLINE vpf vp_load(const float *p) FR_VP_LANES(p[i])
+FR_INLINE void vp_store(float *p, vpf a) { for (int i = 0; i < P; i++) p[i] = a.f[i]; }
+#define FR_VP_BIN(name, expr) FR_INLINE vpf name(vpf a, vpf b) FR_VP_LANES(expr)
+FR_VP_BIN(vp_add, a.f[i] + b.f[i]) FR_VP_BIN(vp_sub, a.f[i] - b.f[i]) FR_VP_BIN(vp_mul, a.f[i] * b.f[i])
+FR_VP_BIN(vp_div, a.f[i] / b.f[i]) FR_VP_BIN(vp_min, a.f[i] < b.f[i] ? a.f[i] : b.f[i])
+FR_VP_BIN(vp_max, a.f[i] > b.f[i] ? a.f[i] : b.f[i])
+#define FR_CMP_LT_OQ(a, b) ((a) < (b))
+#define FR_CMP_LE_OQ(a, b) ((a) <= (b))
+#define FR_CMP_GT_OQ(a, b) ((a) > (b))
+#define FR_CMP_GE_OQ(a, b) ((a) >= (b))
+#define FR_CMP_EQ_OQ(a, b) ((a) == (b))
+#define FR_VP_CMP(name, op) FR_INLINE vpm name(vpf a, vpf b) { vpm r = {0}; for (int i = 0; i < P; i++) r.m |= (unsigned)FR##op(a.f[i], b.f[i]) << i; return r; }
+FR_INLINE vpm vpm_bits_to(unsigned b) { vpm r = {b}; return r; }
+FR_INLINE unsigned vpm_bits(vpm a) { return a.m; }
+FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) FR_VP_LANES(((m.m >> i) & 1) ? t.f[i] : f.f[i])
+FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r = {a.m & b.m}; return r; }
+FR_INLINE vpf vp_loadu(const float *p) FR_VP_LANES(p[i])
+FR_INLINE float vp_reduce_min(vpf a) { float r = a.f[0]; for (int i = 1; i < P; i++) r = a.f[i] < r ? a.f[i] : r; return r; }
+FR_INLINE float vp_reduce_max(vpf a) { float r = a.f[0]; for (int i = 1; i < P; i++) r = a.f[i] > r ? a.f[i] : r; return r; }
+#endif
+
+/* (scalar: FR##op pastes to the FR_CMP_* macros above) */
+FR_VP_CMP(vp_lt, _CMP_LT_OQ) FR_VP_CMP(vp_le, _CMP_LE_OQ) FR_VP_CMP(vp_gt, _CMP_GT_OQ)
+FR_VP_CMP(vp_ge, _CMP_GE_OQ) FR_VP_CMP(vp_eq, _CMP_EQ_OQ)
+
+#if !(defined(FR_BUILD_ISA_AVX512) && P == 16) && !defined(FR_BUILD_ISA_SCALAR)
+/* through memory: rare enough (child ordering, IA bounds) not to matter */
+FR_INLINE float vp_reduce_min(vpf a) {
+  float f[P] __attribute__((aligned(64)));
+  vp_store(f, a);
+  float r = f[0];
+  for (int i = 1; i < P; i++) r = f[i] < r ? f[i] : r;
+  return r;
+}
+FR_INLINE float vp_reduce_max(vpf a) {
+  float f[P] __attribute__((aligned(64)));
+  vp_store(f, a);
+  float r = f[0];
+  for (int i = 1; i < P; i++) r = f[i] > r ? f[i] : r;
+  return r;
+}
+#endif
+#endif

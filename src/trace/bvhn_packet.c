@@ -1,0 +1,421 @@
+/*
+ * Packet traversal (Benthin, Wald, Woop, Ernst, Mark: "Combining Single and
+ * Packet Ray Tracing ... on the Intel MIC Architecture", §V): P = 8 or 16 rays,
+ * one per SIMD lane, traverse an N-wide BVH together. Per node:
+ *
+ *   1. interval arithmetic over the whole packet (Boulos, Wald, Shirley §3.1)
+ *      culls the children no ray can hit, all N at once;
+ *   2. each surviving child is tested against the P rays (one SIMD test);
+ *      children hit by any active ray are pushed with their ray mask and
+ *      per-ray entry distances, nearest last so it pops first.
+ *
+ * Leaves test their triangles one at a time against all P rays with
+ * Shevtsov's test on the precomputed 48-byte record (geom/tri_shevtsov.h),
+ * with its axis-aligned fast path, after an inverse mailbox check.
+ *
+ * The hybrid: on each pop, if at most hybrid_threshold rays are still active
+ * in the popped subtree, they finish it one by one with the single-ray kernel
+ * of the same ISA and width, and the packet goes on with the next pop.
+ *
+ * Compiled once per ISA, packet size (FR_PACKET) and BVH width (FR_WIDTH).
+ */
+#include <math.h>
+#include <string.h>
+#include "base/simd.h"
+#include "base/simd_packet.h"
+#include "trace/counters.h"
+#include "trace/kernels.h"
+
+/* The single-ray kernel's conservative far-plane widening (bvhn_single.c). */
+#define ROUND_UP (1.0f + 0x1p-20f)
+
+#if FR_WIDTH == 8
+typedef fr_bvh8_node node_t;
+typedef vfloat8 vnode;
+#define VN(x) vf8(x)
+#define VN_LOAD vf8_load
+#define VN_SUB vf8_sub
+#define VN_MUL vf8_mul
+#define VN_MIN vf8_min
+#define VN_MAX vf8_max
+#define VN_LE_BITS vf8_le_bits
+#else
+typedef fr_bvh4_node node_t;
+typedef vfloat4 vnode;
+#define VN(x) vf4(x)
+#define VN_LOAD vf4_load
+#define VN_SUB vf4_sub
+#define VN_MUL vf4_mul
+#define VN_MIN vf4_min
+#define VN_MAX vf4_max
+#define VN_LE_BITS(a, b) vm4_bits(vf4_le(a, b))
+#endif
+#define W FR_WIDTH
+#define STACK_SIZE ((W - 1) * (FR_BUILD_MAX_DEPTH + 32) + 4)
+
+typedef struct packet {
+  float o[3][P] __attribute__((aligned(64)));
+  float d[3][P] __attribute__((aligned(64)));
+  float rd[3][P] __attribute__((aligned(64)));
+  float tnear[P] __attribute__((aligned(64)));
+  float tfar[P] __attribute__((aligned(64)));  /* as given */
+  /* uniform: every active ray has the same direction sign on each axis, so
+   * near and far planes are the same for all (near_off: float offsets of the
+   * near planes in a node); then the interval bounds below are finite. */
+  int uniform;
+  int near_off[3];
+  float omin[3], omax[3], rmin[3], rmax[3], tnear_min;
+} packet;
+
+static inline float safe_rcp(float d) {
+  if (fabsf(d) < 1e-18f) d = copysignf(1e-18f, d); /* as the single-ray kernel */
+  return 1.0f / d;
+}
+
+/* Loads lanes 0..P-1; returns the valid mask without rays that cannot hit. */
+static unsigned packet_setup(packet *pk, unsigned valid, const fr_ray16 *in) {
+  valid &= FR_PACKET_ALL;
+  for (int i = 0; i < P; i++) {
+    fr_ray r = {{in->org_x[i], in->org_y[i], in->org_z[i]}, in->tnear[i],
+                {in->dir_x[i], in->dir_y[i], in->dir_z[i]}, in->tfar[i]};
+    if (!((valid >> i) & 1) || fr_ray_invalid(&r)) {
+      valid &= ~(1u << i);
+      /* harmless values: the lane is masked off everywhere */
+      memset(&r, 0, sizeof r);
+      r.dir[0] = r.dir[1] = r.dir[2] = 1.0f;
+    }
+    for (int a = 0; a < 3; a++) {
+      pk->o[a][i] = r.org[a];
+      pk->d[a][i] = r.dir[a];
+      pk->rd[a][i] = safe_rcp(r.dir[a]);
+    }
+    pk->tnear[i] = r.tnear;
+    pk->tfar[i] = r.tfar;
+  }
+  pk->uniform = valid != 0;
+  pk->tnear_min = INFINITY;
+  for (int a = 0; a < 3; a++) {
+    pk->omin[a] = pk->rmin[a] = INFINITY;
+    pk->omax[a] = pk->rmax[a] = -INFINITY;
+  }
+  for (unsigned m = valid; m; m &= m - 1) {
+    int i = __builtin_ctz(m);
+    for (int a = 0; a < 3; a++) {
+      pk->omin[a] = fminf(pk->omin[a], pk->o[a][i]);
+      pk->omax[a] = fmaxf(pk->omax[a], pk->o[a][i]);
+      pk->rmin[a] = fminf(pk->rmin[a], pk->rd[a][i]);
+      pk->rmax[a] = fmaxf(pk->rmax[a], pk->rd[a][i]);
+    }
+    pk->tnear_min = fminf(pk->tnear_min, pk->tnear[i]);
+  }
+  for (int a = 0; a < 3; a++) {
+    int pos = pk->rmin[a] > 0.0f, neg = pk->rmax[a] < 0.0f;
+    pk->uniform &= pos | neg;
+    pk->near_off[a] = pos ? 2 * a * W : (2 * a + 1) * W;
+  }
+  return valid;
+}
+
+/* Step 1: children that no ray of the packet can hit, by interval arithmetic
+ * on [omin, omax] and [rmin, rmax] (uniform packets only). Each bound is a
+ * corner product of the same rounded operations a ray's own test makes, and
+ * rounding is monotonic, so the bounds contain every ray's float distances:
+ * the cull is exactly as conservative as the per-ray test. Returns the mask
+ * of children that may be hit. */
+FR_INLINE int ia_test(const node_t *n, const packet *pk, float tfar_max) {
+  const float *f = (const float *)n;
+  vnode tn = VN(pk->tnear_min), tf = VN(tfar_max);
+  for (int a = 0; a < 3; a++) {
+    vnode np = VN_LOAD(f + pk->near_off[a]), fp = VN_LOAD(f + (pk->near_off[a] ^ W));
+    vnode rlo = VN(pk->rmin[a]), rhi = VN(pk->rmax[a]);
+    vnode na = VN_SUB(np, VN(pk->omax[a])), nb = VN_SUB(np, VN(pk->omin[a]));
+    vnode fa = VN_SUB(fp, VN(pk->omax[a])), fb = VN_SUB(fp, VN(pk->omin[a]));
+    vnode lo = VN_MIN(VN_MIN(VN_MUL(na, rlo), VN_MUL(na, rhi)), VN_MIN(VN_MUL(nb, rlo), VN_MUL(nb, rhi)));
+    vnode hi = VN_MAX(VN_MAX(VN_MUL(fa, rlo), VN_MUL(fa, rhi)), VN_MAX(VN_MUL(fb, rlo), VN_MUL(fb, rhi)));
+    tn = VN_MAX(tn, lo);
+    tf = VN_MIN(tf, hi);
+  }
+  return VN_LE_BITS(tn, VN_MUL(tf, VN(ROUND_UP)));
+}
+
+/* The packet's rays in registers. */
+typedef struct pregs { vpf o[3], rd[3], tnear; } pregs;
+
+/* Step 2: child c against every ray; the mask of active rays that hit it
+ * within [tnear, tfar], entry distances in *tn. Same arithmetic as the
+ * single-ray box test, so a ray sees the same boxes in both modes. */
+FR_INLINE unsigned child_test(const float *f, int c, const packet *pk, const pregs *R, vpf tfar, unsigned active,
+                              vpf *tn_out) {
+  vpf tn = R->tnear, tf = tfar;
+  if (pk->uniform) {
+    for (int a = 0; a < 3; a++) {
+      vpf tna = vp_mul(vp_sub(vp(f[pk->near_off[a] + c]), R->o[a]), R->rd[a]);
+      vpf tfa = vp_mul(vp_sub(vp(f[(pk->near_off[a] ^ W) + c]), R->o[a]), R->rd[a]);
+      tn = vp_max(tn, tna);
+      tf = vp_min(tf, tfa);
+    }
+  } else {
+    /* mixed signs: order the two planes per ray (empty slots never get here,
+     * their inverted boxes would turn inside out) */
+    for (int a = 0; a < 3; a++) {
+      vpf t0 = vp_mul(vp_sub(vp(f[2 * a * W + c]), R->o[a]), R->rd[a]);
+      vpf t1 = vp_mul(vp_sub(vp(f[(2 * a + 1) * W + c]), R->o[a]), R->rd[a]);
+      tn = vp_max(tn, vp_min(t0, t1));
+      tf = vp_min(tf, vp_max(t0, t1));
+    }
+  }
+  *tn_out = tn;
+  return active & vpm_bits(vp_le(tn, vp_mul(tf, vp(ROUND_UP))));
+}
+
+/* Inverse mailboxing (Shevtsov et al.): the packet remembers the last 8
+ * triangles it tested, in a ring on its own stack. */
+typedef struct mailbox { uint32_t id[8] __attribute__((aligned(32))); unsigned pos; } mailbox;
+
+FR_INLINE int mailbox_seen(mailbox *mb, uint32_t id) {
+#if defined(FR_BUILD_ISA_SCALAR)
+  for (int i = 0; i < 8; i++)
+    if (mb->id[i] == id) return 1;
+#else
+  __m256i eq = _mm256_cmpeq_epi32(_mm256_load_si256((const __m256i *)mb->id), _mm256_set1_epi32((int)id));
+  if (_mm256_movemask_epi8(eq)) return 1;
+#endif
+  mb->id[mb->pos++ & 7] = id;
+  return 0;
+}
+
+/* One triangle against the active rays (Shevtsov's test, lane by lane the
+ * same operations as fr_tri_shevtsov_test). Returns the rays hit in
+ * (tnear, tfar); *t, *u, *v hold their hits. */
+FR_INLINE unsigned tri_test(const fr_tri_shevtsov *r, const packet *pk, const pregs *R, vpf tfar, unsigned active,
+                            int aa_path, vpf *t_out, vpf *u_out, vpf *v_out) {
+  static const int next[3] = {1, 2, 0};
+  int k = r->k, ku = next[k], kv = next[ku];
+  /* the origins relative to vertex a */
+  vpf wk = vp_sub(vp(r->a_k), vp_load(pk->o[k]));
+  vpf wu = vp_sub(vp(r->a_u), vp_load(pk->o[ku])), wv = vp_sub(vp(r->a_v), vp_load(pk->o[kv]));
+  vpf dk = vp_load(pk->d[k]), du = vp_load(pk->d[ku]), dv = vp_load(pk->d[kv]);
+  vpf t;
+  if (aa_path && r->axis_aligned) {
+    t = vp_div(wk, dk);
+  } else {
+    vpf nu = vp(r->n_u), nv = vp(r->n_v);
+    vpf det = vp_add(vp_add(dk, vp_mul(nu, du)), vp_mul(nv, dv));
+    t = vp_div(vp_add(vp_add(wk, vp_mul(nu, wu)), vp_mul(nv, wv)), det);
+  }
+  unsigned m = active & vpm_bits(vpm_and(vp_gt(t, R->tnear), vp_lt(t, tfar)));
+  if (!m) return 0;
+  vpf hu = vp_sub(vp_mul(t, du), wu), hv = vp_sub(vp_mul(t, dv), wv);
+  vpf beta = vp_add(vp_mul(vp(r->b_u), hu), vp_mul(vp(r->b_v), hv));
+  vpf gamma = vp_add(vp_mul(vp(r->c_u), hu), vp_mul(vp(r->c_v), hv));
+  vpf zero = vp(0.0f);
+  m &= vpm_bits(vpm_and(vpm_and(vp_ge(beta, zero), vp_ge(gamma, zero)), vp_le(vp_add(beta, gamma), vp(1.0f))));
+  *t_out = t;
+  *u_out = beta;
+  *v_out = gamma;
+  return m;
+}
+
+static inline fr_ray lane_ray(const packet *pk, int i, float tfar) {
+  fr_ray r = {{pk->o[0][i], pk->o[1][i], pk->o[2][i]}, pk->tnear[i], {pk->d[0][i], pk->d[1][i], pk->d[2][i]}, tfar};
+  return r;
+}
+
+static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const fr_ray16 *in,
+                             fr_hit16 *out) {
+  packet pk;
+  const unsigned asked = valid & FR_PACKET_ALL;
+  valid = packet_setup(&pk, valid, in);
+  FR_COUNT(packets, 1);
+  FR_COUNT(rays, __builtin_popcount(valid));
+  uint32_t best[P];
+  for (int i = 0; i < P; i++) best[i] = FR_INVALID_ID;
+  pregs R;
+  for (int a = 0; a < 3; a++) { R.o[a] = vp_load(pk.o[a]); R.rd[a] = vp_load(pk.rd[a]); }
+  R.tnear = vp_load(pk.tnear);
+  vpf tfar = vp_select(vpm_bits_to(valid), vp_load(pk.tfar), vp(-INFINITY));
+  vpf U = vp(0.0f), V = vp(0.0f);
+  mailbox mb;
+  for (int i = 0; i < 8; i++) mb.id[i] = FR_INVALID_ID;
+  mb.pos = 0;
+
+  typedef struct { uint32_t ref; unsigned mask; } pentry;
+  pentry stack[STACK_SIZE];
+  float stack_tn[STACK_SIZE][P] __attribute__((aligned(64)));
+  int sp = 0;
+  if (valid) {
+    stack[0] = (pentry){b->root, valid};
+    vp_store(stack_tn[0], vp(-INFINITY));
+    sp = 1;
+  }
+  while (sp) {
+    sp--;
+    const uint32_t ref = stack[sp].ref;
+    unsigned active = stack[sp].mask & vpm_bits(vp_le(vp_load(stack_tn[sp]), vp_mul(tfar, vp(ROUND_UP))));
+    if (!active) continue;
+    int nactive = __builtin_popcount(active);
+    if (nactive <= o->hybrid_threshold) {
+      FR_COUNT(switches, 1);
+      FR_COUNT(switch_rays, nactive);
+      float TF[P] __attribute__((aligned(64))), UU[P] __attribute__((aligned(64))), VV[P] __attribute__((aligned(64)));
+      vp_store(TF, tfar); vp_store(UU, U); vp_store(VV, V);
+      for (unsigned m = active; m; m &= m - 1) {
+        int i = __builtin_ctz(m);
+        fr_ray r = lane_ray(&pk, i, TF[i]);
+        fr_subtree_hit h;
+        if (o->single->intersect_subtree(b, ref, &r, &h)) { TF[i] = h.t; UU[i] = h.u; VV[i] = h.v; best[i] = h.id; }
+      }
+      tfar = vp_load(TF); U = vp_load(UU); V = vp_load(VV);
+      continue;
+    }
+    if (ref & FR_BVHN_LEAF) {
+      const uint32_t li = ref & ~FR_BVHN_LEAF;
+      const fr_tri_shevtsov *rec = &b->shev[4 * (size_t)li];
+      for (int j = 0; j < 4 && rec[j].prim != FR_INVALID_ID; j++) {
+        if (o->mailbox && mailbox_seen(&mb, rec[j].prim)) { FR_COUNT(mailbox_hits, 1); continue; }
+        FR_COUNT(pk_tri_tests, 1);
+        FR_COUNT(pk_tri_lanes, nactive);
+        vpf t, u, v;
+        unsigned hit = tri_test(&rec[j], &pk, &R, tfar, active, o->axis_aligned, &t, &u, &v);
+        if (!hit) continue;
+        vpm hm = vpm_bits_to(hit);
+        tfar = vp_select(hm, t, tfar);
+        U = vp_select(hm, u, U);
+        V = vp_select(hm, v, V);
+        for (unsigned m = hit; m; m &= m - 1) best[__builtin_ctz(m)] = 4 * li + (uint32_t)j;
+      }
+      continue;
+    }
+    const node_t *n = (const node_t *)b->nodes + ref;
+    const float *f = (const float *)n;
+    FR_COUNT(pk_nodes, 1);
+    int nc = (int)n->nchildren;
+    int cand = (1 << nc) - 1;
+    if (o->ia_cull && pk.uniform) {
+      float tmax = vp_reduce_max(vp_select(vpm_bits_to(active), tfar, vp(-INFINITY)));
+      int keep = ia_test(n, &pk, tmax) & cand;
+      FR_COUNT(ia_culled, __builtin_popcount((unsigned)(cand & ~keep)));
+      cand = keep;
+    }
+    /* hit children, then pushed farthest first */
+    int hc[W], nh = 0;
+    unsigned hmask[W];
+    float key[W];
+    float tn_c[W][P] __attribute__((aligned(64)));
+    for (; cand; cand &= cand - 1) {
+      int c = __builtin_ctz((unsigned)cand);
+      FR_COUNT(pk_box_tests, 1);
+      FR_COUNT(pk_box_lanes, nactive);
+      vpf tn;
+      unsigned hm = child_test(f, c, &pk, &R, tfar, active, &tn);
+      if (!hm) continue;
+      vp_store(tn_c[nh], tn);
+      key[nh] = vp_reduce_min(vp_select(vpm_bits_to(hm), tn, vp(INFINITY)));
+      hmask[nh] = hm;
+      hc[nh++] = c;
+    }
+    int order[W];
+    for (int a = 0; a < nh; a++) { /* insertion sort by entry distance, farthest first */
+      int x = a, bpos = a - 1;
+      while (bpos >= 0 && key[order[bpos]] < key[x]) { order[bpos + 1] = order[bpos]; bpos--; }
+      order[bpos + 1] = x;
+    }
+    for (int a = 0; a < nh; a++) {
+      int e = order[a];
+      stack[sp] = (pentry){n->child[hc[e]], hmask[e]};
+      vp_store(stack_tn[sp], vp_load(tn_c[e]));
+      sp++;
+    }
+  }
+
+  float TF[P] __attribute__((aligned(64))), UU[P] __attribute__((aligned(64))), VV[P] __attribute__((aligned(64)));
+  vp_store(TF, tfar); vp_store(UU, U); vp_store(VV, V);
+  for (unsigned m = asked; m; m &= m - 1) {
+    int i = __builtin_ctz(m);
+    fr_hit h;
+    fr_hit_miss(&h);
+    if (best[i] != FR_INVALID_ID) {
+      fr_subtree_hit sh = {TF[i], UU[i], VV[i], best[i]};
+      fr_ray r = lane_ray(&pk, i, pk.tfar[i]);
+      fr_hit_finish(b, &sh, v3_load(r.org), v3_load(r.dir), r.tnear, r.tfar, &h);
+    }
+    out->t[i] = h.t; out->u[i] = h.u; out->v[i] = h.v; out->prim[i] = h.prim;
+    out->ng_x[i] = h.ng[0]; out->ng_y[i] = h.ng[1]; out->ng_z[i] = h.ng[2];
+  }
+}
+
+static unsigned occluded_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const fr_ray16 *in) {
+  packet pk;
+  valid = packet_setup(&pk, valid, in);
+  FR_COUNT(packets, 1);
+  FR_COUNT(rays, __builtin_popcount(valid));
+  pregs R;
+  for (int a = 0; a < 3; a++) { R.o[a] = vp_load(pk.o[a]); R.rd[a] = vp_load(pk.rd[a]); }
+  R.tnear = vp_load(pk.tnear);
+  const vpf tfar = vp_load(pk.tfar);
+  float tfar_max = -INFINITY;
+  for (unsigned m = valid; m; m &= m - 1) tfar_max = fmaxf(tfar_max, pk.tfar[__builtin_ctz(m)]);
+  mailbox mb;
+  for (int i = 0; i < 8; i++) mb.id[i] = FR_INVALID_ID;
+  mb.pos = 0;
+
+  /* A ray's tfar never shrinks here, so a pushed child needs no distances:
+   * its rays hit its box and stay active until occluded. */
+  typedef struct { uint32_t ref; unsigned mask; } pentry;
+  pentry stack[STACK_SIZE];
+  int sp = 0;
+  unsigned occ = 0;
+  if (valid) stack[sp++] = (pentry){b->root, valid};
+  while (sp) {
+    sp--;
+    const uint32_t ref = stack[sp].ref;
+    unsigned active = stack[sp].mask & ~occ;
+    if (!active) continue;
+    int nactive = __builtin_popcount(active);
+    if (nactive <= o->hybrid_threshold) {
+      FR_COUNT(switches, 1);
+      FR_COUNT(switch_rays, nactive);
+      for (unsigned m = active; m; m &= m - 1) {
+        int i = __builtin_ctz(m);
+        fr_ray r = lane_ray(&pk, i, pk.tfar[i]);
+        if (o->single->occluded_subtree(b, ref, &r)) occ |= 1u << i;
+      }
+    } else if (ref & FR_BVHN_LEAF) {
+      const fr_tri_shevtsov *rec = &b->shev[4 * (size_t)(ref & ~FR_BVHN_LEAF)];
+      for (int j = 0; j < 4 && rec[j].prim != FR_INVALID_ID && active; j++) {
+        if (o->mailbox && mailbox_seen(&mb, rec[j].prim)) { FR_COUNT(mailbox_hits, 1); continue; }
+        FR_COUNT(pk_tri_tests, 1);
+        FR_COUNT(pk_tri_lanes, __builtin_popcount(active));
+        vpf t, u, v;
+        unsigned hit = tri_test(&rec[j], &pk, &R, tfar, active, o->axis_aligned, &t, &u, &v);
+        occ |= hit;
+        active &= ~hit;
+      }
+    } else {
+      const node_t *n = (const node_t *)b->nodes + ref;
+      const float *f = (const float *)n;
+      FR_COUNT(pk_nodes, 1);
+      int cand = (1 << n->nchildren) - 1;
+      if (o->ia_cull && pk.uniform) {
+        int keep = ia_test(n, &pk, tfar_max) & cand;
+        FR_COUNT(ia_culled, __builtin_popcount((unsigned)(cand & ~keep)));
+        cand = keep;
+      }
+      /* slot order, so the last slot pops first (see the single-ray any-hit) */
+      for (; cand; cand &= cand - 1) {
+        int c = __builtin_ctz((unsigned)cand);
+        FR_COUNT(pk_box_tests, 1);
+        FR_COUNT(pk_box_lanes, nactive);
+        vpf tn;
+        unsigned hm = child_test(f, c, &pk, &R, tfar, active, &tn);
+        if (hm) stack[sp++] = (pentry){n->child[c], hm};
+      }
+    }
+    if (occ == valid) break;
+  }
+  return occ;
+}
+
+#define PK_NAME3(p, w, isa) fr_packet_p##p##_w##w##_##isa
+#define PK_NAME(p, w, isa) PK_NAME3(p, w, isa)
+const fr_packet_fns PK_NAME(FR_PACKET, FR_WIDTH, FR_ISA_SUFFIX) = {P, intersect_packet, occluded_packet};

@@ -1,0 +1,198 @@
+/*
+ * Packet and hybrid kernels against the single-ray kernels and brute force,
+ * on random scenes: every ISA, packets of 8 and 16, BVH4 and BVH8, pure
+ * packets and the hybrid at several thresholds, and each measurement switch
+ * (mailbox, axis-aligned path, interval culling) on and off. Packets come in
+ * the kinds the renderers make: a common origin with a narrow cone (camera),
+ * many origins to one point (shadows), a common origin with directions of
+ * every sign (ambient occlusion), and unrelated rays, with holes in the
+ * valid mask and invalid rays (NaN, zero direction) among them.
+ */
+#include <string.h>
+#include "io/rayfile.h"
+#include "random_scene.h"
+#include "test_util.h"
+
+enum { KIND_CAMERA, KIND_SHADOW, KIND_HEMISPHERE, KIND_RANDOM, KIND_COUNT };
+
+static void make_packet(fr_rng *r, int kind, vec3 center, float size, const scene_data *sd, fr_ray *rays) {
+  vec3 o = v3_add(center, v3(urand(r, -2 * size, 2 * size), urand(r, -2 * size, 2 * size), urand(r, -2 * size, 2 * size)));
+  vec3 aim = v3_add(center, v3(urand(r, -size, size), urand(r, -size, size), urand(r, -size, size)));
+  float spread = size * 0.05f;
+  for (int i = 0; i < 16; i++) {
+    vec3 ro = o, d;
+    float tfar = INFINITY;
+    uint32_t src;
+    switch (kind) {
+    case KIND_CAMERA:
+      d = v3_sub(v3_add(aim, v3((float)(i & 3) * spread, (float)(i >> 2) * spread, 0.0f)), o);
+      break;
+    case KIND_SHADOW: /* from scattered points to one light; tfar stops short of it */
+      ro = v3_add(aim, v3(urand(r, -spread, spread) * 4, urand(r, -spread, spread) * 4, urand(r, -spread, spread) * 4));
+      d = v3_sub(o, ro);
+      tfar = 1.0f - 1e-4f;
+      break;
+    case KIND_HEMISPHERE:
+      ro = aim;
+      d = v3(urand(r, -1, 1), urand(r, -1, 1), urand(r, -1, 1));
+      break;
+    default: {
+      fr_ray x = random_ray(r, center, size, sd, (int)(fr_rng_u32(r) % 4), &src);
+      rays[i] = x;
+      continue;
+    }
+    }
+    rays[i] = (fr_ray){{ro.x, ro.y, ro.z}, 0.0f, {d.x, d.y, d.z}, tfar};
+  }
+}
+
+static void to_ray16(const fr_ray *rays, fr_ray16 *p) {
+  for (int i = 0; i < 16; i++) {
+    p->org_x[i] = rays[i].org[0]; p->org_y[i] = rays[i].org[1]; p->org_z[i] = rays[i].org[2];
+    p->dir_x[i] = rays[i].dir[0]; p->dir_y[i] = rays[i].dir[1]; p->dir_z[i] = rays[i].dir[2];
+    p->tnear[i] = rays[i].tnear; p->tfar[i] = rays[i].tfar;
+  }
+}
+
+/* The configurations under test; each is compared with the single-ray kernels. */
+typedef struct config { const char *name; fr_trace_mode mode; int threshold, width, mailbox, axis_aligned, ia; } config;
+static const config configs[] = {
+    {"packet16", FR_TRACE_PACKET16, 0, 4, 0, 1, 1},  {"packet8", FR_TRACE_PACKET8, 0, 4, 0, 1, 1},
+    {"hybrid16", FR_TRACE_HYBRID16, 7, 4, 0, 1, 1},  {"hybrid16/t3", FR_TRACE_HYBRID16, 3, 4, 0, 1, 1},
+    {"hybrid16/t16", FR_TRACE_HYBRID16, 16, 4, 0, 1, 1}, {"packet16/bvh8", FR_TRACE_PACKET16, 0, 8, 0, 1, 1},
+    {"hybrid16/bvh8", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1}, {"packet16/mailbox", FR_TRACE_PACKET16, 0, 4, 1, 1, 1},
+    {"packet16/no-aa", FR_TRACE_PACKET16, 0, 4, 0, 0, 1}, {"packet16/no-ia", FR_TRACE_PACKET16, 0, 4, 0, 1, 0},
+    {"auto", FR_TRACE_AUTO, 7, 4, 0, 1, 1},
+};
+#define NCONFIGS (sizeof configs / sizeof configs[0])
+
+static void set_config(fr_scene *s, const config *c) {
+  fr_trace_options o;
+  fr_trace_options_default(&o);
+  o.mode = c->mode;
+  o.hybrid_threshold = c->threshold;
+  o.packet_bvh_width = c->width;
+  o.mailbox = c->mailbox;
+  o.axis_aligned = c->axis_aligned;
+  o.ia_cull = c->ia;
+  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+}
+
+static void check_scene(vec3 center, float size, uint64_t seed) {
+  fr_rng r = fr_rng_seed(seed, 3);
+  scene_data sd = make_scene(&r, 3000, center, size);
+  fr_scene *s;
+  assert_int_equal(fr_scene_from_arrays(sd.pos, sd.nv, sd.idx, sd.nt, &s), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  long compared = 0, hits = 0;
+  for (int p = 0; p < 160; p++) {
+    fr_ray rays[16];
+    int kind = p % KIND_COUNT;
+    make_packet(&r, kind, center, size, &sd, rays);
+    unsigned valid = (p % 3 == 0) ? 0xFFFFu : (fr_rng_u32(&r) & 0xFFFFu);
+    if (p % 7 == 0) { rays[3].dir[0] = NAN; rays[5].dir[0] = rays[5].dir[1] = rays[5].dir[2] = 0.0f; }
+    /* the single-ray answers, and which rays are clear of edges for brute force */
+    fr_hit single[16];
+    int occ1[16], clear[16];
+    assert_int_equal(fr_set_isa(FR_ISA_SCALAR), FR_OK);
+    fr_trace_options dflt;
+    fr_trace_options_default(&dflt);
+    fr_scene_set_trace_options(s, &dflt);
+    for (int i = 0; i < 16; i++) {
+      fr_intersect1(s, &rays[i], &single[i]);
+      occ1[i] = fr_occluded1(s, &rays[i]);
+      uint32_t bp;
+      double margin;
+      double bt = brute_force(sd.pos, sd.idx, sd.nt, &rays[i], &bp, &margin, 1);
+      clear[i] = margin >= 1e-4 && (rays[i].tnear == 0.0f || single[i].prim == FR_INVALID_ID || single[i].t > 1e-3f * size);
+      if (clear[i] && !(isinf(bt) ? single[i].prim == FR_INVALID_ID : fabs(single[i].t - bt) <= 1e-4 * fmax(1.0, fabs(bt))))
+        fail_msg("single-ray kernel disagrees with brute force (packet %d ray %d)", p, i);
+      hits += (valid >> i & 1) && single[i].prim != FR_INVALID_ID;
+    }
+    fr_ray16 r16;
+    to_ray16(rays, &r16);
+    for (int isa = 0; isa < 3; isa++) {
+      if (!fr_isa_supported((fr_isa)isa)) continue;
+      assert_int_equal(fr_set_isa((fr_isa)isa), FR_OK);
+      for (size_t c = 0; c < NCONFIGS; c++) {
+        set_config(s, &configs[c]);
+        fr_hit16 h16;
+        memset(&h16, 0x5A, sizeof h16); /* lanes outside valid must stay as they are */
+        fr_hit hs[16];
+        uint8_t occs[16];
+        fr_ray copy[16];
+        memcpy(copy, rays, sizeof copy);
+        fr_intersect_stream(s, copy, hs, 16);
+        fr_occluded_stream(s, copy, occs, 16);
+        fr_intersect16(s, valid, &r16, &h16);
+        unsigned occ16 = fr_occluded16(s, valid, &r16);
+        for (int i = 0; i < 16; i++) {
+          const char *cn = configs[c].name;
+          if (!((valid >> i) & 1)) {
+            assert_int_equal(h16.prim[i], 0x5A5A5A5Au);
+            assert_false((occ16 >> i) & 1);
+          } else {
+            assert_true(h16.t[i] == h16.t[i]); /* never NaN */
+            if (clear[i]) {
+              if (!fr_hits_agree(h16.t[i], single[i].t))
+                fail_msg("%s isa %d packet %d (kind %d) ray %d: t %g vs single %g", cn, isa, p, kind, i, h16.t[i], single[i].t);
+              if (h16.prim[i] == single[i].prim && h16.prim[i] != FR_INVALID_ID)
+                assert_memory_equal(&h16.t[i], &single[i].t, sizeof(float)); /* t refined the same way */
+              if ((int)((occ16 >> i) & 1) != occ1[i] && !fr_occlusion_near_boundary(&rays[i], single[i].t))
+                fail_msg("%s isa %d packet %d ray %d: occluded %d vs single %d", cn, isa, p, i, (occ16 >> i) & 1, occ1[i]);
+            }
+          }
+          if (clear[i]) {
+            if (!fr_hits_agree(hs[i].t, single[i].t))
+              fail_msg("%s stream isa %d packet %d ray %d: t %g vs single %g", cn, isa, p, i, hs[i].t, single[i].t);
+            if (occs[i] != occ1[i] && !fr_occlusion_near_boundary(&rays[i], single[i].t))
+              fail_msg("%s stream isa %d packet %d ray %d: occluded", cn, isa, p, i);
+            compared++;
+          }
+        }
+      }
+    }
+  }
+  print_message("compared %ld packet lanes with single rays, %ld single hits\n", compared, hits);
+  assert_true(compared > 10000);
+  assert_true(hits > 300);
+  fr_scene_release(s);
+  free_scene(&sd);
+}
+
+static void test_packets_origin(void **st) { (void)st; check_scene(v3(0, 0, 0), 1.0f, 21); }
+static void test_packets_far(void **st) { (void)st; check_scene(v3(1e4f, -2e4f, 5e3f), 50.0f, 22); }
+static void test_packets_tiny(void **st) { (void)st; check_scene(v3(0.1f, 0.2f, 0.3f), 1e-3f, 23); }
+
+/* The option checks of the API. */
+static void test_options(void **st) {
+  (void)st;
+  fr_scene *s;
+  assert_int_equal(fr_scene_builtin(&s), FR_OK);
+  fr_trace_options o;
+  fr_trace_options_default(&o);
+  assert_int_equal(o.hybrid_threshold, 7);
+  o.hybrid_threshold = 17;
+  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  o.hybrid_threshold = 7;
+  o.packet_bvh_width = 6;
+  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  /* an uncommitted scene: misses, nothing occluded */
+  fr_ray16 r16;
+  memset(&r16, 0, sizeof r16);
+  fr_hit16 h;
+  fr_intersect16(s, 0xFFFF, &r16, &h);
+  assert_int_equal(h.prim[0], FR_INVALID_ID);
+  assert_int_equal(fr_occluded16(s, 0xFFFF, &r16), 0);
+  fr_scene_release(s);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_packets_origin),
+      cmocka_unit_test(test_packets_far),
+      cmocka_unit_test(test_packets_tiny),
+      cmocka_unit_test(test_options),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
