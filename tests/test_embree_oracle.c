@@ -16,6 +16,9 @@
 
 #define SIDE 80
 
+/* Camera rays in 4x4 pixel blocks, then a shadow ray and a hemisphere ray
+ * from each hit (in the same order), then random rays through the bounds: as
+ * coherent in groups of 16 as the renderers' rays, for the packet modes. */
 static size_t make_rays(const fr_scene *s, fr_ray *rays, size_t cap) {
   fr_view v;
   if (!fr_view_lookup(s->name, &v)) v = fr_view_from_bounds(s->bounds);
@@ -24,19 +27,27 @@ static size_t make_rays(const fr_scene *s, fr_ray *rays, size_t cap) {
   float eps = 1e-4f * v3_len(v3_sub(s->bounds.hi, s->bounds.lo));
   fr_rng r = fr_rng_seed(5, 5);
   size_t n = 0;
-  for (int y = 0; y < SIDE; y++)
-    for (int x = 0; x < SIDE; x++) {
-      fr_ray pr = fr_camera_ray(&cam, x, y);
-      rays[n++] = pr;
+  for (int by = 0; by < SIDE; by += 4)
+    for (int bx = 0; bx < SIDE; bx += 4)
+      for (int k = 0; k < 16; k++) rays[n++] = fr_camera_ray(&cam, bx + (k & 3), by + (k >> 2));
+  size_t ncam = n, nshadow;
+  for (int pass = 0; pass < 2; pass++) {
+    if (pass == 1) nshadow = n;
+    for (size_t i = 0; i < ncam && n < cap; i++) {
       fr_hit h;
-      fr_intersect1_reference(s, &pr, &h);
-      if (h.prim == FR_INVALID_ID || n + 3 > cap) continue;
-      vec3 p = v3_add(v3_load(pr.org), v3_scale(v3_load(pr.dir), h.t));
-      vec3 L = v3_sub(v.light, p);
-      rays[n++] = (fr_ray){{p.x, p.y, p.z}, eps, {L.x, L.y, L.z}, 1.0f - 1e-4f};
-      vec3 d = v3(urand(&r, -1, 1), urand(&r, -1, 1), urand(&r, -1, 1));
-      rays[n++] = (fr_ray){{p.x, p.y, p.z}, eps, {d.x, d.y, d.z}, INFINITY};
+      fr_intersect1_reference(s, &rays[i], &h);
+      if (h.prim == FR_INVALID_ID) continue;
+      vec3 p = v3_add(v3_load(rays[i].org), v3_scale(v3_load(rays[i].dir), h.t));
+      if (pass == 0) {
+        vec3 L = v3_sub(v.light, p);
+        rays[n++] = (fr_ray){{p.x, p.y, p.z}, eps, {L.x, L.y, L.z}, 1.0f - 1e-4f};
+      } else {
+        vec3 d = v3(urand(&r, -1, 1), urand(&r, -1, 1), urand(&r, -1, 1));
+        rays[n++] = (fr_ray){{p.x, p.y, p.z}, eps, {d.x, d.y, d.z}, INFINITY};
+      }
     }
+  }
+  (void)nshadow;
   vec3 ext = v3_sub(s->bounds.hi, s->bounds.lo);
   while (n < cap) { /* random rays through the bounds */
     vec3 o = v3_add(s->bounds.lo, v3_mul(ext, v3(urand(&r, -0.2f, 1.2f), urand(&r, -0.2f, 1.2f), urand(&r, -0.2f, 1.2f))));
@@ -44,6 +55,45 @@ static size_t make_rays(const fr_scene *s, fr_ray *rays, size_t cap) {
     rays[n++] = (fr_ray){{o.x, o.y, o.z}, 0.0f, {d.x, d.y, d.z}, INFINITY};
   }
   return n;
+}
+
+/* The packet modes through the stream calls, at every ISA: against Embree's
+ * answers eh/eo. Returns the disagreements (closest + any). */
+static long check_packet_modes(fr_scene *s, const fr_ray *rays, size_t n, const fr_hit *eh, const uint8_t *eo) {
+  static const fr_trace_mode modes[] = {FR_TRACE_PACKET8, FR_TRACE_PACKET16, FR_TRACE_HYBRID16, FR_TRACE_AUTO};
+  static const char *names[] = {"packet8", "packet16", "hybrid16", "auto"};
+  fr_hit *h = malloc(n * sizeof *h);
+  uint8_t *occ = malloc(n);
+  long total = 0;
+  char line[512];
+  int len = snprintf(line, sizeof line, "%-12s packets:", s->name);
+  for (int isa = 0; isa < 3; isa++) {
+    if (!fr_isa_supported((fr_isa)isa)) continue;
+    fr_set_isa((fr_isa)isa);
+    for (int m = 0; m < 4; m++) {
+      fr_trace_options o;
+      fr_trace_options_default(&o);
+      o.mode = modes[m];
+      assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+      fr_intersect_stream(s, rays, h, n);
+      fr_occluded_stream(s, rays, occ, n);
+      long bad = 0;
+      for (size_t i = 0; i < n; i++) {
+        bad += !fr_hits_agree(h[i].t, eh[i].t);
+        bad += occ[i] != eo[i] && !fr_occlusion_near_boundary(&rays[i], h[i].t) &&
+               !fr_occlusion_near_boundary(&rays[i], eh[i].t);
+      }
+      len += snprintf(line + len, sizeof line - (size_t)len, " %s/%s=%ld", fr_isa_name((fr_isa)isa), names[m], bad);
+      total += bad;
+    }
+  }
+  fr_trace_options o;
+  fr_trace_options_default(&o);
+  fr_scene_set_trace_options(s, &o);
+  print_message("%s\n", line);
+  free(h);
+  free(occ);
+  return total;
 }
 
 static void check_scene(const char *path) {
@@ -58,10 +108,18 @@ static void check_scene(const char *path) {
   fr_ray *rays = malloc(cap * sizeof *rays);
   size_t n = make_rays(s, rays, cap);
   long bad_hit[6] = {0}, bad_occ[6] = {0}, hits = 0;
+  fr_hit *ehits = malloc(n * sizeof *ehits);
+  uint8_t *eoccs = malloc(n);
+  fr_trace_options single;
+  fr_trace_options_default(&single);
+  single.mode = FR_TRACE_SINGLE;
+  fr_scene_set_trace_options(s, &single);
   for (size_t i = 0; i < n; i++) {
     fr_hit eh;
     ebr_intersect1(eb, &rays[i], &eh);
     int eo = ebr_occluded1(eb, &rays[i]);
+    ehits[i] = eh;
+    eoccs[i] = (uint8_t)eo;
     hits += eh.prim != FR_INVALID_ID;
     for (int isa = 0; isa < 6; isa++) { /* ISA x BVH width */
       if (!fr_isa_supported((fr_isa)(isa % 3))) continue;
@@ -87,6 +145,13 @@ static void check_scene(const char *path) {
     assert_true(bad_occ[i] <= 1);
   }
   assert_true(hits > (long)n / 10);
+  /* Packets test triangles with Shevtsov's test, which is not watertight: a
+   * ray exactly through a shared edge or vertex may slip through. None does
+   * today; one per scene is let pass, as above. */
+  long bad_packets = check_packet_modes(s, rays, n, ehits, eoccs);
+  assert_true(bad_packets <= 1);
+  free(ehits);
+  free(eoccs);
   free(rays);
   ebr_release(eb);
   fr_scene_release(s);
