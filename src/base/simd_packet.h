@@ -34,6 +34,7 @@ FR_INLINE vpm vpm_bits_to(unsigned b) { vpm r = {(__mmask16)b}; return r; }
 FR_INLINE unsigned vpm_bits(vpm a) { return a.m; }
 FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) { vpf r = {_mm512_mask_blend_ps(m.m, f.v, t.v)}; return r; }
 FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r = {(__mmask16)(a.m & b.m)}; return r; }
+FR_VP_BIN(vp_and, _mm512_and_ps) FR_VP_BIN(vp_or, _mm512_or_ps)
 FR_INLINE vpf vp_loadu(const float *p) { vpf r = {_mm512_loadu_ps(p)}; return r; }
 FR_INLINE float vp_reduce_min(vpf a) { return _mm512_reduce_min_ps(a.v); }
 FR_INLINE float vp_reduce_max(vpf a) { return _mm512_reduce_max_ps(a.v); }
@@ -52,6 +53,7 @@ FR_INLINE vpm vpm_bits_to(unsigned b) { vpm r = {(__mmask8)b}; return r; }
 FR_INLINE unsigned vpm_bits(vpm a) { return a.m; }
 FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) { vpf r = {_mm256_mask_blend_ps(m.m, f.v, t.v)}; return r; }
 FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r = {(__mmask8)(a.m & b.m)}; return r; }
+FR_VP_BIN(vp_and, _mm256_and_ps) FR_VP_BIN(vp_or, _mm256_or_ps)
 FR_INLINE vpf vp_loadu(const float *p) { vpf r = {_mm256_loadu_ps(p)}; return r; }
 
 #elif defined(FR_BUILD_ISA_AVX2) || defined(FR_BUILD_ISA_AVX512)
@@ -82,6 +84,7 @@ FR_INLINE vpm vpm_bits_to(unsigned b) {
 }
 FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_blendv_ps(f.v[h], t.v[h], m.m[h]); return r; }
 FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r; for (int h = 0; h < FR_VP_HALVES; h++) r.m[h] = _mm256_and_ps(a.m[h], b.m[h]); return r; }
+FR_VP_BIN(vp_and, _mm256_and_ps) FR_VP_BIN(vp_or, _mm256_or_ps)
 FR_INLINE vpf vp_loadu(const float *p) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_loadu_ps(p + 8 * h); return r; }
 
 #else /* scalar */
@@ -105,6 +108,17 @@ FR_INLINE vpm vpm_bits_to(unsigned b) { vpm r = {b}; return r; }
 FR_INLINE unsigned vpm_bits(vpm a) { return a.m; }
 FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) FR_VP_LANES(((m.m >> i) & 1) ? t.f[i] : f.f[i])
 FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r = {a.m & b.m}; return r; }
+FR_INLINE float fr_vp_bits_and(float a, float b) {
+  union { float f; uint32_t u; } x = {a}, y = {b};
+  x.u &= y.u;
+  return x.f;
+}
+FR_INLINE float fr_vp_bits_or(float a, float b) {
+  union { float f; uint32_t u; } x = {a}, y = {b};
+  x.u |= y.u;
+  return x.f;
+}
+FR_VP_BIN(vp_and, fr_vp_bits_and(a.f[i], b.f[i])) FR_VP_BIN(vp_or, fr_vp_bits_or(a.f[i], b.f[i]))
 FR_INLINE vpf vp_loadu(const float *p) FR_VP_LANES(p[i])
 FR_INLINE float vp_reduce_min(vpf a) { float r = a.f[0]; for (int i = 1; i < P; i++) r = a.f[i] < r ? a.f[i] : r; return r; }
 FR_INLINE float vp_reduce_max(vpf a) { float r = a.f[0]; for (int i = 1; i < P; i++) r = a.f[i] > r ? a.f[i] : r; return r; }
@@ -113,6 +127,13 @@ FR_INLINE float vp_reduce_max(vpf a) { float r = a.f[0]; for (int i = 1; i < P; 
 /* (scalar: FR##op pastes to the FR_CMP_* macros above) */
 FR_VP_CMP(vp_lt, _CMP_LT_OQ) FR_VP_CMP(vp_le, _CMP_LE_OQ) FR_VP_CMP(vp_gt, _CMP_GT_OQ)
 FR_VP_CMP(vp_ge, _CMP_GE_OQ) FR_VP_CMP(vp_eq, _CMP_EQ_OQ)
+
+/* bitwise on the float patterns: |a|, and b with a's sign */
+FR_INLINE vpf vp_abs(vpf a) {
+  union { uint32_t u; float f; } m = {0x7FFFFFFFu};
+  return vp_and(a, vp(m.f));
+}
+FR_INLINE vpf vp_copysign(vpf mag, vpf sgn) { return vp_or(vp_abs(mag), vp_and(sgn, vp(-0.0f))); }
 
 #if !(defined(FR_BUILD_ISA_AVX512) && P == 16) && !defined(FR_BUILD_ISA_SCALAR)
 /* through memory: rare enough (child ordering, IA bounds) not to matter */

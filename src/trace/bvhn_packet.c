@@ -65,75 +65,75 @@ typedef struct packet {
   int uniform;
   int near_off[3];
   float omin[3], omax[3], rmin[3], rmax[3], tnear_min;
+  float ia_near_o[3], ia_far_o[3]; /* see ia_test */
 } packet;
 
-static inline float safe_rcp(float d) {
-  if (fabsf(d) < 1e-18f) d = copysignf(1e-18f, d); /* as the single-ray kernel */
-  return 1.0f / d;
-}
-
-/* Loads lanes 0..P-1; returns the valid mask without rays that cannot hit. */
+/* Loads lanes 0..P-1; returns the valid mask without rays that cannot hit
+ * (the conditions of fr_ray_invalid, lane by lane). */
 static unsigned packet_setup(packet *pk, unsigned valid, const fr_ray16 *in) {
-  valid &= FR_PACKET_ALL;
-  for (int i = 0; i < P; i++) {
-    fr_ray r = {{in->org_x[i], in->org_y[i], in->org_z[i]}, in->tnear[i],
-                {in->dir_x[i], in->dir_y[i], in->dir_z[i]}, in->tfar[i]};
-    if (!((valid >> i) & 1) || fr_ray_invalid(&r)) {
-      valid &= ~(1u << i);
-      /* harmless values: the lane is masked off everywhere */
-      memset(&r, 0, sizeof r);
-      r.dir[0] = r.dir[1] = r.dir[2] = 1.0f;
-    }
-    for (int a = 0; a < 3; a++) {
-      pk->o[a][i] = r.org[a];
-      pk->d[a][i] = r.dir[a];
-      pk->rd[a][i] = safe_rcp(r.dir[a]);
-    }
-    pk->tnear[i] = r.tnear;
-    pk->tfar[i] = r.tfar;
-  }
-  pk->uniform = valid != 0;
-  pk->tnear_min = INFINITY;
+  const float *org[3] = {in->org_x, in->org_y, in->org_z}, *dir[3] = {in->dir_x, in->dir_y, in->dir_z};
+  const vpf inf = vp(INFINITY), zero = vp(0.0f), tiny = vp(1e-18f);
+  vpf tnear = vp_loadu(in->tnear), tfar = vp_loadu(in->tfar);
+  valid &= FR_PACKET_ALL & vpm_bits(vp_le(tnear, tfar));
+  unsigned nonzero = 0;
+  vpf o[3], d[3];
   for (int a = 0; a < 3; a++) {
-    pk->omin[a] = pk->rmin[a] = INFINITY;
-    pk->omax[a] = pk->rmax[a] = -INFINITY;
+    o[a] = vp_loadu(org[a]);
+    d[a] = vp_loadu(dir[a]);
+    valid &= vpm_bits(vpm_and(vp_lt(vp_abs(o[a]), inf), vp_lt(vp_abs(d[a]), inf)));
+    nonzero |= ~vpm_bits(vp_eq(d[a], zero));
   }
-  for (unsigned m = valid; m; m &= m - 1) {
-    int i = __builtin_ctz(m);
-    for (int a = 0; a < 3; a++) {
-      pk->omin[a] = fminf(pk->omin[a], pk->o[a][i]);
-      pk->omax[a] = fmaxf(pk->omax[a], pk->o[a][i]);
-      pk->rmin[a] = fminf(pk->rmin[a], pk->rd[a][i]);
-      pk->rmax[a] = fmaxf(pk->rmax[a], pk->rd[a][i]);
-    }
-    pk->tnear_min = fminf(pk->tnear_min, pk->tnear[i]);
+  valid &= nonzero;
+  /* invalid lanes get harmless values: they are masked off everywhere */
+  vpm ok = vpm_bits_to(valid);
+  for (int a = 0; a < 3; a++) {
+    o[a] = vp_select(ok, o[a], zero);
+    d[a] = vp_select(ok, d[a], vp(1.0f));
+    /* as the single-ray kernel: a zero component would give inf * 0 = NaN */
+    vpf dd = vp_select(vp_lt(vp_abs(d[a]), tiny), vp_copysign(tiny, d[a]), d[a]);
+    vpf rd = vp_div(vp(1.0f), dd);
+    vp_store(pk->o[a], o[a]);
+    vp_store(pk->d[a], d[a]);
+    vp_store(pk->rd[a], rd);
+    pk->omin[a] = vp_reduce_min(vp_select(ok, o[a], inf));
+    pk->omax[a] = vp_reduce_max(vp_select(ok, o[a], vp(-INFINITY)));
+    pk->rmin[a] = vp_reduce_min(vp_select(ok, rd, inf));
+    pk->rmax[a] = vp_reduce_max(vp_select(ok, rd, vp(-INFINITY)));
   }
+  tnear = vp_select(ok, tnear, zero);
+  vp_store(pk->tnear, tnear);
+  vp_store(pk->tfar, vp_select(ok, tfar, zero));
+  pk->tnear_min = vp_reduce_min(vp_select(ok, tnear, inf));
+  pk->uniform = valid != 0;
   for (int a = 0; a < 3; a++) {
     int pos = pk->rmin[a] > 0.0f, neg = pk->rmax[a] < 0.0f;
     pk->uniform &= pos | neg;
     pk->near_off[a] = pos ? 2 * a * W : (2 * a + 1) * W;
+    pk->ia_near_o[a] = pos ? pk->omax[a] : pk->omin[a];
+    pk->ia_far_o[a] = pos ? pk->omin[a] : pk->omax[a];
   }
   return valid;
 }
 
 /* Step 1: children that no ray of the packet can hit, by interval arithmetic
- * on [omin, omax] and [rmin, rmax] (uniform packets only). Each bound is a
- * corner product of the same rounded operations a ray's own test makes, and
- * rounding is monotonic, so the bounds contain every ray's float distances:
- * the cull is exactly as conservative as the per-ray test. Returns the mask
- * of children that may be hit. */
+ * on the origins [omin, omax] and reciprocal directions [rmin, rmax] (uniform
+ * packets only). On an axis where every r > 0, (plane - o) * r is smallest
+ * for the largest o and largest for the smallest o; where every r < 0 the
+ * other way round: so ia_near_o / ia_far_o hold the origin bound that gives
+ * the nearest entry and the farthest exit, and two products per plane bound
+ * the rest. Each bound is the same rounded operations a ray's own test makes,
+ * and rounding is monotonic, so the bounds contain every ray's float
+ * distances: the cull is exactly as conservative as the per-ray test.
+ * Returns the mask of children that may be hit. */
 FR_INLINE int ia_test(const node_t *n, const packet *pk, float tfar_max) {
   const float *f = (const float *)n;
   vnode tn = VN(pk->tnear_min), tf = VN(tfar_max);
   for (int a = 0; a < 3; a++) {
-    vnode np = VN_LOAD(f + pk->near_off[a]), fp = VN_LOAD(f + (pk->near_off[a] ^ W));
     vnode rlo = VN(pk->rmin[a]), rhi = VN(pk->rmax[a]);
-    vnode na = VN_SUB(np, VN(pk->omax[a])), nb = VN_SUB(np, VN(pk->omin[a]));
-    vnode fa = VN_SUB(fp, VN(pk->omax[a])), fb = VN_SUB(fp, VN(pk->omin[a]));
-    vnode lo = VN_MIN(VN_MIN(VN_MUL(na, rlo), VN_MUL(na, rhi)), VN_MIN(VN_MUL(nb, rlo), VN_MUL(nb, rhi)));
-    vnode hi = VN_MAX(VN_MAX(VN_MUL(fa, rlo), VN_MUL(fa, rhi)), VN_MAX(VN_MUL(fb, rlo), VN_MUL(fb, rhi)));
-    tn = VN_MAX(tn, lo);
-    tf = VN_MIN(tf, hi);
+    vnode x = VN_SUB(VN_LOAD(f + pk->near_off[a]), VN(pk->ia_near_o[a]));
+    vnode y = VN_SUB(VN_LOAD(f + (pk->near_off[a] ^ W)), VN(pk->ia_far_o[a]));
+    tn = VN_MAX(tn, VN_MIN(VN_MUL(x, rlo), VN_MUL(x, rhi)));
+    tf = VN_MIN(tf, VN_MAX(VN_MUL(y, rlo), VN_MUL(y, rhi)));
   }
   return VN_LE_BITS(tn, VN_MUL(tf, VN(ROUND_UP)));
 }
@@ -235,6 +235,8 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
   R.tnear = vp_load(pk.tnear);
   vpf tfar = vp_select(vpm_bits_to(valid), vp_load(pk.tfar), vp(-INFINITY));
   vpf U = vp(0.0f), V = vp(0.0f);
+  float tmax = INFINITY;
+  int tmax_stale = 1;
   mailbox mb;
   for (int i = 0; i < 8; i++) mb.id[i] = FR_INVALID_ID;
   mb.pos = 0;
@@ -266,6 +268,7 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
         if (o->single->intersect_subtree(b, ref, &r, &h)) { TF[i] = h.t; UU[i] = h.u; VV[i] = h.v; best[i] = h.id; }
       }
       tfar = vp_load(TF); U = vp_load(UU); V = vp_load(VV);
+      tmax_stale = 1;
       continue;
     }
     if (ref & FR_BVHN_LEAF) {
@@ -279,6 +282,7 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
         unsigned hit = tri_test(&rec[j], &pk, &R, tfar, active, o->axis_aligned, &t, &u, &v);
         if (!hit) continue;
         vpm hm = vpm_bits_to(hit);
+        tmax_stale = 1;
         tfar = vp_select(hm, t, tfar);
         U = vp_select(hm, u, U);
         V = vp_select(hm, v, V);
@@ -292,7 +296,9 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
     int nc = (int)n->nchildren;
     int cand = (1 << nc) - 1;
     if (o->ia_cull && pk.uniform) {
-      float tmax = vp_reduce_max(vp_select(vpm_bits_to(active), tfar, vp(-INFINITY)));
+      /* the packet's farthest tfar: over all its rays, recomputed only after
+       * hits (a bound over the active rays alone measured no better) */
+      if (tmax_stale) { tmax = vp_reduce_max(tfar); tmax_stale = 0; }
       int keep = ia_test(n, &pk, tmax) & cand;
       FR_COUNT(ia_culled, __builtin_popcount((unsigned)(cand & ~keep)));
       cand = keep;
@@ -310,7 +316,9 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
       unsigned hm = child_test(f, c, &pk, &R, tfar, active, &tn);
       if (!hm) continue;
       vp_store(tn_c[nh], tn);
-      key[nh] = vp_reduce_min(vp_select(vpm_bits_to(hm), tn, vp(INFINITY)));
+      /* order by the first hitting ray's entry distance: as good as the
+       * packet's minimum for coherent packets, without a reduction */
+      key[nh] = tn_c[nh][__builtin_ctz(hm)];
       hmask[nh] = hm;
       hc[nh++] = c;
     }
@@ -353,8 +361,7 @@ static unsigned occluded_packet(const fr_bvhn *b, const fr_packet_opts *o, unsig
   for (int a = 0; a < 3; a++) { R.o[a] = vp_load(pk.o[a]); R.rd[a] = vp_load(pk.rd[a]); }
   R.tnear = vp_load(pk.tnear);
   const vpf tfar = vp_load(pk.tfar);
-  float tfar_max = -INFINITY;
-  for (unsigned m = valid; m; m &= m - 1) tfar_max = fmaxf(tfar_max, pk.tfar[__builtin_ctz(m)]);
+  const float tfar_max = vp_reduce_max(vp_select(vpm_bits_to(valid), tfar, vp(-INFINITY)));
   mailbox mb;
   for (int i = 0; i < 8; i++) mb.id[i] = FR_INVALID_ID;
   mb.pos = 0;
