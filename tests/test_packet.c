@@ -111,6 +111,10 @@ static void check_scene(vec3 center, float size, uint64_t seed) {
     }
     fr_ray16 r16;
     to_ray16(rays, &r16);
+    /* every ISA runs the same arithmetic: bit-identical packet answers */
+    fr_hit16 first[NCONFIGS];
+    unsigned first_occ[NCONFIGS];
+    int have_first = 0;
     for (int isa = 0; isa < 3; isa++) {
       if (!fr_isa_supported((fr_isa)isa)) continue;
       assert_int_equal(fr_set_isa((fr_isa)isa), FR_OK);
@@ -126,6 +130,13 @@ static void check_scene(vec3 center, float size, uint64_t seed) {
         fr_occluded_stream(s, copy, occs, 16);
         fr_intersect16(s, valid, &r16, &h16);
         unsigned occ16 = fr_occluded16(s, valid, &r16);
+        if (!have_first) {
+          first[c] = h16;
+          first_occ[c] = occ16;
+        } else {
+          assert_int_equal(occ16, first_occ[c]);
+          assert_memory_equal(&h16, &first[c], sizeof h16);
+        }
         for (int i = 0; i < 16; i++) {
           const char *cn = configs[c].name;
           if (!((valid >> i) & 1)) {
@@ -151,6 +162,7 @@ static void check_scene(vec3 center, float size, uint64_t seed) {
           }
         }
       }
+      have_first = 1;
     }
   }
   print_message("compared %ld packet lanes with single rays, %ld single hits\n", compared, hits);

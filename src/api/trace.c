@@ -8,7 +8,7 @@
 void fr_trace_options_default(fr_trace_options *o) {
   o->mode = FR_TRACE_AUTO;
   o->hybrid_threshold = 7;
-  o->packet_bvh_width = 4;
+  o->packet_bvh_width = 8;
   o->mailbox = 0;
   o->axis_aligned = 1;
   o->ia_cull = 1;

@@ -256,7 +256,7 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
     unsigned active = stack[sp].mask & vpm_bits(vp_le(vp_load(stack_tn[sp]), vp_mul(tfar, vp(ROUND_UP))));
     if (!active) continue;
     int nactive = __builtin_popcount(active);
-    if (nactive <= o->hybrid_threshold) {
+    if (nactive <= o->hybrid_threshold && !(ref & FR_BVHN_LEAF)) {
       FR_COUNT(switches, 1);
       FR_COUNT(switch_rays, nactive);
       float TF[P] __attribute__((aligned(64))), UU[P] __attribute__((aligned(64))), VV[P] __attribute__((aligned(64)));
@@ -379,7 +379,7 @@ static unsigned occluded_packet(const fr_bvhn *b, const fr_packet_opts *o, unsig
     unsigned active = stack[sp].mask & ~occ;
     if (!active) continue;
     int nactive = __builtin_popcount(active);
-    if (nactive <= o->hybrid_threshold) {
+    if (nactive <= o->hybrid_threshold && !(ref & FR_BVHN_LEAF)) {
       FR_COUNT(switches, 1);
       FR_COUNT(switch_rays, nactive);
       for (unsigned m = active; m; m &= m - 1) {

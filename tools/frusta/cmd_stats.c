@@ -1,5 +1,8 @@
 /* frusta stats SCENE: BVH statistics (the MIC paper's Tables I-II), and with
- * --embree Embree's own builder on the same triangles for comparison. */
+ * --embree Embree's own builder on the same triangles for comparison. With
+ * --workload W, the MIC paper's Table V for the hybrid on that workload: the
+ * share of box and triangle tests made in packet and in single-ray mode, and
+ * the switches per packet (needs a build with -DFRUSTA_COUNTERS=ON). */
 #include <omp.h>
 #include <stdio.h>
 #include <string.h>
@@ -7,12 +10,67 @@
 #include "cli.h"
 #include "commands.h"
 #include "embree_tracer.h"
+#include "render/workload.h"
+#include "trace/counters.h"
+
+/* Table V: runs the workload once in hybrid16 mode with the counters on. */
+static int table5(const char *path, const cli_view *v, int threads, const char *wl_name, int threshold, int width) {
+  if (!fr_counters_enabled())
+    return cli_error(1, "stats --workload needs the counters: configure with cmake -DFRUSTA_COUNTERS=ON and rebuild");
+  fr_workload_kind k;
+  if (!fr_workload_parse(wl_name, &k)) return cli_error(CLI_USAGE_ERROR, "unknown workload '%s'", wl_name);
+  fr_scene *s;
+  fr_workload w;
+  memset(&w, 0, sizeof w);
+  int rc = cli_workload_setup(path, v, threads, &s, &w);
+  if (rc) return rc;
+  w.kind = k;
+  w.seed = 7;
+  fr_trace_options o;
+  fr_trace_options_default(&o);
+  o.mode = FR_TRACE_HYBRID16;
+  o.hybrid_threshold = threshold;
+  o.packet_bvh_width = width;
+  fr_scene_set_trace_options(s, &o);
+  fr_tracer t = fr_tracer_frusta(s);
+  fr_counters_reset();
+  fr_workload_result r = fr_workload_run(&w, &t);
+  fr_counters c = fr_counters_read();
+  /* ray-box and ray-triangle tests: a packet test counts its active rays */
+  double box_p = (double)c.pk_box_lanes, box_s = (double)c.box_tests;
+  double tri_p = (double)c.pk_tri_lanes, tri_s = (double)c.tri_tests;
+  double box = box_p + box_s, tri = tri_p + tri_s;
+  printf("table5 scene=%s workload=%s threshold=%d packet_bvh_width=%d rays=%llu packets=%llu "
+         "box_tests_packet=%.1f%% box_tests_single=%.1f%% tri_tests_packet=%.1f%% tri_tests_single=%.1f%% "
+         "switches_per_packet=%.2f rays_per_switch=%.2f avg_active_box=%.2f avg_active_tri=%.2f ia_culled_per_packet=%.2f "
+         "mailbox_hits_per_packet=%.3f\n",
+         s->name, wl_name, threshold, width, (unsigned long long)r.rays, (unsigned long long)c.packets,
+         box > 0 ? 100.0 * box_p / box : 0.0, box > 0 ? 100.0 * box_s / box : 0.0, tri > 0 ? 100.0 * tri_p / tri : 0.0,
+         tri > 0 ? 100.0 * tri_s / tri : 0.0, c.packets ? (double)c.switches / c.packets : 0.0,
+         c.switches ? (double)c.switch_rays / c.switches : 0.0, c.pk_box_tests ? (double)c.pk_box_lanes / c.pk_box_tests : 0.0,
+         c.pk_tri_tests ? (double)c.pk_tri_lanes / c.pk_tri_tests : 0.0, c.packets ? (double)c.ia_culled / c.packets : 0.0,
+         c.packets ? (double)c.mailbox_hits / c.packets : 0.0);
+  fr_scene_release(s);
+  return 0;
+}
 
 int cmd_stats(int argc, char **argv) {
-  const char *path = NULL;
-  int embree = 0, threads = omp_get_num_procs();
+  const char *path = NULL, *workload = NULL;
+  int embree = 0, threads = omp_get_num_procs(), threshold = 7, width = 8;
+  cli_view v;
+  memset(&v, 0, sizeof v);
+  v.width = 1024; v.height = 1024;
   for (int i = 0; i < argc; i++) {
+    int r = cli_view_flag(argc, argv, &i, &v);
+    if (r < 0) return CLI_USAGE_ERROR;
+    if (r > 0) continue;
     if (strcmp(argv[i], "--embree") == 0) embree = 1;
+    else if (strcmp(argv[i], "--workload") == 0 && i + 1 < argc) workload = argv[++i];
+    else if (strcmp(argv[i], "--threshold") == 0 && i + 1 < argc) {
+      if (!cli_parse_int(argv[++i], 0, 16, &threshold)) return cli_error(CLI_USAGE_ERROR, "--threshold wants 0..16");
+    } else if (strcmp(argv[i], "--packet-width") == 0 && i + 1 < argc) {
+      if (!cli_parse_int(argv[++i], 4, 8, &width) || (width != 4 && width != 8)) return cli_error(CLI_USAGE_ERROR, "--packet-width is 4 or 8");
+    }
     else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
       if (!cli_parse_int(argv[++i], 1, 1024, &threads)) return cli_error(CLI_USAGE_ERROR, "--threads wants 1..1024");
     } else if (strcmp(argv[i], "--builtin") == 0 || argv[i][0] != '-') {
@@ -20,8 +78,10 @@ int cmd_stats(int argc, char **argv) {
       path = argv[i];
     } else return cli_error(CLI_USAGE_ERROR, "stats: unknown option '%s'", argv[i]);
   }
-  if (!path) return cli_error(CLI_USAGE_ERROR, "usage: frusta stats SCENE|--builtin [--embree] [--threads N]");
+  if (!path)
+    return cli_error(CLI_USAGE_ERROR, "usage: frusta stats SCENE|--builtin [--embree] [--threads N] [--workload W [--threshold N] [--packet-width 4|8] [view flags]]");
   omp_set_num_threads(threads);
+  if (workload) return table5(path, &v, threads, workload, threshold, width);
   fr_scene *s;
   if (cli_load_scene(path, &s)) return 1;
   fr_bvh_stats st;

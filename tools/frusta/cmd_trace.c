@@ -1,5 +1,7 @@
 /* frusta trace SCENE RAYS --query closest|any --out FILE: answers a ray file
- * (../shared/spec/rayfile.md) with frusta, or with Embree for comparison. */
+ * (../shared/spec/rayfile.md) with frusta, or with Embree for comparison.
+ * --mode picks frusta's kernels: single rays (default), or the stream calls
+ * in packet8, packet16, hybrid16 or auto mode over consecutive rays. */
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,15 +13,23 @@
 
 int cmd_trace(int argc, char **argv) {
   const char *scene = NULL, *rays_path = NULL, *out = NULL, *query = NULL, *tracer = "frusta";
+  static const char *mode_names[] = {"auto", "single", "packet8", "packet16", "hybrid16"}; /* fr_trace_mode order */
+  int mode = FR_TRACE_SINGLE;
   for (int i = 0; i < argc; i++) {
     const char *a = argv[i];
-    if ((strcmp(a, "--query") == 0 || strcmp(a, "--out") == 0 || strcmp(a, "--tracer") == 0 || strcmp(a, "--isa") == 0)) {
+    if ((strcmp(a, "--query") == 0 || strcmp(a, "--out") == 0 || strcmp(a, "--tracer") == 0 || strcmp(a, "--isa") == 0 ||
+         strcmp(a, "--mode") == 0)) {
       if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
       const char *v = argv[++i];
       if (a[2] == 'q') query = v;
       else if (a[2] == 'o') out = v;
       else if (a[2] == 't') tracer = v;
-      else if (cli_set_isa(v)) return 1;
+      else if (a[2] == 'm') {
+        mode = -1;
+        for (int m = 0; m < 5; m++)
+          if (strcmp(v, mode_names[m]) == 0) mode = m;
+        if (mode < 0) return cli_error(CLI_USAGE_ERROR, "--mode is single, packet8, packet16, hybrid16 or auto, not '%s'", v);
+      } else if (cli_set_isa(v)) return 1;
     } else if (a[0] == '-' && strcmp(a, "--builtin") != 0) {
       return cli_error(CLI_USAGE_ERROR, "trace: unknown option '%s'", a);
     } else if (!scene) scene = a;
@@ -27,7 +37,7 @@ int cmd_trace(int argc, char **argv) {
     else return cli_error(CLI_USAGE_ERROR, "trace: unexpected argument '%s'", a);
   }
   if (!scene || !rays_path || !out || !query)
-    return cli_error(CLI_USAGE_ERROR, "usage: frusta trace SCENE RAYS --query closest|any --out FILE [--tracer frusta|embree]");
+    return cli_error(CLI_USAGE_ERROR, "usage: frusta trace SCENE RAYS --query closest|any --out FILE [--tracer frusta|embree] [--mode M]");
   int closest = strcmp(query, "closest") == 0;
   if (!closest && strcmp(query, "any") != 0) return cli_error(CLI_USAGE_ERROR, "--query is closest or any, not '%s'", query);
   int use_embree = strcmp(tracer, "embree") == 0;
@@ -38,6 +48,12 @@ int cmd_trace(int argc, char **argv) {
   if (fr_rays_read(rays_path, &rays, &n)) return cli_error(1, "%s", fr_last_error());
   fr_scene *s;
   if (cli_load_scene(scene, &s)) { free(rays); return 1; }
+  fr_trace_options topt;
+  fr_trace_options_default(&topt);
+  topt.mode = (fr_trace_mode)mode;
+  fr_scene_set_trace_options(s, &topt);
+  const int stream = !use_embree && mode != FR_TRACE_SINGLE;
+  const size_t chunk = 4096; /* a multiple of 16: packets never straddle chunks */
   ebr_scene *e = NULL;
   if (use_embree) {
     ebr_options o = {0, 2, 1}; /* robust: Embree's watertight mode */
@@ -48,10 +64,15 @@ int cmd_trace(int argc, char **argv) {
     fr_hit *hits = malloc((n ? n : 1) * sizeof *hits);
     if (!hits) rc = cli_error(1, "out of memory for %zu hits", n);
     else {
+      if (stream) {
+#pragma omp parallel for schedule(dynamic, 1)
+        for (size_t c = 0; c < n; c += chunk) fr_intersect_stream(s, rays + c, hits + c, n - c < chunk ? n - c : chunk);
+      } else {
 #pragma omp parallel for schedule(dynamic, 4096)
-      for (size_t i = 0; i < n; i++) {
-        if (e) ebr_intersect1(e, &rays[i], &hits[i]);
-        else fr_intersect1(s, &rays[i], &hits[i]);
+        for (size_t i = 0; i < n; i++) {
+          if (e) ebr_intersect1(e, &rays[i], &hits[i]);
+          else fr_intersect1(s, &rays[i], &hits[i]);
+        }
       }
       if (fr_hits_write(out, hits, n)) rc = cli_error(1, "%s", fr_last_error());
     }
@@ -60,8 +81,13 @@ int cmd_trace(int argc, char **argv) {
     uint8_t *occ = malloc(n ? n : 1);
     if (!occ) rc = cli_error(1, "out of memory for %zu rays", n);
     else {
+      if (stream) {
+#pragma omp parallel for schedule(dynamic, 1)
+        for (size_t c = 0; c < n; c += chunk) fr_occluded_stream(s, rays + c, occ + c, n - c < chunk ? n - c : chunk);
+      } else {
 #pragma omp parallel for schedule(dynamic, 4096)
-      for (size_t i = 0; i < n; i++) occ[i] = (uint8_t)(e ? ebr_occluded1(e, &rays[i]) : fr_occluded1(s, &rays[i]));
+        for (size_t i = 0; i < n; i++) occ[i] = (uint8_t)(e ? ebr_occluded1(e, &rays[i]) : fr_occluded1(s, &rays[i]));
+      }
       if (fr_occl_write(out, occ, n)) rc = cli_error(1, "%s", fr_last_error());
     }
     free(occ);
