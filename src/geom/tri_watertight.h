@@ -65,14 +65,23 @@ static inline int fr_tri_watertight(const fr_wt_ray *w, vec3 o, float tnear, flo
  * seen at grazing angles (1e-4 relative on conference walls, against Embree
  * and a double-precision reference); the plane distance in double does not.
  * Kept within (tnear, tfar), so the hit stays a hit. */
-static inline float fr_tri_refine_t(vec3 o, vec3 d, float tnear, float tfar, vec3 p0, vec3 p1, vec3 p2, float t) {
-  double e1[3] = {(double)p1.x - p0.x, (double)p1.y - p0.y, (double)p1.z - p0.z};
-  double e2[3] = {(double)p2.x - p0.x, (double)p2.y - p0.y, (double)p2.z - p0.z};
-  double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
-  double den = n[0] * d.x + n[1] * d.y + n[2] * d.z;
-  if (den == 0.0) return t;
-  double num = n[0] * ((double)p0.x - o.x) + n[1] * ((double)p0.y - o.y) + n[2] * ((double)p0.z - o.z);
+/* The same on plain floats and without branches (den == 0 gives inf or NaN,
+ * which the final choice drops), so that a loop over a packet's rays
+ * vectorizes; IEEE double operations give the same bits either way. */
+static inline float fr_tri_refine_lane(float ox, float oy, float oz, float dx, float dy, float dz, float tnear,
+                                       float tfar, float ax, float ay, float az, float bx, float by, float bz, float cx,
+                                       float cy, float cz, float t) {
+  double e1x = (double)bx - ax, e1y = (double)by - ay, e1z = (double)bz - az;
+  double e2x = (double)cx - ax, e2y = (double)cy - ay, e2z = (double)cz - az;
+  double nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z, nz = e1x * e2y - e1y * e2x;
+  double den = nx * dx + ny * dy + nz * dz;
+  double num = nx * ((double)ax - ox) + ny * ((double)ay - oy) + nz * ((double)az - oz);
   float r = (float)(num / den);
-  return (r > tnear && r < tfar) ? r : t;
+  int ok = (den != 0.0) & (r > tnear) & (r < tfar);
+  return ok ? r : t;
+}
+static inline float fr_tri_refine_t(vec3 o, vec3 d, float tnear, float tfar, vec3 p0, vec3 p1, vec3 p2, float t) {
+  return fr_tri_refine_lane(o.x, o.y, o.z, d.x, d.y, d.z, tnear, tfar, p0.x, p0.y, p0.z, p1.x, p1.y, p1.z, p2.x, p2.y,
+                            p2.z, t);
 }
 #endif
