@@ -9,6 +9,7 @@
  * valid mask and invalid rays (NaN, zero direction) among them.
  */
 #include <string.h>
+#include "geom/tri_shevtsov.h"
 #include "io/rayfile.h"
 #include "random_scene.h"
 #include "test_util.h"
@@ -176,6 +177,62 @@ static void test_packets_origin(void **st) { (void)st; check_scene(v3(0, 0, 0), 
 static void test_packets_far(void **st) { (void)st; check_scene(v3(1e4f, -2e4f, 5e3f), 50.0f, 22); }
 static void test_packets_tiny(void **st) { (void)st; check_scene(v3(0.1f, 0.2f, 0.3f), 1e-3f, 23); }
 
+/* The packet leaf test lane by lane against the scalar Shevtsov test
+ * (geom/tri_shevtsov.h) on one-triangle scenes: the same hits and the same
+ * barycentric bits, at every ISA, with and without the axis-aligned path. */
+static void test_leaf_against_scalar(void **st) {
+  (void)st;
+  fr_rng r = fr_rng_seed(31, 1);
+  long hits = 0;
+  for (int tri = 0; tri < 200; tri++) {
+    float v[9];
+    for (int k = 0; k < 9; k++) v[k] = urand(&r, -1, 1);
+    if (tri % 3 == 0) v[2] = v[5] = v[8] = 0.25f; /* axis-aligned */
+    const uint32_t idx[3] = {0, 1, 2};
+    fr_scene *s;
+    assert_int_equal(fr_scene_from_arrays(v, 3, idx, 1, &s), FR_OK);
+    assert_int_equal(fr_scene_commit(s), FR_OK);
+    if (fr_scene_triangle_count(s) == 0 || fr_scene_skipped_triangles(s)) { fr_scene_release(s); continue; }
+    fr_tri_shevtsov rec;
+    if (!fr_tri_shevtsov_make(&rec, v3(v[0], v[1], v[2]), v3(v[3], v[4], v[5]), v3(v[6], v[7], v[8]), 0)) {
+      fr_scene_release(s);
+      continue;
+    }
+    fr_ray rays[16];
+    vec3 o = v3(urand(&r, -2, 2), urand(&r, -2, 2), urand(&r, 2, 3));
+    for (int i = 0; i < 16; i++) {
+      vec3 target = v3(urand(&r, -1, 1), urand(&r, -1, 1), urand(&r, -1, 1));
+      vec3 d = v3_sub(target, o);
+      rays[i] = (fr_ray){{o.x, o.y, o.z}, 0.0f, {d.x, d.y, d.z}, INFINITY};
+    }
+    fr_ray16 r16;
+    to_ray16(rays, &r16);
+    for (int isa = 0; isa < 3; isa++) {
+      if (!fr_isa_supported((fr_isa)isa)) continue;
+      fr_set_isa((fr_isa)isa);
+      for (int aa = 0; aa < 2; aa++) {
+        config c = {"leaf", FR_TRACE_PACKET16, 0, 4, 0, aa, 1};
+        set_config(s, &c);
+        fr_tri_shevtsov use = rec;
+        if (!aa) use.axis_aligned = 0;
+        fr_hit16 h;
+        fr_intersect16(s, 0xFFFF, &r16, &h);
+        for (int i = 0; i < 16; i++) {
+          float t, u, w;
+          int hit = fr_tri_shevtsov_test(&use, v3_load(rays[i].org), v3_load(rays[i].dir), 0.0f, INFINITY, &t, &u, &w);
+          assert_int_equal(hit, h.prim[i] == 0);
+          if (!hit) continue;
+          hits++;
+          assert_memory_equal(&u, &h.u[i], sizeof u);
+          assert_memory_equal(&w, &h.v[i], sizeof w);
+        }
+      }
+    }
+    fr_scene_release(s);
+  }
+  assert_true(hits > 500);
+}
+
 /* The option checks of the API. */
 static void test_options(void **st) {
   (void)st;
@@ -204,6 +261,7 @@ int main(void) {
       cmocka_unit_test(test_packets_origin),
       cmocka_unit_test(test_packets_far),
       cmocka_unit_test(test_packets_tiny),
+      cmocka_unit_test(test_leaf_against_scalar),
       cmocka_unit_test(test_options),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -34,7 +34,7 @@ FR_INLINE vpm vpm_bits_to(unsigned b) { vpm r = {(__mmask16)b}; return r; }
 FR_INLINE unsigned vpm_bits(vpm a) { return a.m; }
 FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) { vpf r = {_mm512_mask_blend_ps(m.m, f.v, t.v)}; return r; }
 FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r = {(__mmask16)(a.m & b.m)}; return r; }
-FR_VP_BIN(vp_and, _mm512_and_ps) FR_VP_BIN(vp_or, _mm512_or_ps)
+FR_VP_BIN(vp_and, _mm512_and_ps) FR_VP_BIN(vp_or, _mm512_or_ps) FR_VP_BIN(vp_xor, _mm512_xor_ps)
 FR_INLINE vpf vp_loadu(const float *p) { vpf r = {_mm512_loadu_ps(p)}; return r; }
 FR_INLINE float vp_reduce_min(vpf a) { return _mm512_reduce_min_ps(a.v); }
 FR_INLINE float vp_reduce_max(vpf a) { return _mm512_reduce_max_ps(a.v); }
@@ -53,7 +53,7 @@ FR_INLINE vpm vpm_bits_to(unsigned b) { vpm r = {(__mmask8)b}; return r; }
 FR_INLINE unsigned vpm_bits(vpm a) { return a.m; }
 FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) { vpf r = {_mm256_mask_blend_ps(m.m, f.v, t.v)}; return r; }
 FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r = {(__mmask8)(a.m & b.m)}; return r; }
-FR_VP_BIN(vp_and, _mm256_and_ps) FR_VP_BIN(vp_or, _mm256_or_ps)
+FR_VP_BIN(vp_and, _mm256_and_ps) FR_VP_BIN(vp_or, _mm256_or_ps) FR_VP_BIN(vp_xor, _mm256_xor_ps)
 FR_INLINE vpf vp_loadu(const float *p) { vpf r = {_mm256_loadu_ps(p)}; return r; }
 
 #elif defined(FR_BUILD_ISA_AVX2) || defined(FR_BUILD_ISA_AVX512)
@@ -84,7 +84,7 @@ FR_INLINE vpm vpm_bits_to(unsigned b) {
 }
 FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_blendv_ps(f.v[h], t.v[h], m.m[h]); return r; }
 FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r; for (int h = 0; h < FR_VP_HALVES; h++) r.m[h] = _mm256_and_ps(a.m[h], b.m[h]); return r; }
-FR_VP_BIN(vp_and, _mm256_and_ps) FR_VP_BIN(vp_or, _mm256_or_ps)
+FR_VP_BIN(vp_and, _mm256_and_ps) FR_VP_BIN(vp_or, _mm256_or_ps) FR_VP_BIN(vp_xor, _mm256_xor_ps)
 FR_INLINE vpf vp_loadu(const float *p) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_loadu_ps(p + 8 * h); return r; }
 
 #else /* scalar */
@@ -118,7 +118,13 @@ FR_INLINE float fr_vp_bits_or(float a, float b) {
   x.u |= y.u;
   return x.f;
 }
+FR_INLINE float fr_vp_bits_xor(float a, float b) {
+  union { float f; uint32_t u; } x = {a}, y = {b};
+  x.u ^= y.u;
+  return x.f;
+}
 FR_VP_BIN(vp_and, fr_vp_bits_and(a.f[i], b.f[i])) FR_VP_BIN(vp_or, fr_vp_bits_or(a.f[i], b.f[i]))
+FR_VP_BIN(vp_xor, fr_vp_bits_xor(a.f[i], b.f[i]))
 FR_INLINE vpf vp_loadu(const float *p) FR_VP_LANES(p[i])
 FR_INLINE float vp_reduce_min(vpf a) { float r = a.f[0]; for (int i = 1; i < P; i++) r = a.f[i] < r ? a.f[i] : r; return r; }
 FR_INLINE float vp_reduce_max(vpf a) { float r = a.f[0]; for (int i = 1; i < P; i++) r = a.f[i] > r ? a.f[i] : r; return r; }

@@ -19,6 +19,7 @@
  */
 #ifndef FR_GEOM_TRI_SHEVTSOV_H
 #define FR_GEOM_TRI_SHEVTSOV_H
+#include <math.h>
 #include <stdint.h>
 #include "base/vec3.h"
 
@@ -36,6 +37,9 @@ _Static_assert(sizeof(fr_tri_shevtsov) == 48, "Shevtsov record is 48 bytes");
 /* 0 if the triangle is degenerate (no record made). */
 int fr_tri_shevtsov_make(fr_tri_shevtsov *r, vec3 p0, vec3 p1, vec3 p2, uint32_t prim);
 
+/* The division is deferred, as in the paper: hit point and barycentrics are
+ * kept multiplied by det, compared after flipping signs by det's sign, and
+ * only a hit divides. */
 static inline int fr_tri_shevtsov_test(const fr_tri_shevtsov *r, vec3 o, vec3 d, float tnear, float tfar,
                                        float *t, float *u, float *v) {
   static const int next[3] = {1, 2, 0};
@@ -43,21 +47,24 @@ static inline int fr_tri_shevtsov_test(const fr_tri_shevtsov *r, vec3 o, vec3 d,
   /* the origin relative to vertex a */
   float wk = r->a_k - v3_get(o, k), wu = r->a_u - v3_get(o, ku), wv = r->a_v - v3_get(o, kv);
   float dk = v3_get(d, k), du = v3_get(d, ku), dv = v3_get(d, kv);
-  float tt;
+  float det, num; /* t = num / det */
   if (r->axis_aligned) {
-    tt = wk / dk;
+    det = dk;
+    num = wk;
   } else {
-    float det = dk + r->n_u * du + r->n_v * dv;
-    tt = (wk + r->n_u * wu + r->n_v * wv) / det;
+    det = (dk + r->n_u * du) + r->n_v * dv;
+    num = (wk + r->n_u * wu) + r->n_v * wv;
   }
-  if (!(tt > tnear && tt < tfar)) return 0;
-  float hu = tt * du - wu, hv = tt * dv - wv; /* hit point - a */
-  float beta = r->b_u * hu + r->b_v * hv;
-  float gamma = r->c_u * hu + r->c_v * hv;
+  float hu = num * du - wu * det, hv = num * dv - wv * det; /* (hit point - a) * det */
+  float bd = r->b_u * hu + r->b_v * hv, gd = r->c_u * hu + r->c_v * hv;
+  float sg = det < 0.0f ? -1.0f : 1.0f, ad = fabsf(det);
+  float bs = bd * sg, gs = gd * sg, ns = num * sg;
   /* branchless mask: one combined condition, NaN fails it */
-  int hit = (beta >= 0.0f) & (gamma >= 0.0f) & (beta + gamma <= 1.0f);
+  int hit = (ad > 0.0f) & (bs >= 0.0f) & (gs >= 0.0f) & (bs + gs <= ad) & (ns > tnear * ad) & (ns < tfar * ad);
   if (!hit) return 0;
-  *t = tt; *u = beta; *v = gamma;
+  float tt = num / det, inv = 1.0f / det;
+  if (!(tt > tnear && tt < tfar)) return 0; /* rounding of the division */
+  *t = tt; *u = bd * inv; *v = gd * inv;
   return 1;
 }
 #endif

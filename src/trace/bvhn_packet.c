@@ -184,9 +184,10 @@ FR_INLINE int mailbox_seen(mailbox *mb, uint32_t id) {
   return 0;
 }
 
-/* One triangle against the active rays (Shevtsov's test, lane by lane the
- * same operations as fr_tri_shevtsov_test). Returns the rays hit in
- * (tnear, tfar); *t, *u, *v hold their hits. */
+/* One triangle against the active rays: Shevtsov's test with the division
+ * deferred to the hits, lane by lane the same operations as
+ * fr_tri_shevtsov_test (a sign flip by xor is the multiply by +-1 there).
+ * Returns the rays hit in (tnear, tfar); *t, *u, *v hold their hits. */
 FR_INLINE unsigned tri_test(const fr_tri_shevtsov *r, const packet *pk, const pregs *R, vpf tfar, unsigned active,
                             int aa_path, vpf *t_out, vpf *u_out, vpf *v_out) {
   static const int next[3] = {1, 2, 0};
@@ -195,24 +196,30 @@ FR_INLINE unsigned tri_test(const fr_tri_shevtsov *r, const packet *pk, const pr
   vpf wk = vp_sub(vp(r->a_k), vp_load(pk->o[k]));
   vpf wu = vp_sub(vp(r->a_u), vp_load(pk->o[ku])), wv = vp_sub(vp(r->a_v), vp_load(pk->o[kv]));
   vpf dk = vp_load(pk->d[k]), du = vp_load(pk->d[ku]), dv = vp_load(pk->d[kv]);
-  vpf t;
+  vpf det, num;
   if (aa_path && r->axis_aligned) {
-    t = vp_div(wk, dk);
+    det = dk;
+    num = wk;
   } else {
     vpf nu = vp(r->n_u), nv = vp(r->n_v);
-    vpf det = vp_add(vp_add(dk, vp_mul(nu, du)), vp_mul(nv, dv));
-    t = vp_div(vp_add(vp_add(wk, vp_mul(nu, wu)), vp_mul(nv, wv)), det);
+    det = vp_add(vp_add(dk, vp_mul(nu, du)), vp_mul(nv, dv));
+    num = vp_add(vp_add(wk, vp_mul(nu, wu)), vp_mul(nv, wv));
   }
-  unsigned m = active & vpm_bits(vpm_and(vp_gt(t, R->tnear), vp_lt(t, tfar)));
-  if (!m) return 0;
-  vpf hu = vp_sub(vp_mul(t, du), wu), hv = vp_sub(vp_mul(t, dv), wv);
-  vpf beta = vp_add(vp_mul(vp(r->b_u), hu), vp_mul(vp(r->b_v), hv));
-  vpf gamma = vp_add(vp_mul(vp(r->c_u), hu), vp_mul(vp(r->c_v), hv));
+  vpf hu = vp_sub(vp_mul(num, du), vp_mul(wu, det)), hv = vp_sub(vp_mul(num, dv), vp_mul(wv, det));
+  vpf bd = vp_add(vp_mul(vp(r->b_u), hu), vp_mul(vp(r->b_v), hv));
+  vpf gd = vp_add(vp_mul(vp(r->c_u), hu), vp_mul(vp(r->c_v), hv));
+  vpf sg = vp_and(det, vp(-0.0f)), ad = vp_abs(det);
+  vpf bs = vp_xor(bd, sg), gs = vp_xor(gd, sg), ns = vp_xor(num, sg);
   vpf zero = vp(0.0f);
-  m &= vpm_bits(vpm_and(vpm_and(vp_ge(beta, zero), vp_ge(gamma, zero)), vp_le(vp_add(beta, gamma), vp(1.0f))));
+  unsigned m = active & vpm_bits(vpm_and(vpm_and(vp_gt(ad, zero), vp_ge(bs, zero)), vp_ge(gs, zero)));
+  if (!m) return 0;
+  m &= vpm_bits(vpm_and(vpm_and(vp_le(vp_add(bs, gs), ad), vp_gt(ns, vp_mul(R->tnear, ad))), vp_lt(ns, vp_mul(tfar, ad))));
+  if (!m) return 0;
+  vpf t = vp_div(num, det), inv = vp_div(vp(1.0f), det);
+  m &= vpm_bits(vpm_and(vp_gt(t, R->tnear), vp_lt(t, tfar))); /* rounding of the division */
   *t_out = t;
-  *u_out = beta;
-  *v_out = gamma;
+  *u_out = vp_mul(bd, inv);
+  *v_out = vp_mul(gd, inv);
   return m;
 }
 
