@@ -34,6 +34,7 @@ typedef fr_bvh8_node node_t;
 typedef vfloat8 vnode;
 #define VN(x) vf8(x)
 #define VN_LOAD vf8_load
+#define VN_STORE vf8_store
 #define VN_SUB vf8_sub
 #define VN_MUL vf8_mul
 #define VN_MIN vf8_min
@@ -44,6 +45,7 @@ typedef fr_bvh4_node node_t;
 typedef vfloat4 vnode;
 #define VN(x) vf4(x)
 #define VN_LOAD vf4_load
+#define VN_STORE vf4_store
 #define VN_SUB vf4_sub
 #define VN_MUL vf4_mul
 #define VN_MIN vf4_min
@@ -124,8 +126,9 @@ static unsigned packet_setup(packet *pk, unsigned valid, const fr_ray16 *in) {
  * the rest. Each bound is the same rounded operations a ray's own test makes,
  * and rounding is monotonic, so the bounds contain every ray's float
  * distances: the cull is exactly as conservative as the per-ray test.
- * Returns the mask of children that may be hit. */
-FR_INLINE int ia_test(const node_t *n, const packet *pk, float tfar_max) {
+ * Returns the mask of children that may be hit; lo gets the packet's nearest
+ * entry distance into each. */
+FR_INLINE int ia_test(const node_t *n, const packet *pk, float tfar_max, float *lo) {
   const float *f = (const float *)n;
   vnode tn = VN(pk->tnear_min), tf = VN(tfar_max);
   for (int a = 0; a < 3; a++) {
@@ -135,6 +138,7 @@ FR_INLINE int ia_test(const node_t *n, const packet *pk, float tfar_max) {
     tn = VN_MAX(tn, VN_MIN(VN_MUL(x, rlo), VN_MUL(x, rhi)));
     tf = VN_MIN(tf, VN_MAX(VN_MUL(y, rlo), VN_MUL(y, rhi)));
   }
+  VN_STORE(lo, tn);
   return VN_LE_BITS(tn, VN_MUL(tf, VN(ROUND_UP)));
 }
 
@@ -223,6 +227,44 @@ FR_INLINE unsigned tri_test(const fr_tri_shevtsov *r, const packet *pk, const pr
   return m;
 }
 
+/* A pending subtree. Two kinds: box == NULL, its rays already tested
+ * against its box (their entry distances in a parallel array); or box = the
+ * parent's node, slot its place there, dist the packet's interval bound: the
+ * per-ray test waits until the entry is popped, and is skipped when dist
+ * shows that every ray has found something nearer (Embree's coherent
+ * traversal works this way too). */
+typedef struct stack_entry {
+  uint32_t ref;
+  unsigned mask;
+  int slot;
+  float dist;
+  const float *box;
+} stack_entry;
+
+/* Pushes the children in keep for a lazy test: sorted farthest first (closest
+ * hit), or in slot order so that the last slot pops first (any hit). */
+FR_INLINE int push_lazy(stack_entry *stack, int sp, const node_t *n, int keep, unsigned active, const float *lo,
+                        int sorted) {
+  const float *f = (const float *)n;
+  if (!sorted) {
+    for (; keep; keep &= keep - 1) {
+      int c = __builtin_ctz((unsigned)keep);
+      stack[sp++] = (stack_entry){n->child[c], active, c, lo[c], f};
+    }
+    return sp;
+  }
+  int base = sp;
+  for (; keep; keep &= keep - 1) { /* insertion sort by entry bound, farthest first */
+    int c = __builtin_ctz((unsigned)keep);
+    stack_entry x = {n->child[c], active, c, lo[c], f};
+    int b = sp - 1;
+    while (b >= base && stack[b].dist < x.dist) { stack[b + 1] = stack[b]; b--; }
+    stack[b + 1] = x;
+    sp++;
+  }
+  return sp;
+}
+
 static inline fr_ray lane_ray(const packet *pk, int i, float tfar) {
   fr_ray r = {{pk->o[0][i], pk->o[1][i], pk->o[2][i]}, pk->tnear[i], {pk->d[0][i], pk->d[1][i], pk->d[2][i]}, tfar};
   return r;
@@ -290,19 +332,29 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
   for (int i = 0; i < 8; i++) mb.id[i] = FR_INVALID_ID;
   mb.pos = 0;
 
-  typedef struct { uint32_t ref; unsigned mask; } pentry;
-  pentry stack[STACK_SIZE];
+  stack_entry stack[STACK_SIZE];
   float stack_tn[STACK_SIZE][P] __attribute__((aligned(64)));
   int sp = 0;
   if (valid) {
-    stack[0] = (pentry){b->root, valid};
+    stack[0] = (stack_entry){b->root, valid, 0, 0.0f, NULL};
     vp_store(stack_tn[0], vp(-INFINITY));
     sp = 1;
   }
   while (sp) {
     sp--;
-    const uint32_t ref = stack[sp].ref;
-    unsigned active = stack[sp].mask & vpm_bits(vp_le(vp_load(stack_tn[sp]), vp_mul(tfar, vp(ROUND_UP))));
+    const stack_entry e = stack[sp];
+    const uint32_t ref = e.ref;
+    unsigned active;
+    if (e.box) {
+      if (tmax_stale) { tmax = vp_reduce_max(tfar); tmax_stale = 0; }
+      if (e.dist > tmax * ROUND_UP) continue;
+      FR_COUNT(pk_box_tests, 1);
+      FR_COUNT(pk_box_lanes, __builtin_popcount(e.mask));
+      vpf tn;
+      active = child_test(e.box, e.slot, &pk, &R, tfar, e.mask, &tn);
+    } else {
+      active = e.mask & vpm_bits(vp_le(vp_load(stack_tn[sp]), vp_mul(tfar, vp(ROUND_UP))));
+    }
     if (!active) continue;
     int nactive = __builtin_popcount(active);
     if (nactive <= o->hybrid_threshold && !(ref & FR_BVHN_LEAF)) {
@@ -348,11 +400,14 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
       /* the packet's farthest tfar: over all its rays, recomputed only after
        * hits (a bound over the active rays alone measured no better) */
       if (tmax_stale) { tmax = vp_reduce_max(tfar); tmax_stale = 0; }
-      int keep = ia_test(n, &pk, tmax) & cand;
+      float lo[W] __attribute__((aligned(32)));
+      int keep = ia_test(n, &pk, tmax, lo) & cand;
       FR_COUNT(ia_culled, __builtin_popcount((unsigned)(cand & ~keep)));
-      cand = keep;
+      sp = push_lazy(stack, sp, n, keep, active, lo, 1);
+      continue;
     }
-    /* hit children, then pushed farthest first */
+    /* Mixed direction signs: each child against every ray now; hit
+     * children pushed farthest first with their rays' entry distances. */
     int hc[W], nh = 0;
     unsigned hmask[W];
     float key[W];
@@ -378,9 +433,9 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
       order[bpos + 1] = x;
     }
     for (int a = 0; a < nh; a++) {
-      int e = order[a];
-      stack[sp] = (pentry){n->child[hc[e]], hmask[e]};
-      vp_store(stack_tn[sp], vp_load(tn_c[e]));
+      int x = order[a];
+      stack[sp] = (stack_entry){n->child[hc[x]], hmask[x], 0, 0.0f, NULL};
+      vp_store(stack_tn[sp], vp_load(tn_c[x]));
       sp++;
     }
   }
@@ -404,15 +459,21 @@ static unsigned occluded_packet(const fr_bvhn *b, const fr_packet_opts *o, unsig
 
   /* A ray's tfar never shrinks here, so a pushed child needs no distances:
    * its rays hit its box and stay active until occluded. */
-  typedef struct { uint32_t ref; unsigned mask; } pentry;
-  pentry stack[STACK_SIZE];
+  stack_entry stack[STACK_SIZE];
   int sp = 0;
   unsigned occ = 0;
-  if (valid) stack[sp++] = (pentry){b->root, valid};
+  if (valid) stack[sp++] = (stack_entry){b->root, valid, 0, 0.0f, NULL};
   while (sp) {
     sp--;
-    const uint32_t ref = stack[sp].ref;
-    unsigned active = stack[sp].mask & ~occ;
+    const stack_entry e = stack[sp];
+    const uint32_t ref = e.ref;
+    unsigned active = e.mask & ~occ;
+    if (active && e.box) {
+      FR_COUNT(pk_box_tests, 1);
+      FR_COUNT(pk_box_lanes, __builtin_popcount(active));
+      vpf tn;
+      active = child_test(e.box, e.slot, &pk, &R, tfar, active, &tn);
+    }
     if (!active) continue;
     int nactive = __builtin_popcount(active);
     if (nactive <= o->hybrid_threshold && !(ref & FR_BVHN_LEAF)) {
@@ -440,9 +501,11 @@ static unsigned occluded_packet(const fr_bvhn *b, const fr_packet_opts *o, unsig
       FR_COUNT(pk_nodes, 1);
       int cand = (1 << n->nchildren) - 1;
       if (o->ia_cull && pk.uniform) {
-        int keep = ia_test(n, &pk, tfar_max) & cand;
+        float lo[W] __attribute__((aligned(32)));
+        int keep = ia_test(n, &pk, tfar_max, lo) & cand;
         FR_COUNT(ia_culled, __builtin_popcount((unsigned)(cand & ~keep)));
-        cand = keep;
+        sp = push_lazy(stack, sp, n, keep, active, lo, 0);
+        goto next;
       }
       /* slot order, so the last slot pops first (see the single-ray any-hit) */
       for (; cand; cand &= cand - 1) {
@@ -451,9 +514,10 @@ static unsigned occluded_packet(const fr_bvhn *b, const fr_packet_opts *o, unsig
         FR_COUNT(pk_box_lanes, nactive);
         vpf tn;
         unsigned hm = child_test(f, c, &pk, &R, tfar, active, &tn);
-        if (hm) stack[sp++] = (pentry){n->child[c], hm};
+        if (hm) stack[sp++] = (stack_entry){n->child[c], hm, 0, 0.0f, NULL};
       }
     }
+  next:
     if (occ == valid) break;
   }
   return occ;
