@@ -165,15 +165,15 @@ unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays);
 
 /* ---- streams ------------------------------------------------------------------
  * n independent rays. In FR_TRACE_AUTO mode each group of 16 consecutive rays
- * is traced as a hybrid packet when its directions share an octant, else ray
- * by ray; order rays so that neighbours are coherent to profit. */
+ * is traced as a hybrid packet (a last group of hybrid_threshold rays or fewer
+ * ray by ray); order rays so that neighbours are coherent to profit. */
 void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n);
 void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occluded, size_t n);
 
 /* How the stream and packet calls trace; for measurement and tuning. Set it
  * while no thread traces the scene. */
 typedef enum fr_trace_mode {
-  FR_TRACE_AUTO,      /* per group of 16: hybrid packet if coherent, else single rays */
+  FR_TRACE_AUTO,      /* per group of 16: the hybrid */
   FR_TRACE_SINGLE,    /* every ray alone (BVH of fr_scene_set_bvh_width) */
   FR_TRACE_PACKET8,   /* packets of 8 on the BVH4, no single-ray phase */
   FR_TRACE_PACKET16,  /* packets of 16 on the BVH4, no single-ray phase */

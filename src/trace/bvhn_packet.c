@@ -388,6 +388,10 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
         U = vp_select(hm, u, U);
         V = vp_select(hm, v, V);
         for (unsigned m = hit; m; m &= m - 1) best[__builtin_ctz(m)] = 4 * li + (uint32_t)j;
+        /* finish() reads the hit triangles' vertices: start loading them now */
+        __builtin_prefetch(&b->tris[li]);
+        __builtin_prefetch((const char *)&b->tris[li] + 64);
+        __builtin_prefetch((const char *)&b->tris[li] + 128);
       }
       continue;
     }
