@@ -141,9 +141,9 @@ int fr_occluded1(const fr_scene *s, const fr_ray *ray);
 /* ---- packets of 16 rays ------------------------------------------------------
  * Structure of arrays, one lane per ray. valid has bit i set for each ray i
  * to trace; lanes not in valid are neither read nor written. The packet
- * traverses the 4-wide BVH together and, when few of its rays are left in a
- * subtree, continues them one by one (the hybrid of Benthin et al.); the
- * threshold is fr_trace_options.hybrid_threshold. Answers agree with
+ * traverses the BVH together (8-wide by default, see packet_bvh_width) and,
+ * when few of its rays are left in a subtree, continues them one by one (the
+ * hybrid of Benthin et al.); the threshold is fr_trace_options.hybrid_threshold. Answers agree with
  * fr_intersect1's ray by ray (same t; the packet's triangle test is not
  * watertight, so a ray exactly through a shared edge may report either
  * triangle, or, rarely, miss where fr_intersect1 hits). See
@@ -164,16 +164,19 @@ void fr_intersect16(const fr_scene *s, unsigned valid, const fr_ray16 *rays, fr_
 unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays);
 
 /* ---- streams ------------------------------------------------------------------
- * n independent rays. In FR_TRACE_AUTO mode each group of 16 consecutive rays
- * is traced as a hybrid packet (a last group of hybrid_threshold rays or fewer
- * ray by ray); order rays so that neighbours are coherent to profit. */
+ * n independent rays. In FR_TRACE_AUTO mode the rays are sorted by direction
+ * octant (in chunks of 1024, keeping their order within an octant) and each
+ * group of 16 is traced as a hybrid packet; groups of hybrid_threshold rays or
+ * fewer go ray by ray. Order rays so that neighbours are coherent to profit
+ * (for example, pixels in 4x4 blocks). The other modes trace consecutive rays
+ * together, unsorted. */
 void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n);
 void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occluded, size_t n);
 
 /* How the stream and packet calls trace; for measurement and tuning. Set it
  * while no thread traces the scene. */
 typedef enum fr_trace_mode {
-  FR_TRACE_AUTO,      /* per group of 16: the hybrid */
+  FR_TRACE_AUTO,      /* sorted by octant, then hybrid packets of 16 */
   FR_TRACE_SINGLE,    /* every ray alone (BVH of fr_scene_set_bvh_width) */
   FR_TRACE_PACKET8,   /* packets of 8 on the BVH4, no single-ray phase */
   FR_TRACE_PACKET16,  /* packets of 16 on the BVH4, no single-ray phase */
@@ -183,7 +186,7 @@ typedef enum fr_trace_mode {
 typedef struct fr_trace_options {
   fr_trace_mode mode;     /* default FR_TRACE_AUTO */
   int hybrid_threshold;   /* 0..16, default 7 (the MIC paper's) */
-  int packet_bvh_width;   /* 4 (default, the MIC paper's) or 8 */
+  int packet_bvh_width;   /* 8 (default, measured faster) or 4 (the MIC paper's) */
   int mailbox;            /* inverse mailboxing in packet leaves (default off, see README) */
   int axis_aligned;       /* Shevtsov's axis-aligned fast path (default on) */
   int ia_cull;            /* interval-arithmetic culling of nodes for whole packets (default on) */

@@ -76,6 +76,8 @@ static long check_packet_modes(fr_scene *s, const fr_ray *rays, size_t n, const 
       fr_trace_options_default(&o);
       o.mode = modes[m];
       assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+      memset(h, 0x5A, n * sizeof *h); /* every ray must be answered */
+      memset(occ, 0x5A, n);
       fr_intersect_stream(s, rays, h, n);
       fr_occluded_stream(s, rays, occ, n);
       long bad = 0;

@@ -127,6 +127,8 @@ static void check_scene(vec3 center, float size, uint64_t seed) {
         uint8_t occs[16];
         fr_ray copy[16];
         memcpy(copy, rays, sizeof copy);
+        memset(hs, 0x5A, sizeof hs); /* every ray must be answered */
+        memset(occs, 0x5A, sizeof occs);
         fr_intersect_stream(s, copy, hs, 16);
         fr_occluded_stream(s, copy, occs, 16);
         fr_intersect16(s, valid, &r16, &h16);

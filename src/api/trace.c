@@ -87,12 +87,19 @@ unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays) 
   return packet_fns(s, 16, s->trace.hybrid_threshold, &po, &b)->occluded(b, &po, valid & 0xFFFF, rays);
 }
 
-/* ---- streams: groups of up to 16 consecutive rays ---- */
+/* ---- streams ----
+ * The explicit packet modes trace consecutive rays together, as the papers
+ * measure them. FR_TRACE_AUTO first sorts each chunk of the stream by
+ * direction octant (keeping stream order within an octant), as Embree's
+ * stream mode does: rays of neighbouring pixels that leave in the same
+ * octant then share a packet, which traverses with one set of near planes
+ * and culls by interval arithmetic. */
+#define STREAM_CHUNK 1024
 
-/* Packs rays[0..n) into r16; returns the valid mask. */
-static unsigned gather(const fr_ray *rays, size_t n, fr_ray16 *r16) {
+/* The rays of a packet: rays[idx[0..n)]. Returns the valid mask. */
+static unsigned gather(const fr_ray *rays, const uint32_t *idx, size_t n, fr_ray16 *r16) {
   for (size_t i = 0; i < n; i++) {
-    const fr_ray *r = &rays[i];
+    const fr_ray *r = &rays[idx[i]];
     r16->org_x[i] = r->org[0]; r16->org_y[i] = r->org[1]; r16->org_z[i] = r->org[2]; r16->tnear[i] = r->tnear;
     r16->dir_x[i] = r->dir[0]; r16->dir_y[i] = r->dir[1]; r16->dir_z[i] = r->dir[2]; r16->tfar[i] = r->tfar;
   }
@@ -100,45 +107,84 @@ static unsigned gather(const fr_ray *rays, size_t n, fr_ray16 *r16) {
 }
 
 /* How a group is traced: 0 single rays, else the packet size. */
-static int group_plan(const fr_scene *s, const fr_ray *rays, size_t n, int *threshold) {
+static int group_plan(const fr_scene *s, size_t n, int *threshold) {
   switch (s->trace.mode) {
   case FR_TRACE_SINGLE: return 0;
   case FR_TRACE_PACKET8: *threshold = 0; return 8;
   case FR_TRACE_PACKET16: *threshold = 0; return 16;
   case FR_TRACE_HYBRID16: *threshold = s->trace.hybrid_threshold; return 16;
   case FR_TRACE_AUTO: default:
-    /* The hybrid is never much slower than single rays, even for rays in
-     * every direction (measured on all six workloads; choosing single rays
-     * for groups spanning several octants cost up to 20% on ao16). A group
-     * too small to ever run as a packet goes ray by ray at once. */
-    (void)rays;
+    /* a group too small ever to run as a packet goes ray by ray at once */
     *threshold = s->trace.hybrid_threshold;
     return n > (size_t)s->trace.hybrid_threshold ? 16 : 0;
   }
 }
+
+/* The order in which a chunk's rays are grouped into packets; group_end[g]
+ * ends the g-th run of rays that may share packets. Returns the run count. */
+static int chunk_order(const fr_scene *s, const fr_ray *rays, size_t n, uint32_t *order, size_t *run_end) {
+  if (s->trace.mode != FR_TRACE_AUTO) {
+    for (size_t i = 0; i < n; i++) order[i] = (uint32_t)i;
+    run_end[0] = n;
+    return 1;
+  }
+  size_t start[9] = {0};
+  uint8_t oct[STREAM_CHUNK];
+  for (size_t i = 0; i < n; i++) {
+    const float *d = rays[i].dir;
+    oct[i] = (uint8_t)((__builtin_signbit(d[0]) != 0) | (__builtin_signbit(d[1]) != 0) << 1 | (__builtin_signbit(d[2]) != 0) << 2);
+    start[oct[i] + 1]++;
+  }
+  int runs = 0;
+  for (int o = 0; o < 8; o++) {
+    start[o + 1] += start[o];
+    if (start[o + 1] > start[o]) run_end[runs++] = start[o + 1];
+  }
+  for (size_t i = 0; i < n; i++) order[start[oct[i]]++] = (uint32_t)i;
+  return runs;
+}
+
+/* Calls trace(group) for each packet-sized group of a chunk, or single() for
+ * the rays of a group too small for a packet. */
+#define FOR_EACH_GROUP(s, rays, n, BODY_PACKET, BODY_SINGLE)                                     \
+  do {                                                                                            \
+    uint32_t order[STREAM_CHUNK];                                                                 \
+    size_t run_end[8];                                                                            \
+    size_t group = (s)->trace.mode == FR_TRACE_PACKET8 ? 8 : 16;                                  \
+    for (size_t c0 = 0; c0 < (n); c0 += STREAM_CHUNK) {                                           \
+      size_t cn = (n) - c0 < STREAM_CHUNK ? (n) - c0 : STREAM_CHUNK;                              \
+      int runs = chunk_order((s), (rays) + c0, cn, order, run_end);                               \
+      size_t g = 0;                                                                               \
+      for (int r = 0; r < runs; r++)                                                              \
+        for (size_t m; g < run_end[r]; g += m) {                                                  \
+          m = run_end[r] - g < group ? run_end[r] - g : group;                                    \
+          const uint32_t *idx = order + g;                                                        \
+          int threshold = 0, size = group_plan((s), m, &threshold);                               \
+          if (size) { BODY_PACKET; } else { BODY_SINGLE; }                                        \
+        }                                                                                         \
+    }                                                                                             \
+  } while (0)
 
 void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
   if (!s->committed) { for (size_t i = 0; i < n; i++) fr_hit_miss(&hits[i]); return; }
   const fr_bvhn *sb;
   const fr_trace_fns *single = single_fns(s, &sb);
   if (s->trace.mode == FR_TRACE_SINGLE) { single->intersect_stream(sb, rays, hits, n); return; }
-  size_t group = s->trace.mode == FR_TRACE_PACKET8 ? 8 : 16;
   fr_ray16 r16 __attribute__((aligned(64)));
   fr_hit16 h16 __attribute__((aligned(64)));
-  for (size_t g = 0; g < n; g += group) {
-    size_t m = n - g < group ? n - g : group;
-    int threshold = 0, size = group_plan(s, rays + g, m, &threshold);
-    if (!size) { single->intersect_stream(sb, rays + g, hits + g, m); continue; }
+  FOR_EACH_GROUP(s, rays, n, {
     fr_packet_opts po;
     const fr_bvhn *pb;
     const fr_packet_fns *pf = packet_fns(s, size, threshold, &po, &pb);
-    pf->intersect(pb, &po, gather(rays + g, m, &r16), &r16, &h16);
+    pf->intersect(pb, &po, gather(rays + c0, idx, m, &r16), &r16, &h16);
     for (size_t i = 0; i < m; i++) {
-      fr_hit *h = &hits[g + i];
+      fr_hit *h = &hits[c0 + idx[i]];
       h->t = h16.t[i]; h->u = h16.u[i]; h->v = h16.v[i]; h->prim = h16.prim[i];
       h->ng[0] = h16.ng_x[i]; h->ng[1] = h16.ng_y[i]; h->ng[2] = h16.ng_z[i];
     }
-  }
+  }, {
+    for (size_t i = 0; i < m; i++) single->intersect1(sb, &rays[c0 + idx[i]], &hits[c0 + idx[i]]);
+  });
 }
 
 void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
@@ -146,16 +192,14 @@ void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, siz
   const fr_bvhn *sb;
   const fr_trace_fns *single = single_fns(s, &sb);
   if (s->trace.mode == FR_TRACE_SINGLE) { single->occluded_stream(sb, rays, occ, n); return; }
-  size_t group = s->trace.mode == FR_TRACE_PACKET8 ? 8 : 16;
   fr_ray16 r16 __attribute__((aligned(64)));
-  for (size_t g = 0; g < n; g += group) {
-    size_t m = n - g < group ? n - g : group;
-    int threshold = 0, size = group_plan(s, rays + g, m, &threshold);
-    if (!size) { single->occluded_stream(sb, rays + g, occ + g, m); continue; }
+  FOR_EACH_GROUP(s, rays, n, {
     fr_packet_opts po;
     const fr_bvhn *pb;
     const fr_packet_fns *pf = packet_fns(s, size, threshold, &po, &pb);
-    unsigned o = pf->occluded(pb, &po, gather(rays + g, m, &r16), &r16);
-    for (size_t i = 0; i < m; i++) occ[g + i] = (uint8_t)((o >> i) & 1);
-  }
+    unsigned o = pf->occluded(pb, &po, gather(rays + c0, idx, m, &r16), &r16);
+    for (size_t i = 0; i < m; i++) occ[c0 + idx[i]] = (uint8_t)((o >> i) & 1);
+  }, {
+    for (size_t i = 0; i < m; i++) occ[c0 + idx[i]] = (uint8_t)single->occluded1(sb, &rays[c0 + idx[i]]);
+  });
 }
