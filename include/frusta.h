@@ -101,6 +101,7 @@ typedef struct fr_wide_stats {
   double node_fill;              /* mean children per inner node */
   double leaf_fill;              /* mean triangles per leaf (of 4) */
   int depth;
+  size_t packet_tri_bytes;       /* Shevtsov records the packet kernels test */
 } fr_wide_stats;
 
 typedef struct fr_bvh_stats {

@@ -68,4 +68,12 @@ static inline fr_ray random_ray(fr_rng *r, vec3 center, float size, const scene_
 
 
 static inline void free_scene(scene_data *s) { free(s->pos); free(s->idx); }
+
+/* The scene of sd, committed. */
+static inline fr_scene *commit_scene(const scene_data *sd) {
+  fr_scene *s;
+  assert_int_equal(fr_scene_from_arrays(sd->pos, sd->nv, sd->idx, sd->nt, &s), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  return s;
+}
 #endif

@@ -82,9 +82,7 @@ static void set_config(fr_scene *s, const config *c) {
 static void check_scene(vec3 center, float size, uint64_t seed) {
   fr_rng r = fr_rng_seed(seed, 3);
   scene_data sd = make_scene(&r, 3000, center, size);
-  fr_scene *s;
-  assert_int_equal(fr_scene_from_arrays(sd.pos, sd.nv, sd.idx, sd.nt, &s), FR_OK);
-  assert_int_equal(fr_scene_commit(s), FR_OK);
+  fr_scene *s = commit_scene(&sd);
   long compared = 0, hits = 0;
   for (int p = 0; p < 160; p++) {
     fr_ray rays[16];

@@ -12,9 +12,7 @@
 static void check_scene(vec3 center, float size, uint64_t seed) {
   fr_rng r = fr_rng_seed(seed, 1);
   scene_data sd = make_scene(&r, 3000, center, size);
-  fr_scene *s;
-  assert_int_equal(fr_scene_from_arrays(sd.pos, sd.nv, sd.idx, sd.nt, &s), FR_OK);
-  assert_int_equal(fr_scene_commit(s), FR_OK);
+  fr_scene *s = commit_scene(&sd);
   assert_true(fr_scene_skipped_triangles(s) > 0); /* the degenerate ones */
   int checked = 0, hits = 0;
   for (int i = 0; i < 4000; i++) {

@@ -156,6 +156,7 @@ void fr_bvhn_stats_get(const fr_bvhn *b, fr_bvhn_stats *st) {
   st->leaves = b->nleaves;
   st->node_bytes = b->nnodes * node_bytes;
   st->tri_bytes = b->nleaves * sizeof(fr_tri4);
+  st->packet_tri_bytes = b->nleaves * 4 * sizeof(fr_tri_shevtsov);
   st->sah = cost;
   st->sah_blocks = cost_blocks;
   st->node_fill = b->nnodes ? (double)kids / (double)b->nnodes : 0.0;

@@ -59,6 +59,7 @@ typedef struct fr_bvhn_stats {
   double sah, sah_blocks;           /* per triangle test, per 4-wide block test */
   double node_fill, leaf_fill;      /* mean children per node, triangles per leaf */
   int depth;
+  size_t packet_tri_bytes;
 } fr_bvhn_stats;
 
 fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width, fr_bvhn *out);

@@ -3,11 +3,13 @@
  * Packet Ray Tracing ... on the Intel MIC Architecture", §V): P = 8 or 16 rays,
  * one per SIMD lane, traverse an N-wide BVH together. Per node:
  *
- *   1. interval arithmetic over the whole packet (Boulos, Wald, Shirley §3.1)
- *      culls the children no ray can hit, all N at once;
- *   2. each surviving child is tested against the P rays (one SIMD test);
- *      children hit by any active ray are pushed with their ray mask and
- *      per-ray entry distances, nearest last so it pops first.
+ *   1. when all rays share a direction octant, interval arithmetic over the
+ *      whole packet (Boulos, Wald, Shirley §3.1) culls the children no ray
+ *      can hit, all N at once; the survivors are pushed nearest last by that
+ *      bound, and each is tested against the P rays (one SIMD test) only
+ *      when popped;
+ *   2. otherwise each child is tested against the P rays at once and those
+ *      hit are pushed with their ray mask and per-ray entry distances.
  *
  * Leaves test their triangles one at a time against all P rays with
  * Shevtsov's test on the precomputed 48-byte record (geom/tri_shevtsov.h),
@@ -23,37 +25,10 @@
 #include <string.h>
 #include "base/simd.h"
 #include "base/simd_packet.h"
+#include "trace/bvhn_node.h"
 #include "trace/counters.h"
 #include "trace/kernels.h"
 
-/* The single-ray kernel's conservative far-plane widening (bvhn_single.c). */
-#define ROUND_UP (1.0f + 0x1p-20f)
-
-#if FR_WIDTH == 8
-typedef fr_bvh8_node node_t;
-typedef vfloat8 vnode;
-#define VN(x) vf8(x)
-#define VN_LOAD vf8_load
-#define VN_STORE vf8_store
-#define VN_SUB vf8_sub
-#define VN_MUL vf8_mul
-#define VN_MIN vf8_min
-#define VN_MAX vf8_max
-#define VN_LE_BITS vf8_le_bits
-#else
-typedef fr_bvh4_node node_t;
-typedef vfloat4 vnode;
-#define VN(x) vf4(x)
-#define VN_LOAD vf4_load
-#define VN_STORE vf4_store
-#define VN_SUB vf4_sub
-#define VN_MUL vf4_mul
-#define VN_MIN vf4_min
-#define VN_MAX vf4_max
-#define VN_LE_BITS(a, b) vm4_bits(vf4_le(a, b))
-#endif
-#define W FR_WIDTH
-#define STACK_SIZE ((W - 1) * (FR_BUILD_MAX_DEPTH + 32) + 4)
 
 typedef struct packet {
   float o[3][P] __attribute__((aligned(64)));
@@ -150,6 +125,8 @@ typedef struct pregs { vpf o[3], rd[3], tnear; } pregs;
  * single-ray box test, so a ray sees the same boxes in both modes. */
 FR_INLINE unsigned child_test(const float *f, int c, const packet *pk, const pregs *R, vpf tfar, unsigned active,
                               vpf *tn_out) {
+  FR_COUNT(pk_box_tests, 1);
+  FR_COUNT(pk_box_lanes, __builtin_popcount(active));
   vpf tn = R->tnear, tf = tfar;
   if (pk->uniform) {
     for (int a = 0; a < 3; a++) {
@@ -348,8 +325,6 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
     if (e.box) {
       if (tmax_stale) { tmax = vp_reduce_max(tfar); tmax_stale = 0; }
       if (e.dist > tmax * ROUND_UP) continue;
-      FR_COUNT(pk_box_tests, 1);
-      FR_COUNT(pk_box_lanes, __builtin_popcount(e.mask));
       vpf tn;
       active = child_test(e.box, e.slot, &pk, &R, tfar, e.mask, &tn);
     } else {
@@ -418,8 +393,6 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
     float tn_c[W][P] __attribute__((aligned(64)));
     for (; cand; cand &= cand - 1) {
       int c = __builtin_ctz((unsigned)cand);
-      FR_COUNT(pk_box_tests, 1);
-      FR_COUNT(pk_box_lanes, nactive);
       vpf tn;
       unsigned hm = child_test(f, c, &pk, &R, tfar, active, &tn);
       if (!hm) continue;
@@ -473,8 +446,6 @@ static unsigned occluded_packet(const fr_bvhn *b, const fr_packet_opts *o, unsig
     const uint32_t ref = e.ref;
     unsigned active = e.mask & ~occ;
     if (active && e.box) {
-      FR_COUNT(pk_box_tests, 1);
-      FR_COUNT(pk_box_lanes, __builtin_popcount(active));
       vpf tn;
       active = child_test(e.box, e.slot, &pk, &R, tfar, active, &tn);
     }
@@ -514,8 +485,6 @@ static unsigned occluded_packet(const fr_bvhn *b, const fr_packet_opts *o, unsig
       /* slot order, so the last slot pops first (see the single-ray any-hit) */
       for (; cand; cand &= cand - 1) {
         int c = __builtin_ctz((unsigned)cand);
-        FR_COUNT(pk_box_tests, 1);
-        FR_COUNT(pk_box_lanes, nactive);
         vpf tn;
         unsigned hm = child_test(f, c, &pk, &R, tfar, active, &tn);
         if (hm) stack[sp++] = (stack_entry){n->child[c], hm, 0, 0.0f, NULL};

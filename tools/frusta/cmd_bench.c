@@ -142,9 +142,13 @@ int cmd_bench(int argc, char **argv) {
   fr_bvh_stats st;
   fr_scene_stats(s, &st);
   const fr_wide_stats *ws = st.single_width == 4 ? &st.bvh4 : &st.bvh8;
-  printf("build_seconds=%.3f tracer=frusta scene=%s tris=%zu threads=%d isa=%s bvh_width=%d sah=%.2f bytes_per_tri=%.1f\n",
+  /* packets traverse the packet BVH and test its Shevtsov records */
+  const fr_wide_stats *wp = topt.packet_bvh_width == 4 ? &st.bvh4 : &st.bvh8;
+  printf("build_seconds=%.3f tracer=frusta scene=%s tris=%zu threads=%d isa=%s bvh_width=%d sah=%.2f bytes_per_tri=%.1f "
+         "packet_bvh_width=%d packet_bytes_per_tri=%.1f\n",
          st.build_seconds, s->name, tris, threads, fr_isa_name(fr_get_isa()), st.single_width, ws->sah,
-         (double)(ws->node_bytes + ws->tri_bytes) / (double)tris);
+         (double)(ws->node_bytes + ws->tri_bytes) / (double)tris, topt.packet_bvh_width,
+         (double)(wp->node_bytes + wp->tri_bytes + wp->packet_tri_bytes) / (double)tris);
   ebr_scene *e = NULL;
   if (use_embree) {
     ebr_options o = {threads, 2, 0}; /* high quality, not robust: Embree's fastest tracing */
