@@ -120,8 +120,9 @@ static int group_plan(const fr_scene *s, size_t n, int *threshold) {
   }
 }
 
-/* The order in which a chunk's rays are grouped into packets; group_end[g]
- * ends the g-th run of rays that may share packets. Returns the run count. */
+/* The order in which a chunk's rays are grouped into packets; run_end[r] ends
+ * the r-th run of rays that may share packets (one run per octant in auto
+ * mode). Returns the number of runs. */
 static int chunk_order(const fr_scene *s, const fr_ray *rays, size_t n, uint32_t *order, size_t *run_end) {
   if (s->trace.mode != FR_TRACE_AUTO) {
     for (size_t i = 0; i < n; i++) order[i] = (uint32_t)i;
@@ -144,8 +145,8 @@ static int chunk_order(const fr_scene *s, const fr_ray *rays, size_t n, uint32_t
   return runs;
 }
 
-/* Calls trace(group) for each packet-sized group of a chunk, or single() for
- * the rays of a group too small for a packet. */
+/* For each packet-sized group of each chunk (its rays rays[c0 + idx[0..m)]),
+ * runs BODY_PACKET, or BODY_SINGLE where the group is traced ray by ray. */
 #define FOR_EACH_GROUP(s, rays, n, BODY_PACKET, BODY_SINGLE)                                     \
   do {                                                                                            \
     uint32_t order[STREAM_CHUNK];                                                                 \

@@ -377,7 +377,8 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
     int cand = (1 << nc) - 1;
     if (o->ia_cull && pk.uniform) {
       /* the packet's farthest tfar: over all its rays, recomputed only after
-       * hits (a bound over the active rays alone measured no better) */
+       * hits (looser than a bound over the active rays, but no reduction per
+       * node) */
       if (tmax_stale) { tmax = vp_reduce_max(tfar); tmax_stale = 0; }
       float lo[W] __attribute__((aligned(32)));
       int keep = ia_test(n, &pk, tmax, lo) & cand;
