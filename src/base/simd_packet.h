@@ -142,20 +142,29 @@ FR_INLINE vpf vp_abs(vpf a) {
 FR_INLINE vpf vp_copysign(vpf mag, vpf sgn) { return vp_or(vp_abs(mag), vp_and(sgn, vp(-0.0f))); }
 
 #if !(defined(FR_BUILD_ISA_AVX512) && P == 16) && !defined(FR_BUILD_ISA_SCALAR)
-/* through memory: rare enough (child ordering, IA bounds) not to matter */
+/* horizontal min/max of 8 lanes: halves, quarters, pairs */
+#define FR_VP_HREDUCE(name, op128, opss)                                                \
+  FR_INLINE float name(__m256 v) {                                                     \
+    __m128 m = op128(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));          \
+    m = op128(m, _mm_movehl_ps(m, m));                                                 \
+    return _mm_cvtss_f32(opss(m, _mm_movehdup_ps(m)));                                 \
+  }
+FR_VP_HREDUCE(fr_hmin8, _mm_min_ps, _mm_min_ss)
+FR_VP_HREDUCE(fr_hmax8, _mm_max_ps, _mm_max_ss)
+#if defined(FR_BUILD_ISA_AVX512)
+FR_INLINE float vp_reduce_min(vpf a) { return fr_hmin8(a.v); }
+FR_INLINE float vp_reduce_max(vpf a) { return fr_hmax8(a.v); }
+#else
 FR_INLINE float vp_reduce_min(vpf a) {
-  float f[P] __attribute__((aligned(64)));
-  vp_store(f, a);
-  float r = f[0];
-  for (int i = 1; i < P; i++) r = f[i] < r ? f[i] : r;
-  return r;
+  __m256 m = a.v[0];
+  for (int h = 1; h < FR_VP_HALVES; h++) m = _mm256_min_ps(m, a.v[h]);
+  return fr_hmin8(m);
 }
 FR_INLINE float vp_reduce_max(vpf a) {
-  float f[P] __attribute__((aligned(64)));
-  vp_store(f, a);
-  float r = f[0];
-  for (int i = 1; i < P; i++) r = f[i] > r ? f[i] : r;
-  return r;
+  __m256 m = a.v[0];
+  for (int h = 1; h < FR_VP_HALVES; h++) m = _mm256_max_ps(m, a.v[h]);
+  return fr_hmax8(m);
 }
+#endif
 #endif
 #endif
