@@ -90,6 +90,7 @@ expect 1 "$F" trace --builtin "$T/trunc.rays" --query closest --out "$T/t.hits"
 expect 2 "$F" trace --builtin "$T/r.rays" --query nearest --out "$T/x.hits"
 expect 1 "$F" trace --builtin "$T/none.rays" --query any --out "$T/x.occl"
 expect 0 "$F" stats --builtin
+expect 2 "$F" stats --builtin --workload nope
 # Table V needs the counters build; without it, a clear error
 if "$F" stats --builtin --workload ao16 --size 16x16 >"$T/out" 2>"$T/err"; then
   grep -q '^table5 scene=builtin workload=ao16' "$T/out" && ok || bad "table5 line"

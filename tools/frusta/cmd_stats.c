@@ -15,10 +15,10 @@
 
 /* Table V: runs the workload once in hybrid16 mode with the counters on. */
 static int table5(const char *path, const cli_view *v, int threads, const char *wl_name, int threshold, int width) {
-  if (!fr_counters_enabled())
-    return cli_error(1, "stats --workload needs the counters: configure with cmake -DFRUSTA_COUNTERS=ON and rebuild");
   fr_workload_kind k;
   if (!fr_workload_parse(wl_name, &k)) return cli_error(CLI_USAGE_ERROR, "unknown workload '%s'", wl_name);
+  if (!fr_counters_enabled())
+    return cli_error(1, "stats --workload needs the counters: configure with cmake -DFRUSTA_COUNTERS=ON and rebuild");
   fr_scene *s;
   fr_workload w;
   memset(&w, 0, sizeof w);
