@@ -124,32 +124,31 @@ static inline float lane(vfloat4 v, int i) {
 
 typedef struct entry { uint32_t ref; float dist; } entry;
 
-/* Pushes the hit children farthest first and returns the nearest. */
-FR_INLINE uint32_t order_children(const node_t *n, int mask, const float *dist, entry *stack, int *sp) {
+/* Pushes the hit children farthest first and returns the nearest. Three or
+ * more are insertion-sorted straight into the stack (building a local array
+ * and copying it over cost ~15% of a diffuse ray's instructions). */
+FR_INLINE uint32_t order_children(const node_t *n, int mask, const float *dist, entry *stack, int *spp) {
   int i0 = __builtin_ctz(mask);
-  mask &= mask - 1;
-  if (!mask) return n->child[i0];
-  int i1 = __builtin_ctz(mask);
-  mask &= mask - 1;
-  if (!mask) {
+  int rest = mask & (mask - 1);
+  if (!rest) return n->child[i0];
+  int i1 = __builtin_ctz(rest);
+  int sp = *spp;
+  if (!(rest & (rest - 1))) {
     if (dist[i1] < dist[i0]) { int t = i0; i0 = i1; i1 = t; }
-    stack[(*sp)++] = (entry){n->child[i1], dist[i1]};
+    stack[sp] = (entry){n->child[i1], dist[i1]};
+    *spp = sp + 1;
     return n->child[i0];
   }
-  entry e[W] = {{n->child[i0], dist[i0]}, {n->child[i1], dist[i1]}};
-  int k = 2;
-  while (mask) {
+  entry *e = stack + sp;
+  int k = 0;
+  for (; mask; mask &= mask - 1) { /* in slot order; ties keep it */
     int i = __builtin_ctz(mask);
-    mask &= mask - 1;
-    e[k++] = (entry){n->child[i], dist[i]};
+    entry x = {n->child[i], dist[i]};
+    int j = k++ - 1;
+    while (j >= 0 && e[j].dist < x.dist) { e[j + 1] = e[j]; j--; }
+    e[j + 1] = x;
   }
-  for (int a = 1; a < k; a++) { /* insertion sort, farthest first */
-    entry x = e[a];
-    int b = a - 1;
-    while (b >= 0 && e[b].dist < x.dist) { e[b + 1] = e[b]; b--; }
-    e[b + 1] = x;
-  }
-  for (int a = 0; a < k - 1; a++) stack[(*sp)++] = e[a];
+  *spp = sp + k - 1; /* the nearest, last, is not pushed but returned */
   return e[k - 1].ref;
 }
 
