@@ -20,43 +20,38 @@
 #define P FR_PACKET
 #define FR_PACKET_ALL ((unsigned)((1u << P) - 1u))
 
-#if defined(FR_BUILD_ISA_AVX512) && P == 16
-typedef struct vpf { __m512 v; } vpf;
-typedef struct vpm { __mmask16 m; } vpm;
-FR_INLINE vpf vp(float a) { vpf r = {_mm512_set1_ps(a)}; return r; }
-FR_INLINE vpf vp_load(const float *p) { vpf r = {_mm512_load_ps(p)}; return r; }
-FR_INLINE void vp_store(float *p, vpf a) { _mm512_store_ps(p, a.v); }
-#define FR_VP_BIN(name, in) FR_INLINE vpf name(vpf a, vpf b) { vpf r = {in(a.v, b.v)}; return r; }
-FR_VP_BIN(vp_add, _mm512_add_ps) FR_VP_BIN(vp_sub, _mm512_sub_ps) FR_VP_BIN(vp_mul, _mm512_mul_ps)
-FR_VP_BIN(vp_div, _mm512_div_ps) FR_VP_BIN(vp_min, _mm512_min_ps) FR_VP_BIN(vp_max, _mm512_max_ps)
-#define FR_VP_CMP(name, op) FR_INLINE vpm name(vpf a, vpf b) { vpm r = {_mm512_cmp_ps_mask(a.v, b.v, op)}; return r; }
-FR_INLINE vpm vpm_bits_to(unsigned b) { vpm r = {(__mmask16)b}; return r; }
+#if defined(FR_BUILD_ISA_AVX512)
+/* one register of P lanes (zmm for 16, ymm for 8), masks in k registers */
+#if P == 16
+#define FR_VP_OP(op) _mm512_##op
+typedef __m512 fr_vp_reg;
+typedef __mmask16 fr_vp_kmask;
+#else
+#define FR_VP_OP(op) _mm256_##op
+typedef __m256 fr_vp_reg;
+typedef __mmask8 fr_vp_kmask;
+#endif
+typedef struct vpf { fr_vp_reg v; } vpf;
+typedef struct vpm { fr_vp_kmask m; } vpm;
+FR_INLINE vpf vp(float a) { vpf r = {FR_VP_OP(set1_ps)(a)}; return r; }
+FR_INLINE vpf vp_load(const float *p) { vpf r = {FR_VP_OP(load_ps)(p)}; return r; }
+FR_INLINE vpf vp_loadu(const float *p) { vpf r = {FR_VP_OP(loadu_ps)(p)}; return r; }
+FR_INLINE void vp_store(float *p, vpf a) { FR_VP_OP(store_ps)(p, a.v); }
+#define FR_VP_BIN(name, op) FR_INLINE vpf name(vpf a, vpf b) { vpf r = {FR_VP_OP(op)(a.v, b.v)}; return r; }
+FR_VP_BIN(vp_add, add_ps) FR_VP_BIN(vp_sub, sub_ps) FR_VP_BIN(vp_mul, mul_ps)
+FR_VP_BIN(vp_div, div_ps) FR_VP_BIN(vp_min, min_ps) FR_VP_BIN(vp_max, max_ps)
+FR_VP_BIN(vp_and, and_ps) FR_VP_BIN(vp_or, or_ps) FR_VP_BIN(vp_xor, xor_ps)
+#define FR_VP_CMP(name, op) FR_INLINE vpm name(vpf a, vpf b) { vpm r = {FR_VP_OP(cmp_ps_mask)(a.v, b.v, op)}; return r; }
+FR_INLINE vpm vpm_bits_to(unsigned b) { vpm r = {(fr_vp_kmask)b}; return r; }
 FR_INLINE unsigned vpm_bits(vpm a) { return a.m; }
-FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) { vpf r = {_mm512_mask_blend_ps(m.m, f.v, t.v)}; return r; }
-FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r = {(__mmask16)(a.m & b.m)}; return r; }
-FR_VP_BIN(vp_and, _mm512_and_ps) FR_VP_BIN(vp_or, _mm512_or_ps) FR_VP_BIN(vp_xor, _mm512_xor_ps)
-FR_INLINE vpf vp_loadu(const float *p) { vpf r = {_mm512_loadu_ps(p)}; return r; }
+FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r = {(fr_vp_kmask)(a.m & b.m)}; return r; }
+FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) { vpf r = {FR_VP_OP(mask_blend_ps)(m.m, f.v, t.v)}; return r; }
+#if P == 16
 FR_INLINE float vp_reduce_min(vpf a) { return _mm512_reduce_min_ps(a.v); }
 FR_INLINE float vp_reduce_max(vpf a) { return _mm512_reduce_max_ps(a.v); }
+#endif
 
-#elif defined(FR_BUILD_ISA_AVX512) && P == 8
-typedef struct vpf { __m256 v; } vpf;
-typedef struct vpm { __mmask8 m; } vpm;
-FR_INLINE vpf vp(float a) { vpf r = {_mm256_set1_ps(a)}; return r; }
-FR_INLINE vpf vp_load(const float *p) { vpf r = {_mm256_load_ps(p)}; return r; }
-FR_INLINE void vp_store(float *p, vpf a) { _mm256_store_ps(p, a.v); }
-#define FR_VP_BIN(name, in) FR_INLINE vpf name(vpf a, vpf b) { vpf r = {in(a.v, b.v)}; return r; }
-FR_VP_BIN(vp_add, _mm256_add_ps) FR_VP_BIN(vp_sub, _mm256_sub_ps) FR_VP_BIN(vp_mul, _mm256_mul_ps)
-FR_VP_BIN(vp_div, _mm256_div_ps) FR_VP_BIN(vp_min, _mm256_min_ps) FR_VP_BIN(vp_max, _mm256_max_ps)
-#define FR_VP_CMP(name, op) FR_INLINE vpm name(vpf a, vpf b) { vpm r = {_mm256_cmp_ps_mask(a.v, b.v, op)}; return r; }
-FR_INLINE vpm vpm_bits_to(unsigned b) { vpm r = {(__mmask8)b}; return r; }
-FR_INLINE unsigned vpm_bits(vpm a) { return a.m; }
-FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) { vpf r = {_mm256_mask_blend_ps(m.m, f.v, t.v)}; return r; }
-FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r = {(__mmask8)(a.m & b.m)}; return r; }
-FR_VP_BIN(vp_and, _mm256_and_ps) FR_VP_BIN(vp_or, _mm256_or_ps) FR_VP_BIN(vp_xor, _mm256_xor_ps)
-FR_INLINE vpf vp_loadu(const float *p) { vpf r = {_mm256_loadu_ps(p)}; return r; }
-
-#elif defined(FR_BUILD_ISA_AVX2) || defined(FR_BUILD_ISA_AVX512)
+#elif defined(FR_BUILD_ISA_AVX2)
 /* AVX2: P / 8 halves of 8 lanes, masks as vectors of all-ones lanes */
 #define FR_VP_HALVES (P / 8)
 typedef struct vpf { __m256 v[FR_VP_HALVES]; } vpf;
