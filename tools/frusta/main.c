@@ -12,8 +12,12 @@ static void usage(FILE *f) {
           "         [--size WxH] [--eye x,y,z --at x,y,z --up x,y,z --fov deg] [--light x,y,z] [--threads N]\n"
           "  bench  SCENE|--builtin --workload W|all --mode M|all [--tracer frusta|embree|both] [--threads N]\n"
           "         [--size WxH] [view flags] [--light x,y,z] [--area c,e1,e2] [--repeat K]\n"
+          "         frusta modes: single single4 packet8 packet16 hybrid16 auto; embree: single packet4 packet8\n"
+          "         packet16 stream; packet switches: [--threshold N] [--packet-width 4|8] [--mailbox on|off]\n"
+          "         [--axis-aligned on|off] [--ia on|off]\n"
           "  trace  SCENE RAYS --query closest|any --out FILE [--tracer frusta|embree]\n"
-          "  stats  SCENE|--builtin [--embree]\n"
+          "         [--mode single|packet8|packet16|hybrid16|auto]\n"
+          "  stats  SCENE|--builtin [--embree] [--workload W [--threshold N] [--packet-width 4|8]]\n"
           "Scenes: PLY, OBJ(+MTL) and what Assimp reads, optionally .zst. FRUSTA_ISA=avx512|avx2|scalar forces an ISA.\n");
 }
 
