@@ -499,4 +499,4 @@ static unsigned occluded_packet(const fr_bvhn *b, const fr_packet_opts *o, unsig
 
 #define PK_NAME3(p, w, isa) fr_packet_p##p##_w##w##_##isa
 #define PK_NAME(p, w, isa) PK_NAME3(p, w, isa)
-const fr_packet_fns PK_NAME(FR_PACKET, FR_WIDTH, FR_ISA_SUFFIX) = {P, intersect_packet, occluded_packet};
+const fr_packet_fns PK_NAME(FR_PACKET, FR_WIDTH, FR_ISA_SUFFIX) = {intersect_packet, occluded_packet};

@@ -35,7 +35,6 @@ typedef struct fr_packet_opts {
 
 /* Packet kernels for one ISA, packet size and BVH width. valid: bit i for ray i. */
 typedef struct fr_packet_fns {
-  int size;               /* 8 or 16 rays */
   void (*intersect)(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const fr_ray16 *rays, fr_hit16 *hits);
   unsigned (*occluded)(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const fr_ray16 *rays);
 } fr_packet_fns;
