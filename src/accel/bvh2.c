@@ -3,11 +3,11 @@
 #include "base/alloc.h"
 #include "base/error.h"
 
-typedef struct conv { const fr_build_tree *t; fr_bvh2 *b; } conv;
+typedef struct conv { const fr_build_tree *t; fr_bvh2 *b; uint32_t max_leaf; } conv;
 
 static uint32_t convert(conv *c, int32_t bi) {
   const fr_build_node *n = &c->t->nodes[bi];
-  if (n->count <= FR_BUILD_MAX_LEAF) {
+  if (n->count <= c->max_leaf) {
     c->b->nleaves++;
     return FR_BVH2_LEAF | (n->count << FR_BVH2_COUNT_SHIFT) | n->first;
   }
@@ -25,20 +25,33 @@ static uint32_t convert(conv *c, int32_t bi) {
   return self;
 }
 
-fr_error fr_bvh2_from_build(const fr_build_tree *t, fr_bvh2 *out) {
+fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_leaf, fr_bvh2 *out) {
   memset(out, 0, sizeof *out);
+  if (max_leaf < 1 || max_leaf > FR_BVH2_MAX_LEAF) return fr_fail(FR_ERR_ARG, "BVH2: leaf size %d", max_leaf);
   size_t inner = t->nprims;
   out->nodes = fr_alloc_aligned(fr_mul_size(inner, sizeof(fr_bvh2_node)), 64);
   out->prims = fr_alloc_aligned(fr_mul_size(t->nprims, sizeof(uint32_t)), 64);
-  if (!out->nodes || !out->prims) {
+  out->tris = fr_alloc_aligned(fr_mul_size(t->nprims, sizeof(fr_bvh2_tri)), 64);
+  if (!out->nodes || !out->prims || !out->tris) {
     fr_bvh2_free(out);
     return fr_fail(FR_ERR_NOMEM, "BVH2: out of memory");
   }
   memset(out->nodes, 0, inner * sizeof(fr_bvh2_node));
   memcpy(out->prims, t->prims, t->nprims * sizeof(uint32_t));
   out->nprims = t->nprims;
+  out->max_leaf = max_leaf;
+  for (size_t i = 0; i < t->nprims; i++) {
+    fr_bvh2_tri *r = &out->tris[i];
+    const uint32_t *ix = m->idx + 3 * (size_t)t->prims[i];
+    float *dst[3] = {r->v0, r->v1, r->v2};
+    for (int k = 0; k < 3; k++) memcpy(dst[k], m->pos + 3 * (size_t)ix[k], 3 * sizeof(float));
+    vec3 a = v3_load(r->v0), n = v3_cross(v3_sub(v3_load(r->v1), a), v3_sub(v3_load(r->v2), a));
+    r->n[0] = n.x; r->n[1] = n.y; r->n[2] = n.z;
+    r->prim = t->prims[i];
+    r->pad[0] = r->pad[1] = r->pad[2] = 0;
+  }
   out->bounds = t->nodes[0].box;
-  conv c = {t, out};
+  conv c = {t, out, (uint32_t)max_leaf};
   out->root = convert(&c, 0);
   return FR_OK;
 }
@@ -46,6 +59,7 @@ fr_error fr_bvh2_from_build(const fr_build_tree *t, fr_bvh2 *out) {
 void fr_bvh2_free(fr_bvh2 *b) {
   fr_free_aligned(b->nodes);
   fr_free_aligned(b->prims);
+  fr_free_aligned(b->tris);
   memset(b, 0, sizeof *b);
 }
 

@@ -8,6 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "accel/bvh_build.h"
+#include "geom/mesh.h"
 
 /* child reference: inner node index, or FR_BVH2_LEAF | count << 27 | first */
 #define FR_BVH2_LEAF 0x80000000u
@@ -22,16 +23,35 @@ typedef struct fr_bvh2_node {
 
 _Static_assert(sizeof(fr_bvh2_node) == 64, "BVH2 node is one cache line");
 
+/* A triangle as the multi-frusta kernels read it, in leaf order: the
+ * vertices in mesh order (each edge's cross product then comes out exactly
+ * negated in the neighbouring triangle, which makes the common-origin test
+ * watertight) and the unnormalized normal (v1 - v0) x (v2 - v0). One line. */
+typedef struct fr_bvh2_tri {
+  float v0[3], v1[3], v2[3], n[3];
+  uint32_t prim;
+  uint32_t pad[3];
+} __attribute__((aligned(64))) fr_bvh2_tri;
+
+_Static_assert(sizeof(fr_bvh2_tri) == 64, "BVH2 triangle is one cache line");
+
+/* leaves hold at most this many triangles (the count field has 4 bits) */
+#define FR_BVH2_MAX_LEAF 15
+
 typedef struct fr_bvh2 {
   fr_bvh2_node *nodes;
   size_t nnodes, nleaves;
   uint32_t root;     /* reference, as a child would be */
   aabb bounds;
   uint32_t *prims;   /* triangle ids in leaf order */
+  fr_bvh2_tri *tris; /* the same triangles, ready for the frusta kernels */
   size_t nprims;
+  int max_leaf;
 } fr_bvh2;
 
-fr_error fr_bvh2_from_build(const fr_build_tree *t, fr_bvh2 *out);
+/* Leaves are cut where a subtree has at most max_leaf triangles (4: the
+ * regular tree; more: the shallow tree the frusta kernels may prefer). */
+fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_leaf, fr_bvh2 *out);
 void fr_bvh2_free(fr_bvh2 *b);
 double fr_bvh2_sah(const fr_bvh2 *b);
 #endif

@@ -121,7 +121,7 @@ fr_error fr_scene_commit(fr_scene *s) {
   free(boxes);
   free(ids);
   if (e) return e;
-  e = fr_bvh2_from_build(&tree, &s->bvh2);
+  e = fr_bvh2_from_build(&tree, m, FR_BUILD_MAX_LEAF, &s->bvh2);
   if (!e) e = fr_bvhn_from_build(&tree, m, 4, &s->bvh4);
   if (!e) e = fr_bvhn_from_build(&tree, m, 8, &s->bvh8);
   fr_build_tree_free(&tree);

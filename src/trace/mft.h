@@ -1,0 +1,91 @@
+/*
+ * Multi-frusta tracing (Benthin & Wald, "Efficient Ray Traced Soft Shadows
+ * using Multi-Frusta Tracing", HPG 2009): 16 frusta of 16 rays each traverse
+ * the binary BVH together, one frustum per SIMD lane.
+ *
+ * A frustum is an origin o and 16 rays o + t (start + delta_k), t in
+ * (tnear, tfar). The deltas come from a shared table of ray sets, so a ray is
+ * made on demand from two vectors and never stored:
+ *
+ *   primary rays  o = eye, start = direction of the block's first pixel,
+ *                 delta_k = i du + j dv for the 4x4 pixels (one set);
+ *   soft shadows  o = hit point, start = light corner - o,
+ *                 delta_k = s_k e1 + q_k e2 for the samples of the pixel's
+ *                 set on the quad light (16 interleaved sets).
+ *
+ * Every delta is a * e1 + b * e2 with the ray's 2D parameters (a, b), so the
+ * four corner rays of a frustum are the corners of the (a, b) box of its
+ * rays; after a leaf occludes some shadow rays they shrink to the box of the
+ * rays still active (the paper's "CR" shrinking, §5.3).
+ */
+#ifndef FR_TRACE_MFT_H
+#define FR_TRACE_MFT_H
+#include <stdint.h>
+#include "accel/bvh2.h"
+
+#define FR_MFT_RAYS 16    /* rays per frustum */
+#define FR_MFT_FRUSTA 16  /* frusta traced together */
+#define FR_MFT_SETS 16    /* ray sets in a table */
+
+typedef struct fr_mft_set {
+  float a[FR_MFT_RAYS], b[FR_MFT_RAYS];              /* 2D parameters */
+  float dx[FR_MFT_RAYS], dy[FR_MFT_RAYS], dz[FR_MFT_RAYS]; /* delta = a e1 + b e2, rounded once */
+} __attribute__((aligned(64))) fr_mft_set;
+
+typedef struct fr_mft_sets {
+  fr_mft_set set[FR_MFT_SETS];
+  float e1[3], e2[3];
+  int count;
+} fr_mft_sets;
+
+/* Fills the deltas of set s from its (a, b) parameters. */
+void fr_mft_set_finish(fr_mft_sets *t, int s);
+
+/* 16 frusta. Lane f is frustum f; only frusta in `valid` are traced. */
+typedef struct fr_mft_batch {
+  float org[3][FR_MFT_FRUSTA] __attribute__((aligned(64)));
+  float start[3][FR_MFT_FRUSTA] __attribute__((aligned(64)));
+  float tnear[FR_MFT_FRUSTA] __attribute__((aligned(64)));
+  float tfar[FR_MFT_FRUSTA] __attribute__((aligned(64)));
+  uint8_t set[FR_MFT_FRUSTA];
+  unsigned valid;
+} fr_mft_batch;
+
+/* Ray k of frustum f, exactly as the kernels make it (for tests and for the
+ * tracers that trace the same rays one by one). */
+static inline void fr_mft_ray(const fr_mft_batch *b, const fr_mft_sets *t, int f, int k, float org[3], float dir[3]) {
+  const fr_mft_set *s = &t->set[b->set[f]];
+  const float *dl[3] = {s->dx, s->dy, s->dz};
+  for (int a = 0; a < 3; a++) {
+    org[a] = b->org[a][f];
+    dir[a] = b->start[a][f] + dl[a][k];
+  }
+}
+
+/* Closest hits of the 256 rays: t in units of the ray's direction. */
+typedef struct fr_mft_hits {
+  float t[FR_MFT_FRUSTA][FR_MFT_RAYS] __attribute__((aligned(64)));
+  float u[FR_MFT_FRUSTA][FR_MFT_RAYS] __attribute__((aligned(64)));
+  float v[FR_MFT_FRUSTA][FR_MFT_RAYS] __attribute__((aligned(64)));
+  uint32_t prim[FR_MFT_FRUSTA][FR_MFT_RAYS] __attribute__((aligned(64)));
+} fr_mft_hits;
+
+/* What to do (switches for measurement). */
+typedef struct fr_mft_opts {
+  int corner_rays;  /* cull frusta against a triangle's edges and plane with corner rays */
+  int shrink;       /* shadows: shrink corner rays and intervals to the active rays */
+} fr_mft_opts;
+
+typedef struct fr_mft_fns {
+  /* occ[f]: bit k set when ray k of frustum f is occluded */
+  void (*occluded)(const fr_bvh2 *b, const fr_mft_opts *o, const fr_mft_batch *batch, const fr_mft_sets *sets,
+                   uint16_t occ[FR_MFT_FRUSTA]);
+  void (*intersect)(const fr_bvh2 *b, const fr_mft_opts *o, const fr_mft_batch *batch, const fr_mft_sets *sets,
+                    fr_mft_hits *hits);
+} fr_mft_fns;
+
+extern const fr_mft_fns fr_mft_avx512, fr_mft_avx2, fr_mft_scalar;
+
+/* The kernels of the active ISA. */
+const fr_mft_fns *fr_mft_active(void);
+#endif

@@ -1,0 +1,387 @@
+/*
+ * Multi-frusta traversal of the binary BVH (Benthin & Wald 2009, §4), one
+ * frustum per lane of a 16-wide register, compiled once per ISA.
+ *
+ * Node: both child boxes against all 16 frusta by interval arithmetic over
+ * each frustum's box of ray directions (§4.1). An axis whose direction
+ * interval contains 0 gets the straddling bound (the paper's "zero-interval
+ * fix"); bounded frusta (shadows) are also tested with the box of the volume
+ * they sweep. Nearer child first, by how many frusta enter it first.
+ *
+ * Leaf, per triangle: for all 16 frusta at once, the three edge cross
+ * products seen from each frustum's origin, then the corner rays against the
+ * edges and the plane (all four outside one edge, or all four meeting the
+ * plane out of range: the frustum skips the triangle, §4.2). Then, frustum by
+ * frustum (bitscan), its 16 rays are made from start + delta and tested with
+ * the same cross products (§4.4):
+ *
+ *   w_i = d . E_i,  E_0 = (v1-o) x (v2-o), E_1 = (v2-o) x (v0-o), E_2 = (v0-o) x (v1-o)
+ *   hit when every w_i has the sign of det = (v0-o) . n, t = det / (d . n) in (tnear, tfar)
+ *
+ * A shared edge's cross product is exactly negated in the neighbouring
+ * triangle (float products commute, a - b = -(b - a)), so no ray slips
+ * between two triangles: the test is watertight with no extra cost.
+ */
+#include <math.h>
+#include <string.h>
+#include "base/simd.h"
+#include "base/simd_packet.h"
+#include "trace/counters.h"
+#include "trace/mft.h"
+
+#if P != 16
+#error "the frusta kernels are 16 wide"
+#endif
+
+#define ROUND_UP (1.0f + 0x1p-20f)
+#define GUARD 0x1p-19f   /* rounding allowance of a corner-ray dot product, relative to |d| |E| */
+#define STACK 256
+#define TINY 1e-18f
+
+/* The 16 frusta in structure-of-arrays form; lane f is frustum f. */
+typedef struct frusta {
+  float o[3][16] __attribute__((aligned(64)));
+  float s[3][16] __attribute__((aligned(64)));
+  float tnear[16] __attribute__((aligned(64)));
+  float tfar[16] __attribute__((aligned(64)));   /* shadows: given; closest: farthest hit so far */
+  /* interval arithmetic: reciprocals of the direction bounds. On an axis
+   * where a frustum's directions have one sign, rs = 1/(the largest |d|),
+   * rl = 1/(the smallest); where they straddle 0, rs = 1/dhi > 0, rl = 1/dlo < 0 */
+  float rs[3][16] __attribute__((aligned(64)));
+  float rl[3][16] __attribute__((aligned(64)));
+  float vlo[3][16] __attribute__((aligned(64)));  /* box of the swept volume (bounded frusta) */
+  float vhi[3][16] __attribute__((aligned(64)));
+  float corner[4][3][16] __attribute__((aligned(64)));
+  float guard[16] __attribute__((aligned(64)));   /* GUARD * the largest |component| of a direction */
+  unsigned pos[3], straddle[3]; /* lanes with directions > 0 / straddling 0, per axis */
+  int bounded;
+  const fr_mft_set *set[16];
+} frusta;
+
+/* Lane f's bounds from the (a, b) box of its active rays. */
+static void frustum_bounds(frusta *F, const fr_mft_sets *T, int f, unsigned rays) {
+  const fr_mft_set *S = F->set[f];
+  const float *dl[3] = {S->dx, S->dy, S->dz};
+  float amin = INFINITY, amax = -INFINITY, bmin = INFINITY, bmax = -INFINITY;
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (unsigned m = rays; m; m &= m - 1) {
+    int k = __builtin_ctz(m);
+    amin = fminf(amin, S->a[k]); amax = fmaxf(amax, S->a[k]);
+    bmin = fminf(bmin, S->b[k]); bmax = fmaxf(bmax, S->b[k]);
+    for (int a = 0; a < 3; a++) { lo[a] = fminf(lo[a], dl[a][k]); hi[a] = fmaxf(hi[a], dl[a][k]); }
+  }
+  const float ca[4] = {amin, amax, amin, amax}, cb[4] = {bmin, bmin, bmax, bmax};
+  float big = 0.0f;
+  for (int a = 0; a < 3; a++) {
+    float s = F->s[a][f], o = F->o[a][f];
+    /* rounding is monotonic: s + lo <= s + delta_k <= s + hi for the rays' own sums */
+    float dlo = s + lo[a], dhi = s + hi[a];
+    big = fmaxf(big, fmaxf(fabsf(dlo), fabsf(dhi)));
+    unsigned bit = 1u << f;
+    F->pos[a] &= ~bit;
+    F->straddle[a] &= ~bit;
+    if (dlo > 0.0f) {
+      F->pos[a] |= bit;
+      F->rs[a][f] = 1.0f / fmaxf(dhi, TINY);
+      F->rl[a][f] = 1.0f / fmaxf(dlo, TINY);
+    } else if (dhi < 0.0f) {
+      F->rs[a][f] = 1.0f / fminf(dlo, -TINY);
+      F->rl[a][f] = 1.0f / fminf(dhi, -TINY);
+    } else {
+      F->straddle[a] |= bit;
+      F->rs[a][f] = 1.0f / fmaxf(dhi, TINY);
+      F->rl[a][f] = 1.0f / fminf(dlo, -TINY);
+    }
+    if (F->bounded) {
+      /* o + t d over t in [tnear, tfar], d in [dlo, dhi]: bilinear, so the
+       * extremes are at the four combinations */
+      float t0 = F->tnear[f], t1 = F->tfar[f];
+      float p[4] = {t0 * dlo, t0 * dhi, t1 * dlo, t1 * dhi};
+      float mn = fminf(fminf(p[0], p[1]), fminf(p[2], p[3])), mx = fmaxf(fmaxf(p[0], p[1]), fmaxf(p[2], p[3]));
+      float slack = (fabsf(o) + fmaxf(fabsf(mn), fabsf(mx))) * 0x1p-20f;
+      F->vlo[a][f] = o + mn - slack;
+      F->vhi[a][f] = o + mx + slack;
+    } else {
+      F->vlo[a][f] = -INFINITY;
+      F->vhi[a][f] = INFINITY;
+    }
+  }
+  for (int j = 0; j < 4; j++) {
+    float c[3] = {ca[j] * T->e1[0] + cb[j] * T->e2[0], ca[j] * T->e1[1] + cb[j] * T->e2[1],
+                  ca[j] * T->e1[2] + cb[j] * T->e2[2]};
+    for (int a = 0; a < 3; a++) F->corner[j][a][f] = F->s[a][f] + c[a];
+  }
+  F->guard[f] = GUARD * big;
+}
+
+static void frusta_setup(frusta *F, const fr_mft_batch *B, const fr_mft_sets *T, unsigned valid, int bounded) {
+  memset(F->pos, 0, sizeof F->pos);
+  memset(F->straddle, 0, sizeof F->straddle);
+  F->bounded = bounded;
+  for (int f = 0; f < 16; f++) {
+    int lane_valid = (valid >> f) & 1;
+    for (int a = 0; a < 3; a++) {
+      F->o[a][f] = lane_valid ? B->org[a][f] : 0.0f;
+      F->s[a][f] = lane_valid ? B->start[a][f] : 1.0f;
+    }
+    F->tnear[f] = lane_valid ? B->tnear[f] : 0.0f;
+    F->tfar[f] = lane_valid ? B->tfar[f] : 0.0f;
+    F->set[f] = &T->set[lane_valid ? B->set[f] % FR_MFT_SETS : 0];
+    frustum_bounds(F, T, f, 0xFFFFu);
+  }
+}
+
+FR_INLINE vpf dot3(vpf ax, vpf ay, vpf az, vpf bx, vpf by, vpf bz) {
+  return vp_add(vp_add(vp_mul(ax, bx), vp_mul(ay, by)), vp_mul(az, bz));
+}
+
+/* Child k of a node against the frusta in `m`; *tn: a lower bound of each
+ * frustum's entry distance. */
+FR_INLINE unsigned box_test(const frusta *F, const fr_bvh2_node *n, int k, unsigned m, vpf *tn_out) {
+  const float *lo[3] = {n->lo_x, n->lo_y, n->lo_z}, *hi[3] = {n->hi_x, n->hi_y, n->hi_z};
+  vpf tn = vp_load(F->tnear), tf = vp_load(F->tfar);
+  unsigned vol = 0xFFFFu;
+  for (int a = 0; a < 3; a++) {
+    vpf blo = vp(lo[a][k]), bhi = vp(hi[a][k]), o = vp_load(F->o[a]);
+    vpf nlo = vp_sub(blo, o), nhi = vp_sub(bhi, o);
+    vpf rs = vp_load(F->rs[a]), rl = vp_load(F->rl[a]);
+    vpm pos = vpm_bits_to(F->pos[a]);
+    vpf nearp = vp_select(pos, nlo, nhi), farp = vp_select(pos, nhi, nlo);
+    vpf enter = vp_min(vp_mul(nearp, rs), vp_mul(nearp, rl));
+    vpf leave = vp_max(vp_mul(farp, rs), vp_mul(farp, rl));
+    if (F->straddle[a] & m) {
+      /* d in [dlo < 0, dhi > 0]: a box ahead (o < lo) is entered no sooner
+       * than along dhi, one behind (o > hi) no sooner than along dlo, and
+       * nothing bounds the exit */
+      vpm st = vpm_bits_to(F->straddle[a]);
+      enter = vp_select(st, vp_max(vp_mul(nlo, rs), vp_mul(nhi, rl)), enter);
+      leave = vp_select(st, vp(INFINITY), leave);
+    }
+    tn = vp_max(tn, enter);
+    tf = vp_min(tf, leave);
+    if (F->bounded)
+      vol &= vpm_bits(vpm_and(vp_le(vp_load(F->vlo[a]), bhi), vp_ge(vp_load(F->vhi[a]), blo)));
+  }
+  *tn_out = tn;
+  return m & vol & vpm_bits(vp_le(tn, vp_mul(tf, vp(ROUND_UP))));
+}
+
+/* Per-leaf scratch: the cross products and plane distances of one triangle
+ * for all frusta, stored so a frustum's values can be broadcast. */
+typedef struct tri_frusta {
+  float e[3][3][16] __attribute__((aligned(64)));
+  float det[16] __attribute__((aligned(64)));
+} tri_frusta;
+
+/* The frusta of m that may hit triangle r; fills X. */
+FR_INLINE unsigned tri_cull(const frusta *F, const fr_bvh2_tri *r, unsigned m, int corner_rays, tri_frusta *X) {
+  vpf o[3] = {vp_load(F->o[0]), vp_load(F->o[1]), vp_load(F->o[2])};
+  vpf A[3], B[3], C[3];
+  for (int a = 0; a < 3; a++) {
+    A[a] = vp_sub(vp(r->v0[a]), o[a]);
+    B[a] = vp_sub(vp(r->v1[a]), o[a]);
+    C[a] = vp_sub(vp(r->v2[a]), o[a]);
+  }
+  vpf nx = vp(r->n[0]), ny = vp(r->n[1]), nz = vp(r->n[2]);
+  vpf det = dot3(A[0], A[1], A[2], nx, ny, nz);
+  /* E_0 = B x C, E_1 = C x A, E_2 = A x B */
+  const vpf *lhs[3] = {B, C, A}, *rhs[3] = {C, A, B};
+  vpf E[3][3];
+  for (int i = 0; i < 3; i++) {
+    const vpf *p = lhs[i], *q = rhs[i];
+    E[i][0] = vp_sub(vp_mul(p[1], q[2]), vp_mul(p[2], q[1]));
+    E[i][1] = vp_sub(vp_mul(p[2], q[0]), vp_mul(p[0], q[2]));
+    E[i][2] = vp_sub(vp_mul(p[0], q[1]), vp_mul(p[1], q[0]));
+    for (int a = 0; a < 3; a++) vp_store(X->e[i][a], E[i][a]);
+  }
+  vp_store(X->det, det);
+  if (!corner_rays) return m;
+  vpf sg = vp_and(det, vp(-0.0f)), zero = vp(0.0f), guard = vp_load(F->guard);
+  unsigned cull = 0;
+  for (int i = 0; i < 3; i++) {
+    vpf wmax = vp(-INFINITY);
+    for (int j = 0; j < 4; j++) {
+      vpf w = dot3(vp_load(F->corner[j][0]), vp_load(F->corner[j][1]), vp_load(F->corner[j][2]), E[i][0], E[i][1], E[i][2]);
+      wmax = vp_max(wmax, vp_xor(w, sg));
+    }
+    vpf g = vp_mul(guard, vp_add(vp_add(vp_abs(E[i][0]), vp_abs(E[i][1])), vp_abs(E[i][2])));
+    cull |= vpm_bits(vp_lt(vp_add(wmax, g), zero));
+  }
+  /* the plane: t = det / (d . n) beyond tfar (or behind) for all four corners */
+  vpf gmax = vp(-INFINITY);
+  for (int j = 0; j < 4; j++) {
+    vpf g = dot3(vp_load(F->corner[j][0]), vp_load(F->corner[j][1]), vp_load(F->corner[j][2]), nx, ny, nz);
+    gmax = vp_max(gmax, vp_xor(g, sg));
+  }
+  gmax = vp_add(gmax, vp_mul(guard, vp(fabsf(r->n[0]) + fabsf(r->n[1]) + fabsf(r->n[2]))));
+  cull |= vpm_bits(vp_le(gmax, zero));
+  cull |= vpm_bits(vp_lt(vp_mul(gmax, vp_load(F->tfar)), vp_mul(vp_abs(det), vp(1.0f - 0x1p-18f))));
+  return m & ~cull;
+}
+
+/* Frustum f's 16 rays against the triangle of X: the rays hit in (tnear,
+ * tcur); *t, *u, *v their hits. */
+FR_INLINE unsigned ray_test(const frusta *F, const tri_frusta *X, const fr_bvh2_tri *r, int f, vpf tcur,
+                            unsigned rays, vpf *t_out, vpf *u_out, vpf *v_out) {
+  const fr_mft_set *S = F->set[f];
+  vpf dx = vp_add(vp(F->s[0][f]), vp_load(S->dx));
+  vpf dy = vp_add(vp(F->s[1][f]), vp_load(S->dy));
+  vpf dz = vp_add(vp(F->s[2][f]), vp_load(S->dz));
+  vpf w[3];
+  for (int i = 0; i < 3; i++) w[i] = dot3(dx, dy, dz, vp(X->e[i][0][f]), vp(X->e[i][1][f]), vp(X->e[i][2][f]));
+  float det = X->det[f];
+  vpf sg = vp(copysignf(0.0f, det)), zero = vp(0.0f);
+  unsigned m = rays & vpm_bits(vpm_and(vpm_and(vp_ge(vp_xor(w[0], sg), zero), vp_ge(vp_xor(w[1], sg), zero)),
+                                       vp_ge(vp_xor(w[2], sg), zero)));
+  if (!m) return 0;
+  vpf den = dot3(dx, dy, dz, vp(r->n[0]), vp(r->n[1]), vp(r->n[2]));
+  vpf t = vp_div(vp(det), den);
+  m &= vpm_bits(vpm_and(vp_gt(t, vp(F->tnear[f])), vp_lt(t, tcur)));
+  if (!m || !u_out) return m;
+  vpf inv = vp_div(vp(1.0f), vp_add(vp_add(w[0], w[1]), w[2]));
+  *t_out = t;
+  *u_out = vp_mul(w[1], inv);
+  *v_out = vp_mul(w[2], inv);
+  return m;
+}
+
+typedef struct entry { uint32_t ref; unsigned mask; } entry;
+
+/* Both children of a node; pushes the farther, returns the nearer in *next. */
+FR_INLINE int visit_node(const frusta *F, const fr_bvh2 *b, uint32_t ref, unsigned m, entry *stack, int *sp,
+                         entry *next) {
+  const fr_bvh2_node *n = &b->nodes[ref];
+  FR_COUNT(mft_nodes, 1);
+  FR_COUNT(mft_box_tests, 2);
+  FR_COUNT(mft_box_lanes, 2 * __builtin_popcount(m));
+  vpf tn0, tn1;
+  unsigned h0 = box_test(F, n, 0, m, &tn0), h1 = box_test(F, n, 1, m, &tn1);
+  if (h0 && h1) {
+    /* nearer first: the child more of the frusta in both enter first */
+    unsigned both = h0 & h1;
+    int first0 = __builtin_popcount(both & vpm_bits(vp_le(tn0, tn1))) * 2 >= __builtin_popcount(both);
+    entry e0 = {n->child[0], h0}, e1 = {n->child[1], h1};
+    stack[(*sp)++] = first0 ? e1 : e0;
+    *next = first0 ? e0 : e1;
+    return 1;
+  }
+  if (h0 | h1) {
+    *next = (entry){n->child[h0 ? 0 : 1], h0 | h1};
+    return 1;
+  }
+  return 0;
+}
+
+static void occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B, const fr_mft_sets *T,
+                         uint16_t occ[16]) {
+  frusta F;
+  tri_frusta X;
+  unsigned valid = B->valid & 0xFFFFu;
+  for (int f = 0; f < 16; f++) occ[f] = 0;
+  FR_COUNT(mft_batches, 1);
+  FR_COUNT(rays, 16 * __builtin_popcount(valid));
+  if (!valid || !b->nodes) return;
+  frusta_setup(&F, B, T, valid, 1);
+  unsigned active[16];
+  for (int f = 0; f < 16; f++) active[f] = (valid >> f) & 1 ? 0xFFFFu : 0;
+  unsigned alive = valid;
+  entry stack[STACK];
+  int sp = 0;
+  stack[sp++] = (entry){b->root, valid};
+  while (sp && alive) {
+    entry e = stack[--sp];
+    e.mask &= alive;
+    while (e.mask) {
+      if (!(e.ref & FR_BVH2_LEAF)) {
+        if (!visit_node(&F, b, e.ref, e.mask, stack, &sp, &e)) break;
+        continue;
+      }
+      uint32_t first = e.ref & FR_BVH2_FIRST_MASK, count = (e.ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
+      unsigned m = e.mask & alive;
+      for (uint32_t i = first; i < first + count && m; i++) {
+        const fr_bvh2_tri *r = &b->tris[i];
+        FR_COUNT(mft_tris, 1);
+        FR_COUNT(mft_tri_frusta, __builtin_popcount(m));
+        unsigned left = tri_cull(&F, r, m, opt->corner_rays, &X);
+        FR_COUNT(mft_tri_left, __builtin_popcount(left));
+        for (; left; left &= left - 1) {
+          int f = __builtin_ctz(left);
+          unsigned hit = ray_test(&F, &X, r, f, vp(F.tfar[f]), active[f], NULL, NULL, NULL);
+          if (!hit) continue;
+          occ[f] |= (uint16_t)hit;
+          active[f] &= ~hit;
+          if (!active[f]) {
+            alive &= ~(1u << f);
+            m &= ~(1u << f);
+          } else if (opt->shrink) {
+            frustum_bounds(&F, T, f, active[f]);
+          }
+        }
+      }
+      break;
+    }
+  }
+}
+
+static void intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B, const fr_mft_sets *T,
+                          fr_mft_hits *H) {
+  frusta F;
+  tri_frusta X;
+  unsigned valid = B->valid & 0xFFFFu;
+  for (int f = 0; f < 16; f++)
+    for (int k = 0; k < 16; k++) {
+      H->t[f][k] = INFINITY;
+      H->u[f][k] = H->v[f][k] = 0.0f;
+      H->prim[f][k] = FR_INVALID_ID;
+    }
+  FR_COUNT(mft_batches, 1);
+  FR_COUNT(rays, 16 * __builtin_popcount(valid));
+  if (!valid || !b->nodes) return;
+  frusta_setup(&F, B, T, valid, 0);
+  for (int f = 0; f < 16; f++)
+    for (int k = 0; k < 16; k++) H->t[f][k] = (valid >> f) & 1 ? B->tfar[f] : INFINITY;
+  entry stack[STACK];
+  int sp = 0;
+  stack[sp++] = (entry){b->root, valid};
+  while (sp) {
+    entry e = stack[--sp];
+    while (e.mask) {
+      if (!(e.ref & FR_BVH2_LEAF)) {
+        if (!visit_node(&F, b, e.ref, e.mask, stack, &sp, &e)) break;
+        continue;
+      }
+      uint32_t first = e.ref & FR_BVH2_FIRST_MASK, count = (e.ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
+      unsigned changed = 0;
+      for (uint32_t i = first; i < first + count; i++) {
+        const fr_bvh2_tri *r = &b->tris[i];
+        FR_COUNT(mft_tris, 1);
+        FR_COUNT(mft_tri_frusta, __builtin_popcount(e.mask));
+        unsigned left = tri_cull(&F, r, e.mask, opt->corner_rays, &X);
+        FR_COUNT(mft_tri_left, __builtin_popcount(left));
+        for (; left; left &= left - 1) {
+          int f = __builtin_ctz(left);
+          vpf tb = vp_load(H->t[f]), t, u, v;
+          unsigned hit = ray_test(&F, &X, r, f, tb, 0xFFFFu, &t, &u, &v);
+          if (!hit) continue;
+          vpm hm = vpm_bits_to(hit);
+          vp_store(H->t[f], vp_select(hm, t, tb));
+          vp_store(H->u[f], vp_select(hm, u, vp_load(H->u[f])));
+          vp_store(H->v[f], vp_select(hm, v, vp_load(H->v[f])));
+          for (unsigned mm = hit; mm; mm &= mm - 1) H->prim[f][__builtin_ctz(mm)] = r->prim;
+          changed |= 1u << f;
+        }
+      }
+      /* the frusta with hits now end at their farthest ray's hit (open until all rays hit) */
+      for (; changed; changed &= changed - 1) {
+        int f = __builtin_ctz(changed);
+        F.tfar[f] = vp_reduce_max(vp_load(H->t[f]));
+      }
+      break;
+    }
+  }
+  for (int f = 0; f < 16; f++)
+    for (int k = 0; k < 16; k++)
+      if (H->prim[f][k] == FR_INVALID_ID) H->t[f][k] = INFINITY;
+}
+
+const fr_mft_fns FR_ISA_FN(fr_mft) = {occluded_mft, intersect_mft};

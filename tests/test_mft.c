@@ -1,0 +1,276 @@
+/*
+ * Multi-frusta kernels against the single-ray kernels, ray by ray, on random
+ * scenes and on the built-in scene: soft-shadow frusta (16 hit points, 16
+ * interleaved light samples each) with any-hit, camera frusta (16 blocks of
+ * 4x4 pixels) with closest hit. Every ISA, corner-ray culling and shrinking on
+ * and off; the ISAs must agree bit for bit.
+ *
+ * The MFT test and the single-ray test are both watertight but round
+ * differently, so a ray that passes within rounding of an edge may get either
+ * answer; every disagreement must be such a ray (brute force in double
+ * precision), or lie within 1e-4 of tnear/tfar (rayfile.md's rule).
+ */
+#include <string.h>
+#include "api/scene.h"
+#include "random_scene.h"
+#include "render/mft_rays.h"
+#include "test_util.h"
+#include "trace/mft.h"
+
+static const fr_mft_fns *isa_fns[] = {&fr_mft_scalar, &fr_mft_avx2, &fr_mft_avx512};
+static const fr_isa isas[] = {FR_ISA_SCALAR, FR_ISA_AVX2, FR_ISA_AVX512};
+
+typedef struct mesh_ref { const float *pos; const uint32_t *idx; size_t nt; } mesh_ref;
+
+static mesh_ref scene_mesh(const fr_scene *s) {
+  mesh_ref m = {fr_scene_vertices(s), fr_scene_indices(s), fr_scene_triangle_count(s)};
+  return m;
+}
+
+/* 1 if a disagreement on this ray is excusable: its nearest hit (in double
+ * precision, over a range widened by the tolerance) is within rounding of an
+ * edge, or within 1e-4 max(1, |t|) of tnear or tfar. */
+static int ambiguous(const mesh_ref *m, const fr_ray *r) {
+  uint32_t prim;
+  double margin;
+  fr_ray wide = *r;
+  wide.tnear = r->tnear - 1e-4f * fmaxf(1.0f, fabsf(r->tnear));
+  wide.tfar = r->tfar + 1e-4f * fmaxf(1.0f, fabsf(r->tfar));
+  double t = brute_force(m->pos, m->idx, m->nt, &wide, &prim, &margin, 1);
+  if (margin < 1e-4) return 1;
+  if (t < INFINITY && (fabs(t - r->tnear) <= 1e-4 * fmax(1.0, fabs(t)) || fabs(t - r->tfar) <= 1e-4 * fmax(1.0, fabs(t))))
+    return 1;
+  return 0;
+}
+
+/* Soft-shadow frusta from random points of the scene to a quad light. */
+static void make_shadow_batch(fr_rng *r, const mesh_ref *m, vec3 lc, float eps, fr_mft_batch *b) {
+  memset(b, 0, sizeof *b);
+  for (int f = 0; f < 16; f++) {
+    uint32_t t = fr_rng_u32(r) % (uint32_t)m->nt;
+    vec3 a = v3_load(m->pos + 3 * m->idx[3 * t]), bb = v3_load(m->pos + 3 * m->idx[3 * t + 1]),
+         c = v3_load(m->pos + 3 * m->idx[3 * t + 2]);
+    float u = fr_rng_float(r) * 0.5f, v = fr_rng_float(r) * 0.5f;
+    vec3 p = v3_add(a, v3_add(v3_scale(v3_sub(bb, a), u), v3_scale(v3_sub(c, a), v)));
+    vec3 s = v3_sub(lc, p);
+    b->org[0][f] = p.x; b->org[1][f] = p.y; b->org[2][f] = p.z;
+    b->start[0][f] = s.x; b->start[1][f] = s.y; b->start[2][f] = s.z;
+    b->tnear[f] = eps / v3_len(s);
+    b->tfar[f] = 1.0f - 1e-4f;
+    b->set[f] = (uint8_t)f;
+    if (fr_rng_u32(r) % 8) b->valid |= 1u << f;
+  }
+}
+
+typedef struct tally { long rays, disagree, excused; } tally;
+
+static void check_shadows(const fr_scene *s, const fr_mft_batch *b, const fr_mft_sets *T, tally *tl) {
+  mesh_ref m = scene_mesh(s);
+  uint16_t ref[16];
+  int first = 1;
+  for (int corner = 0; corner < 2; corner++)
+    for (int shrink = 0; shrink < 2; shrink++)
+      for (int i = 0; i < 3; i++) {
+        if (!fr_isa_supported(isas[i])) continue;
+        fr_mft_opts o = {corner, shrink};
+        uint16_t occ[16];
+        memset(occ, 0xAB, sizeof occ); /* poison: every frustum must be written */
+        isa_fns[i]->occluded(&s->bvh2, &o, b, T, occ);
+        if (first) {
+          memcpy(ref, occ, sizeof ref);
+          first = 0;
+          for (int f = 0; f < 16; f++) {
+            if (!((b->valid >> f) & 1)) { assert_int_equal(occ[f], 0); continue; }
+            for (int k = 0; k < 16; k++) {
+              fr_ray r;
+              fr_mft_ray(b, T, f, k, r.org, r.dir);
+              r.tnear = b->tnear[f];
+              r.tfar = b->tfar[f];
+              int single = fr_occluded1(s, &r), mft = (occ[f] >> k) & 1;
+              tl->rays++;
+              if (single != mft) {
+                tl->disagree++;
+                if (!ambiguous(&m, &r)) {
+                  uint32_t bp;
+                  double margin, bt = brute_force(m.pos, m.idx, m.nt, &r, &bp, &margin, 1);
+                  print_error("frustum %d ray %d: mft %d single %d (double: t=%g prim %u margin %g; tnear %g)\n", f, k,
+                              mft, single, bt, bp, margin, r.tnear);
+                  fail();
+                }
+                tl->excused++;
+              }
+            }
+          }
+        } else {
+          /* every ISA and switch gives the same bits */
+          assert_memory_equal(occ, ref, sizeof ref);
+        }
+      }
+}
+
+static void check_camera(const fr_scene *s, const fr_camera *cam, int x0, int y0, tally *tl) {
+  mesh_ref m = scene_mesh(s);
+  fr_mft_sets T;
+  fr_mft_batch b;
+  fr_mft_sets_camera(&T, cam);
+  fr_mft_batch_camera(&b, cam, x0, y0);
+  static fr_mft_hits ref, h;
+  int first = 1;
+  for (int corner = 0; corner < 2; corner++)
+    for (int i = 0; i < 3; i++) {
+      if (!fr_isa_supported(isas[i])) continue;
+      fr_mft_opts o = {corner, 0};
+      memset(&h, 0xAB, sizeof h);
+      isa_fns[i]->intersect(&s->bvh2, &o, &b, &T, &h);
+      if (!first) {
+        assert_memory_equal(&h, &ref, sizeof h);
+        continue;
+      }
+      ref = h;
+      first = 0;
+      for (int f = 0; f < 16; f++)
+        for (int k = 0; k < 16; k++) {
+          if (!((b.valid >> f) & 1)) { assert_int_equal(h.prim[f][k], FR_INVALID_ID); continue; }
+          fr_ray r;
+          fr_hit sh;
+          fr_mft_ray(&b, &T, f, k, r.org, r.dir);
+          r.tnear = 0.0f;
+          r.tfar = INFINITY;
+          fr_intersect1(s, &r, &sh);
+          tl->rays++;
+          float t1 = h.t[f][k], t2 = sh.t;
+          int agree = (t1 == INFINITY && t2 == INFINITY) ||
+                      (t1 < INFINITY && t2 < INFINITY && fabsf(t1 - t2) <= 1e-4f * fmaxf(1.0f, fabsf(t1)));
+          if (agree && t1 < INFINITY) {
+            /* the barycentrics describe the reported triangle's hit point */
+            assert_true(h.u[f][k] >= -1e-3f && h.v[f][k] >= -1e-3f && h.u[f][k] + h.v[f][k] <= 1.001f);
+          }
+          if (!agree) {
+            tl->disagree++;
+            if (!ambiguous(&m, &r)) {
+              print_error("block (%d,%d) frustum %d ray %d: mft t=%g prim %u, single t=%g prim %u\n", x0, y0, f, k,
+                          t1, h.prim[f][k], t2, sh.prim);
+              fail();
+            }
+            tl->excused++;
+          }
+        }
+    }
+}
+
+static void random_scenes(void **state) {
+  (void)state;
+  fr_rng r = fr_rng_seed(11, 3);
+  tally tl = {0};
+  for (int round = 0; round < 6; round++) {
+    vec3 center = round % 3 == 2 ? v3(1e4f, -3e3f, 2e3f) : v3(0, 0, 0);
+    float size = round % 2 ? 1.0f : 30.0f;
+    scene_data sd = make_scene(&r, 600 + 300 * (size_t)round, center, size);
+    fr_scene *s = commit_scene(&sd);
+    mesh_ref m = scene_mesh(s);
+    float e1[3] = {size * 0.5f, 0, 0}, e2[3] = {0, 0, size * 0.4f};
+    vec3 lc = v3_add(center, v3(urand(&r, -size, size), 2.5f * size, urand(&r, -size, size)));
+    fr_mft_sets T;
+    fr_mft_sets_light(&T, e1, e2, (uint64_t)round);
+    for (int n = 0; n < 40; n++) {
+      fr_mft_batch b;
+      make_shadow_batch(&r, &m, lc, 1e-4f * size, &b);
+      check_shadows(s, &b, &T, &tl);
+    }
+    fr_camera cam;
+    vec3 eye = v3_add(center, v3(urand(&r, -3, 3) * size, urand(&r, -3, 3) * size, 3.0f * size));
+    assert_int_equal(fr_camera_setup(&cam, eye, center, v3(0, 1, 0), 50.0f, 64, 48), FR_OK);
+    for (int y = 0; y < 48; y += 16)
+      for (int x = 0; x < 64; x += 16) check_camera(s, &cam, x, y, &tl);
+    fr_scene_release(s);
+    free_scene(&sd);
+  }
+  print_message("random scenes: %ld rays, %ld disagreements (all at edges or range ends)\n", tl.rays, tl.disagree);
+  assert_true(tl.disagree * 1000 < tl.rays);
+}
+
+/* The built-in scene: closed boxes and spheres on a floor, axis-aligned faces,
+ * the shadows of its quad light seen from its view. */
+static void builtin_scene(void **state) {
+  (void)state;
+  fr_scene *s;
+  assert_int_equal(fr_scene_builtin(&s), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  float lo[3], hi[3];
+  fr_scene_bounds(s, lo, hi);
+  vec3 c = v3_scale(v3_add(v3_load(lo), v3_load(hi)), 0.5f), ext = v3_sub(v3_load(hi), v3_load(lo));
+  fr_camera cam;
+  assert_int_equal(fr_camera_setup(&cam, v3_add(c, v3(0.3f * ext.x, 0.4f * ext.y, 0.9f * ext.z)), c, v3(0, 1, 0), 45.0f,
+                                   96, 96), FR_OK);
+  tally tl = {0};
+  for (int y = 0; y < 96; y += 32)
+    for (int x = 0; x < 96; x += 32) check_camera(s, &cam, x, y, &tl);
+  /* shadow frusta from the primary hits of pixel blocks */
+  fr_mft_sets T;
+  float e1[3] = {0.2f * ext.x, 0, 0}, e2[3] = {0, 0, 0.2f * ext.z};
+  fr_mft_sets_light(&T, e1, e2, 5);
+  vec3 lc = v3_add(c, v3(-0.1f * ext.x, 0.8f * ext.y, -0.1f * ext.z));
+  for (int by = 0; by < 96; by += 4)
+    for (int bx = 0; bx < 96; bx += 24) {
+      fr_mft_batch b;
+      memset(&b, 0, sizeof b);
+      for (int f = 0; f < 16; f++) {
+        int x = bx + (f & 3), y = by + (f >> 2);
+        fr_ray r = fr_camera_ray(&cam, x, y);
+        fr_hit h;
+        fr_intersect1(s, &r, &h);
+        if (h.prim == FR_INVALID_ID) continue;
+        vec3 p = v3_add(v3_load(r.org), v3_scale(v3_load(r.dir), h.t)), st = v3_sub(lc, p);
+        b.org[0][f] = p.x; b.org[1][f] = p.y; b.org[2][f] = p.z;
+        b.start[0][f] = st.x; b.start[1][f] = st.y; b.start[2][f] = st.z;
+        b.tnear[f] = 1e-4f * v3_len(ext) / v3_len(st);
+        b.tfar[f] = 1.0f - 1e-4f;
+        b.set[f] = (uint8_t)fr_mft_light_set(x, y);
+        b.valid |= 1u << f;
+      }
+      check_shadows(s, &b, &T, &tl);
+    }
+  print_message("built-in scene: %ld rays, %ld disagreements (all at edges or range ends)\n", tl.rays, tl.disagree);
+  assert_true(tl.disagree * 1000 < tl.rays);
+  fr_scene_release(s);
+}
+
+/* The sample sets: each a (0,4,2)-net (one sample per 4x4 stratum and per
+ * 1/16 row and column), the 16 together one per 16x16 stratum. */
+static void light_sets_are_nets(void **state) {
+  (void)state;
+  fr_mft_sets T;
+  float e1[3] = {1, 0, 0}, e2[3] = {0, 1, 0};
+  for (uint64_t seed = 0; seed < 4; seed++) {
+    fr_mft_sets_light(&T, e1, e2, seed);
+    int all[16][16] = {{0}};
+    for (int j = 0; j < 16; j++) {
+      int cell[4][4] = {{0}}, row[16] = {0}, col[16] = {0};
+      for (int k = 0; k < 16; k++) {
+        float a = T.set[j].a[k], b = T.set[j].b[k];
+        assert_true(a >= 0.0f && a < 1.0f && b >= 0.0f && b < 1.0f);
+        cell[(int)(a * 4)][(int)(b * 4)]++;
+        col[(int)(a * 16)]++;
+        row[(int)(b * 16)]++;
+        all[(int)(a * 16)][(int)(b * 16)]++;
+        assert_true(T.set[j].dx[k] == a && T.set[j].dy[k] == b);
+      }
+      for (int i = 0; i < 16; i++) {
+        assert_int_equal(cell[i / 4][i % 4], 1);
+        assert_int_equal(row[i], 1);
+        assert_int_equal(col[i], 1);
+      }
+    }
+    for (int i = 0; i < 16; i++)
+      for (int k = 0; k < 16; k++) assert_int_equal(all[i][k], 1);
+  }
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(light_sets_are_nets),
+      cmocka_unit_test(random_scenes),
+      cmocka_unit_test(builtin_scene),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
