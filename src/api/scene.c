@@ -96,10 +96,8 @@ void fr_scene_release(fr_scene *s) {
   free(s);
 }
 
-fr_error fr_scene_commit(fr_scene *s) {
-  if (!s) return fr_fail(FR_ERR_ARG, "fr_scene_commit: scene is NULL");
-  if (s->committed) return FR_OK;
-  double t0 = fr_seconds();
+/* The SAH tree over the non-degenerate triangles (n of them); sets s->bounds. */
+static fr_error build_tree(fr_scene *s, fr_build_tree *tree, size_t *count) {
   const fr_mesh *m = &s->mesh;
   aabb *boxes = malloc(fr_mul_size(m->ntris, sizeof(aabb)));
   uint32_t *ids = malloc(fr_mul_size(m->ntris, sizeof(uint32_t)));
@@ -114,13 +112,35 @@ fr_error fr_scene_commit(fr_scene *s) {
     ids[n++] = (uint32_t)t;
     s->bounds = aabb_merge(s->bounds, b);
   }
-  s->skipped = m->ntris - n;
+  *count = n;
   if (n == 0) { free(boxes); free(ids); return fr_fail(FR_ERR_FORMAT, "%s: every triangle is degenerate", s->name); }
-  fr_build_tree tree;
-  fr_error e = fr_build_sah(boxes, ids, n, &tree);
+  fr_error e = fr_build_sah(boxes, ids, n, tree);
   free(boxes);
   free(ids);
+  return e;
+}
+
+fr_error fr_scene_build_bvh2(fr_scene *s, int max_leaf, fr_bvh2 *out) {
+  if (!s || !s->committed) return fr_fail(FR_ERR_ARG, "fr_scene_build_bvh2: scene not committed");
+  fr_build_tree tree;
+  size_t n;
+  fr_error e = build_tree(s, &tree, &n);
   if (e) return e;
+  e = fr_bvh2_from_build(&tree, &s->mesh, max_leaf, out);
+  fr_build_tree_free(&tree);
+  return e;
+}
+
+fr_error fr_scene_commit(fr_scene *s) {
+  if (!s) return fr_fail(FR_ERR_ARG, "fr_scene_commit: scene is NULL");
+  if (s->committed) return FR_OK;
+  double t0 = fr_seconds();
+  const fr_mesh *m = &s->mesh;
+  fr_build_tree tree;
+  size_t n;
+  fr_error e = build_tree(s, &tree, &n);
+  if (e) return e;
+  s->skipped = m->ntris - n;
   e = fr_bvh2_from_build(&tree, m, FR_BUILD_MAX_LEAF, &s->bvh2);
   if (!e) e = fr_bvhn_from_build(&tree, m, 4, &s->bvh4);
   if (!e) e = fr_bvhn_from_build(&tree, m, 8, &s->bvh8);

@@ -18,4 +18,9 @@ struct fr_scene {
   double build_seconds;
   char name[64];        /* scene name for views and reports */
 };
+
+/* Another binary BVH of a committed scene with leaves of up to max_leaf
+ * triangles (the shallow trees multi-frusta tracing may prefer); the caller
+ * frees it with fr_bvh2_free. */
+fr_error fr_scene_build_bvh2(fr_scene *s, int max_leaf, fr_bvh2 *out);
 #endif

@@ -3,11 +3,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "base/alloc.h"
 #include "base/rng.h"
 #include "base/timer.h"
+#include "render/mft_rays.h"
 #include "trace/counters.h"
 
-#define TILE 8
+#define TILE 16 /* 16 blocks of 4x4 pixels: one batch of 16 frusta */
 #define TILE_PIX (TILE * TILE)
 #define MAX_SEC 16 /* secondary rays per pixel */
 
@@ -72,6 +74,89 @@ static vec3 albedo(const fr_scene *s, uint32_t prim) {
   return mat ? v3(mat->diffuse[0], mat->diffuse[1], mat->diffuse[2]) : v3(0.8f, 0.8f, 0.8f);
 }
 
+/* Camera rays of a full tile by multi-frusta tracing: pixel 16 f + k of the
+ * tile is ray k of frustum f. The hits and rays are returned in units of the
+ * normalized direction, as fr_camera_ray gives them. */
+static void primary_frusta(const fr_workload *w, const fr_tracer *t, buffers *B, const fr_mft_sets *cam_set, int tx,
+                           int ty) {
+  fr_mft_batch b;
+  static _Thread_local fr_mft_hits h;
+  fr_mft_batch_camera(&b, &w->cam, tx, ty);
+  t->intersect_frusta(t->ctx, &b, cam_set, &h);
+  for (int f = 0; f < FR_MFT_FRUSTA; f++)
+    for (int k = 0; k < FR_MFT_RAYS; k++) {
+      int i = 16 * f + k;
+      fr_ray r;
+      fr_mft_ray(&b, cam_set, f, k, r.org, r.dir);
+      float len = sqrtf(r.dir[0] * r.dir[0] + r.dir[1] * r.dir[1] + r.dir[2] * r.dir[2]);
+      for (int a = 0; a < 3; a++) r.dir[a] /= len;
+      r.tnear = 0.0f;
+      r.tfar = INFINITY;
+      B->prim_ray[i] = r;
+      fr_hit *o = &B->prim_hit[i];
+      o->prim = h.prim[f][k];
+      o->t = o->prim == FR_INVALID_ID ? INFINITY : h.t[f][k] * len;
+      o->u = h.u[f][k];
+      o->v = h.v[f][k];
+      o->ng[0] = o->ng[1] = o->ng[2] = 0.0f;
+    }
+}
+
+/* Soft shadows: pixels 16 j .. 16 j + 15 with a primary hit are the frusta of
+ * batch j: origin p, rays p + t (c + s e1 + q e2 - p) for the samples of the
+ * pixel's interleaved set, t in (eps / |light centre - p|, 1 - 1e-4). Returns
+ * the shadow rays traced; lit[i] gets pixel i's unoccluded fraction. */
+static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *B, int n, float *lit) {
+  const fr_mft_sets *T = w->light_sets;
+  vec3 centre = v3_add(w->view.area_c, v3_scale(v3_add(w->view.area_e1, w->view.area_e2), 0.5f));
+  uint64_t rays = 0;
+  int m = 0;
+  for (int j = 0; j < (n + 15) / 16; j++) {
+    fr_mft_batch b;
+    memset(&b, 0, sizeof b);
+    for (int f = 0; f < 16 && 16 * j + f < n; f++) {
+      int i = 16 * j + f;
+      const fr_hit *h = &B->prim_hit[i];
+      if (h->prim == FR_INVALID_ID) continue;
+      vec3 p = hit_point(&B->prim_ray[i], h), st = v3_sub(w->view.area_c, p);
+      b.org[0][f] = p.x; b.org[1][f] = p.y; b.org[2][f] = p.z;
+      b.start[0][f] = st.x; b.start[1][f] = st.y; b.start[2][f] = st.z;
+      b.tnear[f] = w->eps / v3_len(v3_sub(centre, p));
+      b.tfar[f] = 1.0f - 1e-4f;
+      b.set[f] = (uint8_t)fr_mft_light_set(B->px[i], B->py[i]);
+      b.valid |= 1u << f;
+    }
+    rays += 16u * (uint64_t)__builtin_popcount(b.valid);
+    if (t->occluded_frusta) {
+      uint16_t occ[FR_MFT_FRUSTA];
+      t->occluded_frusta(t->ctx, &b, T, occ);
+      for (unsigned v = b.valid; v; v &= v - 1) {
+        int f = __builtin_ctz(v);
+        lit[16 * j + f] = (float)(16 - __builtin_popcount(occ[f])) / 16.0f;
+      }
+      continue;
+    }
+    for (unsigned v = b.valid; v; v &= v - 1) {
+      int f = __builtin_ctz(v);
+      for (int k = 0; k < FR_MFT_RAYS; k++) {
+        fr_ray *r = &B->rays[m];
+        fr_mft_ray(&b, T, f, k, r->org, r->dir);
+        r->tnear = b.tnear[f];
+        r->tfar = b.tfar[f];
+        B->owner[m++] = 16 * j + f;
+      }
+    }
+  }
+  if (!t->occluded_frusta) {
+    t->occluded(t->ctx, B->rays, B->occ, (size_t)m, 0);
+    int cnt[TILE_PIX] = {0};
+    for (int k = 0; k < m; k++) cnt[B->owner[k]] += !B->occ[k];
+    for (int i = 0; i < n; i++)
+      if (B->prim_hit[i].prim != FR_INVALID_ID) lit[i] = (float)cnt[i] / 16.0f;
+  }
+  return rays;
+}
+
 /* One tile: returns rays traced; writes shaded pixels when w->image is set. */
 static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, int tx, int ty) {
   const int W = w->cam.width, H = w->cam.height;
@@ -89,7 +174,10 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
           n++;
         }
   uint64_t rays = (uint64_t)n;
-  t->intersect(t->ctx, B->rays, B->prim_hit, (size_t)n, 1);
+  if (t->intersect_frusta && n == TILE_PIX)
+    primary_frusta(w, t, B, w->camera_set, tx, ty);
+  else
+    t->intersect(t->ctx, B->rays, B->prim_hit, (size_t)n, 1);
   float lit[TILE_PIX];
   for (int i = 0; i < n; i++) lit[i] = 1.0f;
 
@@ -97,8 +185,11 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
   switch (w->kind) {
   case FR_WL_PRIMARY:
     break;
-  case FR_WL_SHADOW:
   case FR_WL_SOFT16:
+    for (int i = 0; i < n; i++) lit[i] = 0.0f;
+    rays += soft_shadows(w, t, B, n, lit);
+    break;
+  case FR_WL_SHADOW:
   case FR_WL_AO16: {
     int per = w->kind == FR_WL_SHADOW ? 1 : 16;
     for (int i = 0; i < n; i++) {
@@ -114,10 +205,6 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
           tfar = INFINITY;
         } else {
           vec3 L = w->view.light;
-          if (w->kind == FR_WL_SOFT16) { /* stratified 4x4 on the quad */
-            float s = ((float)(k & 3) + fr_rng_float(&rng)) * 0.25f, q = ((float)(k >> 2) + fr_rng_float(&rng)) * 0.25f;
-            L = v3_add(w->view.area_c, v3_add(v3_scale(w->view.area_e1, s), v3_scale(w->view.area_e2, q)));
-          }
           vec3 to = v3_sub(L, p);
           float dist = v3_len(to);
           dir = v3_scale(to, 1.0f / dist);
@@ -196,7 +283,17 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
   return rays;
 }
 
-fr_workload_result fr_workload_run(const fr_workload *w, const fr_tracer *t) {
+fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
+  /* the ray sets of this frame, shared by every tile */
+  fr_workload run = *w0, *w = &run;
+  fr_mft_sets *sets = fr_alloc_aligned(2 * sizeof(fr_mft_sets), 64);
+  if (!sets) { fr_workload_result none = {0, 0.0}; return none; }
+  float e1[3] = {w->view.area_e1.x, w->view.area_e1.y, w->view.area_e1.z};
+  float e2[3] = {w->view.area_e2.x, w->view.area_e2.y, w->view.area_e2.z};
+  fr_mft_sets_light(&sets[0], e1, e2, w->seed);
+  fr_mft_sets_camera(&sets[1], &w->cam);
+  run.light_sets = &sets[0];
+  run.camera_set = &sets[1];
   const int tiles_x = (w->cam.width + TILE - 1) / TILE, tiles_y = (w->cam.height + TILE - 1) / TILE;
   const int ntiles = tiles_x * tiles_y;
   uint64_t total = 0;
@@ -229,6 +326,7 @@ fr_workload_result fr_workload_run(const fr_workload *w, const fr_tracer *t) {
   }
   fr_workload_result r = {total, fr_seconds() - t0};
   if (w->progress && last_pct >= 0) fprintf(stderr, "\n");
+  fr_free_aligned(sets);
   return r;
 }
 
@@ -243,6 +341,31 @@ static void frusta_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int
 }
 
 fr_tracer fr_tracer_frusta(const fr_scene *s) {
-  fr_tracer t = {(void *)s, frusta_intersect, frusta_occluded};
+  fr_tracer t = {(void *)s, frusta_intersect, frusta_occluded, NULL, NULL};
+  return t;
+}
+
+static void mft_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
+  (void)coherent;
+  fr_intersect_stream(((const fr_mft_tracer *)ctx)->scene, rays, hits, n);
+}
+
+static void mft_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
+  (void)coherent;
+  fr_occluded_stream(((const fr_mft_tracer *)ctx)->scene, rays, occ, n);
+}
+
+static void mft_intersect_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *hits) {
+  const fr_mft_tracer *m = ctx;
+  fr_mft_active()->intersect(m->bvh, &m->opts, b, t, hits);
+}
+
+static void mft_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[FR_MFT_FRUSTA]) {
+  const fr_mft_tracer *m = ctx;
+  fr_mft_active()->occluded(m->bvh, &m->opts, b, t, occ);
+}
+
+fr_tracer fr_tracer_mft(const fr_mft_tracer *ctx) {
+  fr_tracer t = {(void *)ctx, mft_intersect, mft_occluded, mft_intersect_frusta, mft_occluded_frusta};
   return t;
 }

@@ -9,6 +9,7 @@
 #include "frusta.h"
 #include "render/camera.h"
 #include "render/views.h"
+#include "trace/mft.h"
 
 typedef enum fr_workload_kind {
   FR_WL_PRIMARY, FR_WL_SHADOW, FR_WL_SOFT16, FR_WL_AO16, FR_WL_DIFFUSE8, FR_WL_SPECULAR8, FR_WL_COUNT
@@ -17,13 +18,20 @@ typedef enum fr_workload_kind {
 const char *fr_workload_name(fr_workload_kind k);
 int fr_workload_parse(const char *name, fr_workload_kind *k);
 
-/* A tracer: rays come in tiles of up to 64 pixels, ordered in 4x4 blocks, so
- * consecutive groups of 16 are coherent when the workload is. Implementations
- * may overwrite the ray arrays. */
+/* A tracer: rays come in tiles of up to 16x16 pixels, ordered in 4x4 blocks,
+ * so consecutive groups of 16 are coherent when the workload is.
+ * Implementations may overwrite the ray arrays.
+ *
+ * A multi-frusta tracer also takes whole frusta: camera rays of full 16x16
+ * tiles, and the soft shadow rays of 16 pixels at a time (trace/mft.h). Where
+ * these are NULL the engine makes the same rays (fr_mft_ray) and hands them to
+ * intersect / occluded, so every tracer traces the same rays. */
 typedef struct fr_tracer {
   void *ctx;
   void (*intersect)(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent);
   void (*occluded)(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent);
+  void (*intersect_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *hits);
+  void (*occluded_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[FR_MFT_FRUSTA]);
 } fr_tracer;
 
 typedef enum fr_shade { FR_SHADE_NONE, FR_SHADE_EYELIGHT, FR_SHADE_NORMALS, FR_SHADE_LIGHT } fr_shade;
@@ -39,12 +47,25 @@ typedef struct fr_workload {
   fr_shade shade;          /* with an image: what to write */
   float *image;            /* width*height*3, or NULL */
   int progress;            /* print progress to stderr */
+  /* set by fr_workload_run for its tiles */
+  const fr_mft_sets *light_sets;  /* this frame's interleaved samples on the quad light */
+  const fr_mft_sets *camera_set;  /* the 4x4 pixels of a block */
 } fr_workload;
 
 typedef struct fr_workload_result { uint64_t rays; double seconds; } fr_workload_result;
 
 fr_workload_result fr_workload_run(const fr_workload *w, const fr_tracer *t);
 
-/* The frusta tracer (single-ray kernels on the scene). */
+/* The frusta tracer: streams as the scene's trace options say. */
 fr_tracer fr_tracer_frusta(const fr_scene *s);
+
+/* The multi-frusta tracer: camera rays and soft shadows by multi-frusta
+ * tracing through bvh (the scene's binary BVH, or a shallower one), every
+ * other ray as fr_tracer_frusta. The context must outlive the tracer. */
+typedef struct fr_mft_tracer {
+  const fr_scene *scene;
+  const fr_bvh2 *bvh;
+  fr_mft_opts opts;
+} fr_mft_tracer;
+fr_tracer fr_tracer_mft(const fr_mft_tracer *ctx);
 #endif

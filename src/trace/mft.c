@@ -8,6 +8,20 @@ void fr_mft_set_finish(fr_mft_sets *t, int s) {
     S->dy[k] = S->a[k] * t->e1[1] + S->b[k] * t->e2[1];
     S->dz[k] = S->a[k] * t->e1[2] + S->b[k] * t->e2[2];
   }
+  S->amin = S->amax = S->a[0];
+  S->bmin = S->bmax = S->b[0];
+  const float *d[3] = {S->dx, S->dy, S->dz};
+  for (int a = 0; a < 3; a++) S->lo[a] = S->hi[a] = d[a][0];
+  for (int k = 1; k < FR_MFT_RAYS; k++) {
+    if (S->a[k] < S->amin) S->amin = S->a[k];
+    if (S->a[k] > S->amax) S->amax = S->a[k];
+    if (S->b[k] < S->bmin) S->bmin = S->b[k];
+    if (S->b[k] > S->bmax) S->bmax = S->b[k];
+    for (int a = 0; a < 3; a++) {
+      if (d[a][k] < S->lo[a]) S->lo[a] = d[a][k];
+      if (d[a][k] > S->hi[a]) S->hi[a] = d[a][k];
+    }
+  }
 }
 
 const fr_mft_fns *fr_mft_active(void) {

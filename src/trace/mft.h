@@ -30,6 +30,8 @@
 typedef struct fr_mft_set {
   float a[FR_MFT_RAYS], b[FR_MFT_RAYS];              /* 2D parameters */
   float dx[FR_MFT_RAYS], dy[FR_MFT_RAYS], dz[FR_MFT_RAYS]; /* delta = a e1 + b e2, rounded once */
+  float amin, amax, bmin, bmax;                      /* the box of (a, b) */
+  float lo[3], hi[3];                                /* the box of the deltas */
 } __attribute__((aligned(64))) fr_mft_set;
 
 typedef struct fr_mft_sets {
@@ -38,7 +40,7 @@ typedef struct fr_mft_sets {
   int count;
 } fr_mft_sets;
 
-/* Fills the deltas of set s from its (a, b) parameters. */
+/* Fills the deltas of set s and their bounds from its (a, b) parameters. */
 void fr_mft_set_finish(fr_mft_sets *t, int s);
 
 /* 16 frusta. Lane f is frustum f; only frusta in `valid` are traced. */

@@ -58,17 +58,28 @@ typedef struct frusta {
   const fr_mft_set *set[16];
 } frusta;
 
-/* Lane f's bounds from the (a, b) box of its active rays. */
+#define MINF(a, b) ((a) < (b) ? (a) : (b))
+#define MAXF(a, b) ((a) > (b) ? (a) : (b))
+
+/* Lane f's bounds from the (a, b) box of its active rays (all 16: the set's
+ * own bounds; fewer after shrinking: masked reductions). */
 static void frustum_bounds(frusta *F, const fr_mft_sets *T, int f, unsigned rays) {
   const fr_mft_set *S = F->set[f];
-  const float *dl[3] = {S->dx, S->dy, S->dz};
-  float amin = INFINITY, amax = -INFINITY, bmin = INFINITY, bmax = -INFINITY;
-  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (unsigned m = rays; m; m &= m - 1) {
-    int k = __builtin_ctz(m);
-    amin = fminf(amin, S->a[k]); amax = fmaxf(amax, S->a[k]);
-    bmin = fminf(bmin, S->b[k]); bmax = fmaxf(bmax, S->b[k]);
-    for (int a = 0; a < 3; a++) { lo[a] = fminf(lo[a], dl[a][k]); hi[a] = fmaxf(hi[a], dl[a][k]); }
+  float amin = S->amin, amax = S->amax, bmin = S->bmin, bmax = S->bmax;
+  float lo[3] = {S->lo[0], S->lo[1], S->lo[2]}, hi[3] = {S->hi[0], S->hi[1], S->hi[2]};
+  if (rays != 0xFFFFu) {
+    vpm m = vpm_bits_to(rays);
+    vpf inf = vp(INFINITY), ninf = vp(-INFINITY);
+    const float *dl[3] = {S->dx, S->dy, S->dz};
+    amin = vp_reduce_min(vp_select(m, vp_load(S->a), inf));
+    amax = vp_reduce_max(vp_select(m, vp_load(S->a), ninf));
+    bmin = vp_reduce_min(vp_select(m, vp_load(S->b), inf));
+    bmax = vp_reduce_max(vp_select(m, vp_load(S->b), ninf));
+    for (int a = 0; a < 3; a++) {
+      vpf d = vp_load(dl[a]);
+      lo[a] = vp_reduce_min(vp_select(m, d, inf));
+      hi[a] = vp_reduce_max(vp_select(m, d, ninf));
+    }
   }
   const float ca[4] = {amin, amax, amin, amax}, cb[4] = {bmin, bmin, bmax, bmax};
   float big = 0.0f;
@@ -76,29 +87,29 @@ static void frustum_bounds(frusta *F, const fr_mft_sets *T, int f, unsigned rays
     float s = F->s[a][f], o = F->o[a][f];
     /* rounding is monotonic: s + lo <= s + delta_k <= s + hi for the rays' own sums */
     float dlo = s + lo[a], dhi = s + hi[a];
-    big = fmaxf(big, fmaxf(fabsf(dlo), fabsf(dhi)));
+    big = MAXF(big, MAXF(fabsf(dlo), fabsf(dhi)));
     unsigned bit = 1u << f;
     F->pos[a] &= ~bit;
     F->straddle[a] &= ~bit;
     if (dlo > 0.0f) {
       F->pos[a] |= bit;
-      F->rs[a][f] = 1.0f / fmaxf(dhi, TINY);
-      F->rl[a][f] = 1.0f / fmaxf(dlo, TINY);
+      F->rs[a][f] = 1.0f / MAXF(dhi, TINY);
+      F->rl[a][f] = 1.0f / MAXF(dlo, TINY);
     } else if (dhi < 0.0f) {
-      F->rs[a][f] = 1.0f / fminf(dlo, -TINY);
-      F->rl[a][f] = 1.0f / fminf(dhi, -TINY);
+      F->rs[a][f] = 1.0f / MINF(dlo, -TINY);
+      F->rl[a][f] = 1.0f / MINF(dhi, -TINY);
     } else {
       F->straddle[a] |= bit;
-      F->rs[a][f] = 1.0f / fmaxf(dhi, TINY);
-      F->rl[a][f] = 1.0f / fminf(dlo, -TINY);
+      F->rs[a][f] = 1.0f / MAXF(dhi, TINY);
+      F->rl[a][f] = 1.0f / MINF(dlo, -TINY);
     }
     if (F->bounded) {
       /* o + t d over t in [tnear, tfar], d in [dlo, dhi]: bilinear, so the
        * extremes are at the four combinations */
       float t0 = F->tnear[f], t1 = F->tfar[f];
       float p[4] = {t0 * dlo, t0 * dhi, t1 * dlo, t1 * dhi};
-      float mn = fminf(fminf(p[0], p[1]), fminf(p[2], p[3])), mx = fmaxf(fmaxf(p[0], p[1]), fmaxf(p[2], p[3]));
-      float slack = (fabsf(o) + fmaxf(fabsf(mn), fabsf(mx))) * 0x1p-20f;
+      float mn = MINF(MINF(p[0], p[1]), MINF(p[2], p[3])), mx = MAXF(MAXF(p[0], p[1]), MAXF(p[2], p[3]));
+      float slack = (fabsf(o) + MAXF(fabsf(mn), fabsf(mx))) * 0x1p-20f;
       F->vlo[a][f] = o + mn - slack;
       F->vhi[a][f] = o + mx + slack;
     } else {

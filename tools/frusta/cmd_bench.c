@@ -16,13 +16,15 @@
 
 /* single: the default single-ray BVH (8-wide); single4: the MIC paper's BVH4;
  * packet8/packet16: packets alone; hybrid16: packets dropping to single rays;
- * auto: what fr_intersect_stream does by default. */
-static const char *frusta_modes[] = {"single", "single4", "packet8", "packet16", "hybrid16", "auto"};
-#define N_FRUSTA_MODES 6
+ * auto: what fr_intersect_stream does by default; mft: camera rays and soft
+ * shadows by multi-frusta tracing, the other rays as auto. */
+static const char *frusta_modes[] = {"single", "single4", "packet8", "packet16", "hybrid16", "auto", "mft"};
+#define N_FRUSTA_MODES 7
+#define MODE_MFT 6
 
 static void set_frusta_mode(fr_scene *s, int m, const fr_trace_options *base, int single_width) {
   static const fr_trace_mode modes[] = {FR_TRACE_SINGLE, FR_TRACE_SINGLE, FR_TRACE_PACKET8, FR_TRACE_PACKET16,
-                                        FR_TRACE_HYBRID16, FR_TRACE_AUTO};
+                                        FR_TRACE_HYBRID16, FR_TRACE_AUTO, FR_TRACE_AUTO};
   fr_trace_options o = *base;
   o.mode = modes[m];
   fr_scene_set_trace_options(s, &o);
@@ -61,6 +63,13 @@ static void run(const fr_workload *w0, const fr_tracer *t, const char *scene, si
     printf("counters tracer=%s mode=%s workload=%s per_ray nodes=%.2f box_tests=%.2f leaves=%.2f tri_tests=%.2f\n", tracer, mode,
            fr_workload_name(w0->kind), (double)c.nodes / c.rays, (double)c.box_tests / c.rays, (double)c.leaves / c.rays,
            (double)c.tri_tests / c.rays);
+  if (fr_counters_enabled() && c.mft_batches)
+    printf("counters tracer=%s mode=%s workload=%s batches=%llu per_batch nodes=%.2f box_tests=%.2f "
+           "avg_active_frusta=%.2f tris=%.2f tri_frusta=%.2f tri_frusta_left=%.2f\n",
+           tracer, mode, fr_workload_name(w0->kind), (unsigned long long)c.mft_batches,
+           (double)c.mft_nodes / c.mft_batches, (double)c.mft_box_tests / c.mft_batches,
+           c.mft_box_tests ? (double)c.mft_box_lanes / c.mft_box_tests : 0.0, (double)c.mft_tris / c.mft_batches,
+           (double)c.mft_tri_frusta / c.mft_batches, (double)c.mft_tri_left / c.mft_batches);
   if (fr_counters_enabled() && c.packets)
     printf("counters tracer=%s mode=%s workload=%s packets=%llu per_packet pk_nodes=%.2f pk_box_tests=%.2f "
            "pk_tri_tests=%.2f ia_culled=%.2f mailbox_hits=%.2f switches=%.2f avg_active_box=%.2f avg_active_tri=%.2f\n",
@@ -80,16 +89,23 @@ int cmd_bench(int argc, char **argv) {
   int threads = omp_get_num_procs(), repeat = 3;
   fr_trace_options topt;
   fr_trace_options_default(&topt);
+  fr_mft_opts mopt = {1, 1};
+  int mft_leaf = FR_BUILD_MAX_LEAF;
   for (int i = 0; i < argc; i++) {
     int r = cli_view_flag(argc, argv, &i, &v);
     if (r < 0) return CLI_USAGE_ERROR;
     if (r > 0) continue;
     const char *a = argv[i];
     if (!strcmp(a, "--threshold") || !strcmp(a, "--mailbox") || !strcmp(a, "--axis-aligned") || !strcmp(a, "--ia") ||
-        !strcmp(a, "--packet-width")) {
+        !strcmp(a, "--packet-width") || !strcmp(a, "--corner-rays") || !strcmp(a, "--shrink") || !strcmp(a, "--mft-leaf")) {
       if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
       const char *val = argv[++i];
-      if (!strcmp(a, "--threshold")) {
+      if (!strcmp(a, "--corner-rays") || !strcmp(a, "--shrink")) {
+        if (parse_onoff(a, val, !strcmp(a, "--shrink") ? &mopt.shrink : &mopt.corner_rays)) return CLI_USAGE_ERROR;
+      } else if (!strcmp(a, "--mft-leaf")) {
+        if (!cli_parse_int(val, 1, FR_BVH2_MAX_LEAF, &mft_leaf))
+          return cli_error(CLI_USAGE_ERROR, "--mft-leaf wants 1..%d, got '%s'", FR_BVH2_MAX_LEAF, val);
+      } else if (!strcmp(a, "--threshold")) {
         if (!cli_parse_int(val, 0, 16, &topt.hybrid_threshold)) return cli_error(CLI_USAGE_ERROR, "--threshold wants 0..16, got '%s'", val);
       } else if (!strcmp(a, "--packet-width")) {
         if (!cli_parse_int(val, 4, 8, &topt.packet_bvh_width) || (topt.packet_bvh_width != 4 && topt.packet_bvh_width != 8))
@@ -127,7 +143,7 @@ int cmd_bench(int argc, char **argv) {
   for (int m = 0; m < N_FRUSTA_MODES; m++) frusta_has_mode |= !strcmp(mode, frusta_modes[m]);
   int embree_has_mode = all_modes || ebr_mode_parse(mode, &em);
   if (use_frusta && !frusta_has_mode && !(use_embree && embree_has_mode))
-    return cli_error(CLI_USAGE_ERROR, "frusta has no mode '%s' (single, single4, packet8, packet16, hybrid16, auto, all)", mode);
+    return cli_error(CLI_USAGE_ERROR, "frusta has no mode '%s' (single, single4, packet8, packet16, hybrid16, auto, mft, all)", mode);
   if (use_embree && !embree_has_mode && !(use_frusta && frusta_has_mode))
     return cli_error(CLI_USAGE_ERROR, "embree has no mode '%s' (single, packet4, packet8, packet16, stream, all)", mode);
 
@@ -149,22 +165,38 @@ int cmd_bench(int argc, char **argv) {
          st.build_seconds, s->name, tris, threads, fr_isa_name(fr_get_isa()), st.single_width, ws->sah,
          (double)(ws->node_bytes + ws->tri_bytes) / (double)tris, topt.packet_bvh_width,
          (double)(wp->node_bytes + wp->tri_bytes + wp->packet_tri_bytes) / (double)tris);
+  /* multi-frusta tracing: the scene's binary BVH, or a shallower one */
+  fr_bvh2 shallow;
+  memset(&shallow, 0, sizeof shallow);
+  fr_mft_tracer mctx = {s, &s->bvh2, mopt};
+  if (use_frusta && (all_modes || !strcmp(mode, "mft")) && mft_leaf != FR_BUILD_MAX_LEAF) {
+    if (fr_scene_build_bvh2(s, mft_leaf, &shallow)) { fr_scene_release(s); return cli_error(1, "%s", fr_last_error()); }
+    mctx.bvh = &shallow;
+  }
+  if (use_frusta && (all_modes || !strcmp(mode, "mft")))
+    printf("mft_bvh leaf=%d inner=%zu leaves=%zu sah=%.2f corner_rays=%s shrink=%s\n", mctx.bvh->max_leaf,
+           mctx.bvh->nnodes, mctx.bvh->nleaves, fr_bvh2_sah(mctx.bvh), mopt.corner_rays ? "on" : "off",
+           mopt.shrink ? "on" : "off");
   ebr_scene *e = NULL;
   if (use_embree) {
     ebr_options o = {threads, 2, 0}; /* high quality, not robust: Embree's fastest tracing */
-    if (ebr_create(s, o, &e)) { fr_scene_release(s); return cli_error(1, "embree: cannot build the scene"); }
+    if (ebr_create(s, o, &e)) {
+      fr_bvh2_free(&shallow);
+      fr_scene_release(s);
+      return cli_error(1, "embree: cannot build the scene");
+    }
     printf("build_seconds=%.3f tracer=embree scene=%s tris=%zu threads=%d quality=high bytes_per_tri=%.1f\n",
            ebr_build_seconds(e), s->name, tris, threads, (double)ebr_bytes(e) / (double)tris);
   }
   for (int k = all_wl ? 0 : (int)wk; k < (all_wl ? FR_WL_COUNT : (int)wk + 1); k++) {
     w.kind = (fr_workload_kind)k;
     if (use_frusta && frusta_has_mode) {
-      fr_tracer t = fr_tracer_frusta(s);
+      fr_tracer t = fr_tracer_frusta(s), tm = fr_tracer_mft(&mctx);
       int width = st.single_width;
       for (int m = 0; m < N_FRUSTA_MODES; m++)
         if (all_modes || !strcmp(mode, frusta_modes[m])) {
           set_frusta_mode(s, m, &topt, width);
-          run(&w, &t, s->name, tris, "frusta", frusta_modes[m], repeat);
+          run(&w, m == MODE_MFT ? &tm : &t, s->name, tris, "frusta", frusta_modes[m], repeat);
         }
       fr_scene_set_bvh_width(s, width);
       fr_scene_set_trace_options(s, &topt);
@@ -177,6 +209,7 @@ int cmd_bench(int argc, char **argv) {
         }
   }
   ebr_release(e);
+  fr_bvh2_free(&shallow);
   fr_scene_release(s);
   return 0;
 }
