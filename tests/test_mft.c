@@ -171,7 +171,7 @@ static void random_scenes(void **state) {
     float e1[3] = {size * 0.5f, 0, 0}, e2[3] = {0, 0, size * 0.4f};
     vec3 lc = v3_add(center, v3(urand(&r, -size, size), 2.5f * size, urand(&r, -size, size)));
     fr_mft_sets T;
-    fr_mft_sets_light(&T, e1, e2, (uint64_t)round);
+    fr_mft_sets_light(&T, e1, e2, (uint64_t)round, round & 1 ? FR_LIGHT_SETS_CELLS : FR_LIGHT_SETS_SPREAD);
     for (int n = 0; n < 40; n++) {
       fr_mft_batch b;
       make_shadow_batch(&r, &m, lc, 1e-4f * size, &b);
@@ -208,7 +208,7 @@ static void builtin_scene(void **state) {
   /* shadow frusta from the primary hits of pixel blocks */
   fr_mft_sets T;
   float e1[3] = {0.2f * ext.x, 0, 0}, e2[3] = {0, 0, 0.2f * ext.z};
-  fr_mft_sets_light(&T, e1, e2, 5);
+  fr_mft_sets_light(&T, e1, e2, 5, FR_LIGHT_SETS_SPREAD);
   vec3 lc = v3_add(c, v3(-0.1f * ext.x, 0.8f * ext.y, -0.1f * ext.z));
   for (int by = 0; by < 96; by += 4)
     for (int bx = 0; bx < 96; bx += 24) {
@@ -235,6 +235,55 @@ static void builtin_scene(void **state) {
   fr_scene_release(s);
 }
 
+/* A fine closed sphere far from the camera (dragon-like: triangles 1000x
+ * smaller than their distance), with soft shadows from its surface: the
+ * common-origin test must keep its barycentrics accurate there. */
+static void fine_far_sphere(void **state) {
+  (void)state;
+  enum { RINGS = 300, SEGS = 600 };
+  size_t nv = (RINGS + 1) * SEGS, nt = 2 * RINGS * SEGS;
+  float *pos = malloc(nv * 3 * sizeof(float));
+  uint32_t *idx = malloc(nt * 3 * sizeof(uint32_t));
+  const float R = 0.1f;
+  vec3 c = v3(0.3f, 0.7f, -0.2f);
+  for (int i = 0; i <= RINGS; i++)
+    for (int j = 0; j < SEGS; j++) {
+      float th = (float)M_PI * (float)i / RINGS, ph = 2.0f * (float)M_PI * (float)j / SEGS;
+      float *p = pos + 3 * ((size_t)i * SEGS + (size_t)j);
+      p[0] = c.x + R * sinf(th) * cosf(ph); p[1] = c.y + R * cosf(th); p[2] = c.z + R * sinf(th) * sinf(ph);
+    }
+  size_t t = 0;
+  for (int i = 0; i < RINGS; i++)
+    for (int j = 0; j < SEGS; j++) {
+      uint32_t a = (uint32_t)(i * SEGS + j), b = (uint32_t)(i * SEGS + (j + 1) % SEGS), d = a + SEGS, e = b + SEGS;
+      uint32_t q[6] = {a, b, d, b, e, d};
+      memcpy(idx + 3 * t, q, sizeof q);
+      t += 2;
+    }
+  scene_data sd = {pos, idx, nv, nt};
+  fr_scene *s = commit_scene(&sd);
+  fr_camera cam;
+  assert_int_equal(fr_camera_setup(&cam, v3_add(c, v3(0.6f, 0.75f, 1.8f)), c, v3(0, 1, 0), 8.0f, 64, 64), FR_OK);
+  tally tl = {0};
+  for (int y = 0; y < 64; y += 16)
+    for (int x = 0; x < 64; x += 16) check_camera(s, &cam, x, y, &tl);
+  /* shadows from points on the sphere towards a light above it */
+  fr_rng r = fr_rng_seed(5, 5);
+  mesh_ref m = scene_mesh(s);
+  fr_mft_sets T;
+  float e1[3] = {0.05f, 0, 0}, e2[3] = {0, 0, 0.05f};
+  fr_mft_sets_light(&T, e1, e2, 9, FR_LIGHT_SETS_CELLS);
+  for (int n = 0; n < 40; n++) {
+    fr_mft_batch b;
+    make_shadow_batch(&r, &m, v3_add(c, v3(0.1f, 0.4f, 0.05f)), 1e-5f, &b);
+    check_shadows(s, &b, &T, &tl);
+  }
+  print_message("fine sphere: %ld rays, %ld disagreements (all at edges or range ends)\n", tl.rays, tl.disagree);
+  assert_true(tl.disagree * 1000 < tl.rays);
+  fr_scene_release(s);
+  free_scene(&sd);
+}
+
 /* The sample sets: each a (0,4,2)-net (one sample per 4x4 stratum and per
  * 1/16 row and column), the 16 together one per 16x16 stratum. */
 static void light_sets_are_nets(void **state) {
@@ -242,7 +291,7 @@ static void light_sets_are_nets(void **state) {
   fr_mft_sets T;
   float e1[3] = {1, 0, 0}, e2[3] = {0, 1, 0};
   for (uint64_t seed = 0; seed < 4; seed++) {
-    fr_mft_sets_light(&T, e1, e2, seed);
+    fr_mft_sets_light(&T, e1, e2, seed, FR_LIGHT_SETS_SPREAD);
     int all[16][16] = {{0}};
     for (int j = 0; j < 16; j++) {
       int cell[4][4] = {{0}}, row[16] = {0}, col[16] = {0};
@@ -263,6 +312,22 @@ static void light_sets_are_nets(void **state) {
     }
     for (int i = 0; i < 16; i++)
       for (int k = 0; k < 16; k++) assert_int_equal(all[i][k], 1);
+    /* cells: the same 256 points, set j inside cell j, one per 1/16 row and column of it */
+    fr_mft_sets C;
+    fr_mft_sets_light(&C, e1, e2, seed, FR_LIGHT_SETS_CELLS);
+    int again[16][16] = {{0}};
+    for (int j = 0; j < 16; j++) {
+      int row[4] = {0}, col[4] = {0};
+      for (int k = 0; k < 16; k++) {
+        float a = C.set[j].a[k], b = C.set[j].b[k];
+        assert_int_equal((int)(b * 4) * 4 + (int)(a * 4), j);
+        again[(int)(a * 16)][(int)(b * 16)]++;
+        col[(int)(a * 16) & 3]++;
+        row[(int)(b * 16) & 3]++;
+      }
+      for (int i = 0; i < 4; i++) { assert_int_equal(row[i], 4); assert_int_equal(col[i], 4); }
+    }
+    assert_memory_equal(again, all, sizeof all);
   }
 }
 
@@ -271,6 +336,7 @@ int main(void) {
       cmocka_unit_test(light_sets_are_nets),
       cmocka_unit_test(random_scenes),
       cmocka_unit_test(builtin_scene),
+      cmocka_unit_test(fine_far_sphere),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -48,7 +48,14 @@ fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_le
     vec3 a = v3_load(r->v0), n = v3_cross(v3_sub(v3_load(r->v1), a), v3_sub(v3_load(r->v2), a));
     r->n[0] = n.x; r->n[1] = n.y; r->n[2] = n.z;
     r->prim = t->prims[i];
-    r->pad[0] = r->pad[1] = r->pad[2] = 0;
+    r->edge_flip = 0;
+    const float *ends[3][2] = {{r->v1, r->v2}, {r->v2, r->v0}, {r->v0, r->v1}};
+    for (int e = 0; e < 3; e++) {
+      const float *p = ends[e][0], *q = ends[e][1];
+      int gt = p[0] != q[0] ? p[0] > q[0] : p[1] != q[1] ? p[1] > q[1] : p[2] > q[2];
+      r->edge_flip |= (uint32_t)gt << e;
+    }
+    r->pad[0] = r->pad[1] = 0;
   }
   out->bounds = t->nodes[0].box;
   conv c = {t, out, (uint32_t)max_leaf};

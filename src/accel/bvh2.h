@@ -24,13 +24,16 @@ typedef struct fr_bvh2_node {
 _Static_assert(sizeof(fr_bvh2_node) == 64, "BVH2 node is one cache line");
 
 /* A triangle as the multi-frusta kernels read it, in leaf order: the
- * vertices in mesh order (each edge's cross product then comes out exactly
- * negated in the neighbouring triangle, which makes the common-origin test
- * watertight) and the unnormalized normal (v1 - v0) x (v2 - v0). One line. */
+ * vertices in mesh order, the unnormalized normal (v1 - v0) x (v2 - v0), and
+ * per edge i (v1->v2, v2->v0, v0->v1) whether its first vertex is the
+ * lexicographically larger one (bit i of edge_flip): the kernels compute an
+ * edge's cross product from its smaller vertex, so the neighbouring triangle
+ * gets exactly the negated value (watertight). One cache line. */
 typedef struct fr_bvh2_tri {
   float v0[3], v1[3], v2[3], n[3];
   uint32_t prim;
-  uint32_t pad[3];
+  uint32_t edge_flip;
+  uint32_t pad[2];
 } __attribute__((aligned(64))) fr_bvh2_tri;
 
 _Static_assert(sizeof(fr_bvh2_tri) == 64, "BVH2 triangle is one cache line");

@@ -49,20 +49,22 @@ static uint32_t sobol2(uint32_t i) {
   return r;
 }
 
-void fr_mft_sets_light(fr_mft_sets *t, const float e1[3], const float e2[3], uint64_t seed) {
+void fr_mft_sets_light(fr_mft_sets *t, const float e1[3], const float e2[3], uint64_t seed, fr_light_sets kind) {
   memset(t, 0, sizeof *t);
   memcpy(t->e1, e1, sizeof t->e1);
   memcpy(t->e2, e2, sizeof t->e2);
   t->count = FR_MFT_SETS;
   fr_rng rng = fr_rng_seed(seed, 0x51ad0u);
   uint32_t sx = fr_rng_u32(&rng), sy = fr_rng_u32(&rng);
-  for (int j = 0; j < FR_MFT_SETS; j++) {
-    for (int k = 0; k < FR_MFT_RAYS; k++) {
-      uint32_t i = (uint32_t)(16 * j + k);
-      uint32_t x = bit_reverse(i) ^ sx, y = sobol2(i) ^ sy;
-      t->set[j].a[k] = (float)(x >> 8) * (1.0f / 16777216.0f);
-      t->set[j].b[k] = (float)(y >> 8) * (1.0f / 16777216.0f);
-    }
-    fr_mft_set_finish(t, j);
+  int fill[FR_MFT_SETS] = {0};
+  for (uint32_t i = 0; i < FR_MFT_SETS * FR_MFT_RAYS; i++) {
+    uint32_t x = bit_reverse(i) ^ sx, y = sobol2(i) ^ sy;
+    /* spread: 16 consecutive points; cells: the 16 points in one quarter by
+     * quarter of the light (a (0,8,2)-net has exactly 16 there) */
+    int j = kind == FR_LIGHT_SETS_CELLS ? (int)((y >> 30) * 4 + (x >> 30)) : (int)(i / FR_MFT_RAYS);
+    int k = fill[j]++;
+    t->set[j].a[k] = (float)(x >> 8) * (1.0f / 16777216.0f);
+    t->set[j].b[k] = (float)(y >> 8) * (1.0f / 16777216.0f);
   }
+  for (int j = 0; j < FR_MFT_SETS; j++) fr_mft_set_finish(t, j);
 }

@@ -290,7 +290,7 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
   if (!sets) { fr_workload_result none = {0, 0.0}; return none; }
   float e1[3] = {w->view.area_e1.x, w->view.area_e1.y, w->view.area_e1.z};
   float e2[3] = {w->view.area_e2.x, w->view.area_e2.y, w->view.area_e2.z};
-  fr_mft_sets_light(&sets[0], e1, e2, w->seed);
+  fr_mft_sets_light(&sets[0], e1, e2, w->seed, w->light_sets_kind);
   fr_mft_sets_camera(&sets[1], &w->cam);
   run.light_sets = &sets[0];
   run.camera_set = &sets[1];

@@ -9,6 +9,7 @@
 #include "frusta.h"
 #include "render/camera.h"
 #include "render/views.h"
+#include "render/mft_rays.h"
 #include "trace/mft.h"
 
 typedef enum fr_workload_kind {
@@ -47,6 +48,7 @@ typedef struct fr_workload {
   fr_shade shade;          /* with an image: what to write */
   float *image;            /* width*height*3, or NULL */
   int progress;            /* print progress to stderr */
+  fr_light_sets light_sets_kind; /* soft16: how the 256 samples of a 4x4 block are dealt to its pixels */
   /* set by fr_workload_run for its tiles */
   const fr_mft_sets *light_sets;  /* this frame's interleaved samples on the quad light */
   const fr_mft_sets *camera_set;  /* the 4x4 pixels of a block */

@@ -18,9 +18,12 @@
  *   w_i = d . E_i,  E_0 = (v1-o) x (v2-o), E_1 = (v2-o) x (v0-o), E_2 = (v0-o) x (v1-o)
  *   hit when every w_i has the sign of det = (v0-o) . n, t = det / (d . n) in (tnear, tfar)
  *
- * A shared edge's cross product is exactly negated in the neighbouring
- * triangle (float products commute, a - b = -(b - a)), so no ray slips
- * between two triangles: the test is watertight with no extra cost.
+ * An edge's cross product is computed as (P - o) x (Q - P) from its
+ * lexicographically smaller vertex P: the error is then relative to the
+ * triangle's size, not to its distance squared (tiny far triangles, as in
+ * the dragon, would otherwise get their barycentrics wrong by 10%), and the
+ * neighbouring triangle computes exactly the negated value, so no ray slips
+ * between two triangles: the test is watertight at no extra cost.
  */
 #include <math.h>
 #include <string.h>
@@ -54,6 +57,10 @@ typedef struct frusta {
   float corner[4][3][16] __attribute__((aligned(64)));
   float guard[16] __attribute__((aligned(64)));   /* GUARD * the largest |component| of a direction */
   unsigned pos[3], straddle[3]; /* lanes with directions > 0 / straddling 0, per axis */
+  /* each frustum's 16 rays' reciprocal directions, made when it first
+   * reaches a leaf (rd_ready): leaf boxes are tested ray by ray */
+  float rd[16][3][16] __attribute__((aligned(64)));
+  unsigned rd_ready;
   int bounded;
   const fr_mft_set *set[16];
 } frusta;
@@ -126,6 +133,7 @@ static void frustum_bounds(frusta *F, const fr_mft_sets *T, int f, unsigned rays
 }
 
 static void frusta_setup(frusta *F, const fr_mft_batch *B, const fr_mft_sets *T, unsigned valid, int bounded) {
+  F->rd_ready = 0;
   memset(F->pos, 0, sizeof F->pos);
   memset(F->straddle, 0, sizeof F->straddle);
   F->bounded = bounded;
@@ -195,14 +203,21 @@ FR_INLINE unsigned tri_cull(const frusta *F, const fr_bvh2_tri *r, unsigned m, i
   }
   vpf nx = vp(r->n[0]), ny = vp(r->n[1]), nz = vp(r->n[2]);
   vpf det = dot3(A[0], A[1], A[2], nx, ny, nz);
-  /* E_0 = B x C, E_1 = C x A, E_2 = A x B */
-  const vpf *lhs[3] = {B, C, A}, *rhs[3] = {C, A, B};
+  /* E_i = (P - o) x (Q - o) = (P - o) x (Q - P) for edge i from P to Q: the
+   * short edge vector keeps the rounding error relative to the triangle, not
+   * to its distance. From the smaller vertex, negated when flipped. */
+  const float *ends[3][2] = {{r->v1, r->v2}, {r->v2, r->v0}, {r->v0, r->v1}};
+  const vpf *from[3][2] = {{B, C}, {C, A}, {A, B}};
   vpf E[3][3];
   for (int i = 0; i < 3; i++) {
-    const vpf *p = lhs[i], *q = rhs[i];
-    E[i][0] = vp_sub(vp_mul(p[1], q[2]), vp_mul(p[2], q[1]));
-    E[i][1] = vp_sub(vp_mul(p[2], q[0]), vp_mul(p[0], q[2]));
-    E[i][2] = vp_sub(vp_mul(p[0], q[1]), vp_mul(p[1], q[0]));
+    int flip = (r->edge_flip >> i) & 1;
+    const float *p = ends[i][flip], *q = ends[i][!flip];
+    const vpf *po = from[i][flip];
+    vpf dx = vp(q[0] - p[0]), dy = vp(q[1] - p[1]), dz = vp(q[2] - p[2]);
+    vpf sg = vp(flip ? -0.0f : 0.0f);
+    E[i][0] = vp_xor(vp_sub(vp_mul(po[1], dz), vp_mul(po[2], dy)), sg);
+    E[i][1] = vp_xor(vp_sub(vp_mul(po[2], dx), vp_mul(po[0], dz)), sg);
+    E[i][2] = vp_xor(vp_sub(vp_mul(po[0], dy), vp_mul(po[1], dx)), sg);
     for (int a = 0; a < 3; a++) vp_store(X->e[i][a], E[i][a]);
   }
   vp_store(X->det, det);
@@ -256,7 +271,34 @@ FR_INLINE unsigned ray_test(const frusta *F, const tri_frusta *X, const fr_bvh2_
   return m;
 }
 
-typedef struct entry { uint32_t ref; unsigned mask; } entry;
+/* The rays of frustum f (among `rays`) whose slab test reaches box k of node
+ * n before tcur (the single-ray kernels' test, on rays made on demand): a
+ * frustum often spans a leaf box its rays all pass by. */
+FR_INLINE unsigned leaf_box_rays(frusta *F, const fr_bvh2_node *n, int k, int f, vpf tcur, unsigned rays) {
+  if (!((F->rd_ready >> f) & 1)) {
+    const fr_mft_set *S = F->set[f];
+    const float *dl[3] = {S->dx, S->dy, S->dz};
+    vpf tiny = vp(TINY);
+    for (int a = 0; a < 3; a++) {
+      vpf d = vp_add(vp(F->s[a][f]), vp_load(dl[a]));
+      d = vp_select(vp_lt(vp_abs(d), tiny), vp_copysign(tiny, d), d);
+      vp_store(F->rd[f][a], vp_div(vp(1.0f), d));
+    }
+    F->rd_ready |= 1u << f;
+  }
+  const float *lo[3] = {n->lo_x, n->lo_y, n->lo_z}, *hi[3] = {n->hi_x, n->hi_y, n->hi_z};
+  vpf tn = vp(F->tnear[f]), tf = tcur;
+  for (int a = 0; a < 3; a++) {
+    vpf rd = vp_load(F->rd[f][a]);
+    vpf t0 = vp_mul(vp(lo[a][k] - F->o[a][f]), rd), t1 = vp_mul(vp(hi[a][k] - F->o[a][f]), rd);
+    tn = vp_max(tn, vp_min(t0, t1));
+    tf = vp_min(tf, vp_max(t0, t1));
+  }
+  return rays & vpm_bits(vp_le(tn, vp_mul(tf, vp(ROUND_UP))));
+}
+
+/* a subtree and the frusta that enter it; leaves keep their box's node and slot */
+typedef struct entry { uint32_t ref; unsigned mask; const fr_bvh2_node *parent; int slot; } entry;
 
 /* Both children of a node; pushes the farther, returns the nearer in *next. */
 FR_INLINE int visit_node(const frusta *F, const fr_bvh2 *b, uint32_t ref, unsigned m, entry *stack, int *sp,
@@ -271,13 +313,13 @@ FR_INLINE int visit_node(const frusta *F, const fr_bvh2 *b, uint32_t ref, unsign
     /* nearer first: the child more of the frusta in both enter first */
     unsigned both = h0 & h1;
     int first0 = __builtin_popcount(both & vpm_bits(vp_le(tn0, tn1))) * 2 >= __builtin_popcount(both);
-    entry e0 = {n->child[0], h0}, e1 = {n->child[1], h1};
+    entry e0 = {n->child[0], h0, n, 0}, e1 = {n->child[1], h1, n, 1};
     stack[(*sp)++] = first0 ? e1 : e0;
     *next = first0 ? e0 : e1;
     return 1;
   }
   if (h0 | h1) {
-    *next = (entry){n->child[h0 ? 0 : 1], h0 | h1};
+    *next = (entry){n->child[h0 ? 0 : 1], h0 | h1, n, h0 ? 0 : 1};
     return 1;
   }
   return 0;
@@ -298,7 +340,7 @@ static void occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_
   unsigned alive = valid;
   entry stack[STACK];
   int sp = 0;
-  stack[sp++] = (entry){b->root, valid};
+  stack[sp++] = (entry){b->root, valid, NULL, 0};
   while (sp && alive) {
     entry e = stack[--sp];
     e.mask &= alive;
@@ -308,7 +350,12 @@ static void occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_
         continue;
       }
       uint32_t first = e.ref & FR_BVH2_FIRST_MASK, count = (e.ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
-      unsigned m = e.mask & alive;
+      unsigned m = e.mask & alive, rays[16];
+      for (unsigned g = m; g; g &= g - 1) {
+        int f = __builtin_ctz(g);
+        rays[f] = e.parent ? leaf_box_rays(&F, e.parent, e.slot, f, vp(F.tfar[f]), active[f]) : active[f];
+        if (!rays[f]) m &= ~(1u << f);
+      }
       for (uint32_t i = first; i < first + count && m; i++) {
         const fr_bvh2_tri *r = &b->tris[i];
         FR_COUNT(mft_tris, 1);
@@ -317,10 +364,12 @@ static void occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_
         FR_COUNT(mft_tri_left, __builtin_popcount(left));
         for (; left; left &= left - 1) {
           int f = __builtin_ctz(left);
-          unsigned hit = ray_test(&F, &X, r, f, vp(F.tfar[f]), active[f], NULL, NULL, NULL);
+          unsigned hit = ray_test(&F, &X, r, f, vp(F.tfar[f]), rays[f] & active[f], NULL, NULL, NULL);
           if (!hit) continue;
           occ[f] |= (uint16_t)hit;
           active[f] &= ~hit;
+          rays[f] &= ~hit;
+          if (!rays[f]) m &= ~(1u << f);
           if (!active[f]) {
             alive &= ~(1u << f);
             m &= ~(1u << f);
@@ -353,7 +402,7 @@ static void intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft
     for (int k = 0; k < 16; k++) H->t[f][k] = (valid >> f) & 1 ? B->tfar[f] : INFINITY;
   entry stack[STACK];
   int sp = 0;
-  stack[sp++] = (entry){b->root, valid};
+  stack[sp++] = (entry){b->root, valid, NULL, 0};
   while (sp) {
     entry e = stack[--sp];
     while (e.mask) {
@@ -362,17 +411,22 @@ static void intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft
         continue;
       }
       uint32_t first = e.ref & FR_BVH2_FIRST_MASK, count = (e.ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
-      unsigned changed = 0;
-      for (uint32_t i = first; i < first + count; i++) {
+      unsigned changed = 0, m = e.mask, rays[16];
+      for (unsigned g = m; g; g &= g - 1) {
+        int f = __builtin_ctz(g);
+        rays[f] = e.parent ? leaf_box_rays(&F, e.parent, e.slot, f, vp_load(H->t[f]), 0xFFFFu) : 0xFFFFu;
+        if (!rays[f]) m &= ~(1u << f);
+      }
+      for (uint32_t i = first; i < first + count && m; i++) {
         const fr_bvh2_tri *r = &b->tris[i];
         FR_COUNT(mft_tris, 1);
-        FR_COUNT(mft_tri_frusta, __builtin_popcount(e.mask));
-        unsigned left = tri_cull(&F, r, e.mask, opt->corner_rays, &X);
+        FR_COUNT(mft_tri_frusta, __builtin_popcount(m));
+        unsigned left = tri_cull(&F, r, m, opt->corner_rays, &X);
         FR_COUNT(mft_tri_left, __builtin_popcount(left));
         for (; left; left &= left - 1) {
           int f = __builtin_ctz(left);
           vpf tb = vp_load(H->t[f]), t, u, v;
-          unsigned hit = ray_test(&F, &X, r, f, tb, 0xFFFFu, &t, &u, &v);
+          unsigned hit = ray_test(&F, &X, r, f, tb, rays[f], &t, &u, &v);
           if (!hit) continue;
           vpm hm = vpm_bits_to(hit);
           vp_store(H->t[f], vp_select(hm, t, tb));

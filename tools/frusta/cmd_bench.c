@@ -91,16 +91,22 @@ int cmd_bench(int argc, char **argv) {
   fr_trace_options_default(&topt);
   fr_mft_opts mopt = {1, 1};
   int mft_leaf = FR_BUILD_MAX_LEAF;
+  fr_light_sets light_sets = FR_LIGHT_SETS_SPREAD;
   for (int i = 0; i < argc; i++) {
     int r = cli_view_flag(argc, argv, &i, &v);
     if (r < 0) return CLI_USAGE_ERROR;
     if (r > 0) continue;
     const char *a = argv[i];
     if (!strcmp(a, "--threshold") || !strcmp(a, "--mailbox") || !strcmp(a, "--axis-aligned") || !strcmp(a, "--ia") ||
-        !strcmp(a, "--packet-width") || !strcmp(a, "--corner-rays") || !strcmp(a, "--shrink") || !strcmp(a, "--mft-leaf")) {
+        !strcmp(a, "--packet-width") || !strcmp(a, "--corner-rays") || !strcmp(a, "--shrink") || !strcmp(a, "--mft-leaf") ||
+        !strcmp(a, "--light-sets")) {
       if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
       const char *val = argv[++i];
-      if (!strcmp(a, "--corner-rays") || !strcmp(a, "--shrink")) {
+      if (!strcmp(a, "--light-sets")) {
+        if (!strcmp(val, "spread")) light_sets = FR_LIGHT_SETS_SPREAD;
+        else if (!strcmp(val, "cells")) light_sets = FR_LIGHT_SETS_CELLS;
+        else return cli_error(CLI_USAGE_ERROR, "--light-sets is spread or cells, not '%s'", val);
+      } else if (!strcmp(a, "--corner-rays") || !strcmp(a, "--shrink")) {
         if (parse_onoff(a, val, !strcmp(a, "--shrink") ? &mopt.shrink : &mopt.corner_rays)) return CLI_USAGE_ERROR;
       } else if (!strcmp(a, "--mft-leaf")) {
         if (!cli_parse_int(val, 1, FR_BVH2_MAX_LEAF, &mft_leaf))
@@ -154,6 +160,7 @@ int cmd_bench(int argc, char **argv) {
   int rc = cli_workload_setup(scene, &v, threads, &s, &w);
   if (rc) return rc;
   w.seed = 7;
+  w.light_sets_kind = light_sets;
   size_t tris = fr_scene_triangle_count(s);
   fr_bvh_stats st;
   fr_scene_stats(s, &st);
