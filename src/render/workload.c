@@ -260,6 +260,19 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
     break;
   }
 
+  if (w->gbuf_vis) {
+    for (int i = 0; i < n; i++) {
+      size_t px = (size_t)B->py[i] * (size_t)W + (size_t)B->px[i];
+      const fr_hit *h = &B->prim_hit[i];
+      vec3 nn = v3(0, 0, 0);
+      if (h->prim != FR_INVALID_ID) nn = facing_normal(w->scene, h, v3_load(B->prim_ray[i].dir));
+      w->gbuf_vis[px] = h->prim == FR_INVALID_ID ? 0.0f : lit[i];
+      w->gbuf_depth[px] = h->prim == FR_INVALID_ID ? INFINITY : h->t;
+      w->gbuf_normal[3 * px] = nn.x; w->gbuf_normal[3 * px + 1] = nn.y; w->gbuf_normal[3 * px + 2] = nn.z;
+      vec3 al = h->prim == FR_INVALID_ID ? v3(0, 0, 0) : albedo(w->scene, h->prim);
+      w->gbuf_albedo[3 * px] = al.x; w->gbuf_albedo[3 * px + 1] = al.y; w->gbuf_albedo[3 * px + 2] = al.z;
+    }
+  }
   if (w->image) {
     for (int i = 0; i < n; i++) {
       float *px = w->image + 3 * ((size_t)B->py[i] * (size_t)W + (size_t)B->px[i]);

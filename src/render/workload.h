@@ -49,6 +49,9 @@ typedef struct fr_workload {
   float *image;            /* width*height*3, or NULL */
   int progress;            /* print progress to stderr */
   fr_light_sets light_sets_kind; /* soft16: how the 256 samples of a 4x4 block are dealt to its pixels */
+  /* optional per-pixel outputs (soft16): light visibility, primary hit
+   * distance (+inf on a miss) and unit normal facing the camera */
+  float *gbuf_vis, *gbuf_depth, *gbuf_normal, *gbuf_albedo;
   /* set by fr_workload_run for its tiles */
   const fr_mft_sets *light_sets;  /* this frame's interleaved samples on the quad light */
   const fr_mft_sets *camera_set;  /* the 4x4 pixels of a block */
