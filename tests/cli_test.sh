@@ -110,5 +110,21 @@ done
 grep -qw avx512f /proc/cpuinfo || expect 1 env FRUSTA_ISA=avx512 "$F" stats --builtin
 expect 1 env FRUSTA_ISA=sse9 "$F" stats --builtin
 
+# multi-frusta: soft shadows render (filtered, against a reference), bench
+# runs, bad values are usage errors
+expect 0 "$F" render --builtin --size 48x32 --shade softshadow --out "$T/soft.png" --reference-out "$T/ref.png"
+[ -s "$T/soft.png" ] && [ -s "$T/ref.png" ] && ok || bad "softshadow images"
+grep -q '^mae_visibility=0\.' "$T/out" && ok || bad "softshadow mae line"
+expect 0 "$F" render --builtin --size 32x32 --shade softshadow --filter off --light-sets spread --light-samples 32 --out "$T/s2.pfm"
+expect 2 "$F" render --builtin --shade softshadow --light-samples 20 --out "$T/s3.png"
+expect 2 "$F" render --builtin --shade softshadow --filter maybe --out "$T/s3.png"
+expect 2 "$F" render --builtin --shade softshadow --light-sets grid --out "$T/s3.png"
+expect 2 "$F" render --builtin --shade softshadow --reference-out "$T/r.bmp" --out "$T/s3.png"
+[ ! -e "$T/s3.png" ] && ok || bad "a refused render left an output file"
+expect 0 "$F" bench --builtin --size 32x32 --workload soft16 --mode mft --repeat 1 --mft-leaf 8 --shrink off --light-sets cells
+grep -q 'mode=mft' "$T/out" && ok || bad "bench mft line"
+expect 2 "$F" bench --builtin --workload soft16 --mode mft --mft-leaf 16
+expect 2 "$F" bench --builtin --workload soft16 --mode mft --corner-rays sometimes
+
 echo "cli: $passes passed, $fails failed"
 [ "$fails" -eq 0 ]

@@ -10,8 +10,11 @@
  * answer; every disagreement must be such a ray (brute force in double
  * precision), or lie within 1e-4 of tnear/tfar (rayfile.md's rule).
  */
+#include <dirent.h>
+#include <stdio.h>
 #include <string.h>
 #include "api/scene.h"
+#include "render/views.h"
 #include "random_scene.h"
 #include "render/mft_rays.h"
 #include "test_util.h"
@@ -64,7 +67,31 @@ static void make_shadow_batch(fr_rng *r, const mesh_ref *m, vec3 lc, float eps, 
 
 typedef struct tally { long rays, disagree, excused; } tally;
 
-static void check_shadows(const fr_scene *s, const fr_mft_batch *b, const fr_mft_sets *T, tally *tl) {
+/* The same rays as 16 packets of 16 (one per frustum), traced as pure packets. */
+static void packet16_occluded(fr_scene *s, const fr_mft_batch *b, const fr_mft_sets *T, uint16_t occ[16]) {
+  fr_trace_options o, saved;
+  fr_scene_get_trace_options(s, &saved);
+  o = saved;
+  o.mode = FR_TRACE_PACKET16;
+  fr_scene_set_trace_options(s, &o);
+  for (int f = 0; f < 16; f++) {
+    occ[f] = 0;
+    if (!((b->valid >> f) & 1)) continue;
+    fr_ray16 p;
+    for (int k = 0; k < 16; k++) {
+      float org[3], dir[3];
+      fr_mft_ray(b, T, f, k, org, dir);
+      p.org_x[k] = org[0]; p.org_y[k] = org[1]; p.org_z[k] = org[2];
+      p.dir_x[k] = dir[0]; p.dir_y[k] = dir[1]; p.dir_z[k] = dir[2];
+      p.tnear[k] = b->tnear[f]; p.tfar[k] = b->tfar[f];
+    }
+    occ[f] = (uint16_t)fr_occluded16(s, 0xFFFFu, &p);
+  }
+  fr_scene_set_trace_options(s, &saved);
+}
+
+static void check_shadows_vs(const fr_scene *s, const fr_mft_batch *b, const fr_mft_sets *T, tally *tl,
+                             const uint16_t *packet_occ) {
   mesh_ref m = scene_mesh(s);
   uint16_t ref[16];
   int first = 1;
@@ -88,6 +115,14 @@ static void check_shadows(const fr_scene *s, const fr_mft_batch *b, const fr_mft
               r.tfar = b->tfar[f];
               int single = fr_occluded1(s, &r), mft = (occ[f] >> k) & 1;
               tl->rays++;
+              if (packet_occ && ((packet_occ[f] >> k) & 1) != mft && single == mft) {
+                tl->disagree++;
+                if (!ambiguous(&m, &r)) {
+                  print_error("frustum %d ray %d: mft %d packet16 %d\n", f, k, mft, !mft);
+                  fail();
+                }
+                tl->excused++;
+              }
               if (single != mft) {
                 tl->disagree++;
                 if (!ambiguous(&m, &r)) {
@@ -106,6 +141,10 @@ static void check_shadows(const fr_scene *s, const fr_mft_batch *b, const fr_mft
           assert_memory_equal(occ, ref, sizeof ref);
         }
       }
+}
+
+static void check_shadows(const fr_scene *s, const fr_mft_batch *b, const fr_mft_sets *T, tally *tl) {
+  check_shadows_vs(s, b, T, tl, NULL);
 }
 
 static void check_camera(const fr_scene *s, const fr_camera *cam, int x0, int y0, tally *tl) {
@@ -284,6 +323,89 @@ static void fine_far_sphere(void **state) {
   free_scene(&sd);
 }
 
+/* Every scene of ../shared/scenes from its own view at 64x64: camera frusta
+ * against the single-ray kernel, and soft-shadow frusta to its quad light
+ * (both ways of dealing out samples) against the single-ray kernel and
+ * against 16-wide packets on the same rays. */
+static void check_shared_scene(const char *path, tally *tl) {
+  fr_scene *s;
+  if (fr_scene_load(path, &s) != FR_OK) fail_msg("%s: %s", path, fr_last_error());
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  fr_view v;
+  if (!fr_view_lookup(s->name, &v)) fail_msg("%s: no view", s->name);
+  enum { SZ = 64 };
+  fr_camera cam;
+  assert_int_equal(fr_camera_setup(&cam, v.eye, v.at, v.up, v.fov, SZ, SZ), FR_OK);
+  for (int y = 0; y < SZ; y += 16)
+    for (int x = 0; x < SZ; x += 16) check_camera(s, &cam, x, y, tl);
+  float lo[3], hi[3];
+  fr_scene_bounds(s, lo, hi);
+  float eps = 1e-4f * v3_len(v3_sub(v3_load(hi), v3_load(lo)));
+  float e1[3] = {v.area_e1.x, v.area_e1.y, v.area_e1.z}, e2[3] = {v.area_e2.x, v.area_e2.y, v.area_e2.z};
+  vec3 centre = v3_add(v.area_c, v3_scale(v3_add(v.area_e1, v.area_e2), 0.5f));
+  for (int kind = 0; kind < 2; kind++) {
+    fr_mft_sets T;
+    fr_mft_sets_light(&T, e1, e2, 3, kind ? FR_LIGHT_SETS_CELLS : FR_LIGHT_SETS_SPREAD);
+    for (int by = kind * 2; by < SZ; by += 8)
+      for (int bx = 0; bx < SZ; bx += 4) {
+        fr_mft_batch b;
+        memset(&b, 0, sizeof b);
+        for (int f = 0; f < 16; f++) {
+          int x = bx + (f & 3), y = by + (f >> 2);
+          fr_ray r = fr_camera_ray(&cam, x, y);
+          fr_hit h;
+          fr_intersect1(s, &r, &h);
+          if (h.prim == FR_INVALID_ID) continue;
+          vec3 p = v3_add(v3_load(r.org), v3_scale(v3_load(r.dir), h.t)), st = v3_sub(v.area_c, p);
+          b.org[0][f] = p.x; b.org[1][f] = p.y; b.org[2][f] = p.z;
+          b.start[0][f] = st.x; b.start[1][f] = st.y; b.start[2][f] = st.z;
+          b.tnear[f] = eps / v3_len(v3_sub(centre, p));
+          b.tfar[f] = 1.0f - 1e-4f;
+          b.set[f] = (uint8_t)fr_mft_light_set(x, y);
+          b.valid |= 1u << f;
+        }
+        uint16_t pk[16];
+        packet16_occluded(s, &b, &T, pk);
+        check_shadows_vs(s, &b, &T, tl, pk);
+      }
+  }
+  fr_scene_release(s);
+}
+
+static void shared_scenes(void **state) {
+  (void)state;
+  const char *root = getenv("FRUSTA_SHARED");
+  char dir[1024];
+  snprintf(dir, sizeof dir, "%s/scenes", root ? root : "../shared");
+  DIR *d = opendir(dir);
+  if (!d) fail_msg("cannot open %s: the shared scenes must sit beside the repository", dir);
+  struct dirent *ent;
+  int checked = 0;
+  tally tl = {0};
+  while ((ent = readdir(d))) {
+    if (ent->d_name[0] == '.') continue;
+    char sub[1400];
+    snprintf(sub, sizeof sub, "%s/%s", dir, ent->d_name);
+    DIR *sd = opendir(sub);
+    if (!sd) continue;
+    struct dirent *f;
+    while ((f = readdir(sd)))
+      if (strstr(f->d_name, ".ply.zst")) {
+        char path[2000];
+        snprintf(path, sizeof path, "%s/%s", sub, f->d_name);
+        long before = tl.disagree;
+        check_shared_scene(path, &tl);
+        print_message("%s: %ld disagreements so far (+%ld)\n", f->d_name, tl.disagree, tl.disagree - before);
+        checked++;
+      }
+    closedir(sd);
+  }
+  closedir(d);
+  print_message("shared scenes: %ld rays, %ld disagreements (all at edges or range ends)\n", tl.rays, tl.disagree);
+  assert_true(checked >= 14);
+  assert_true(tl.disagree * 1000 < tl.rays);
+}
+
 /* The sample sets: each a (0,4,2)-net (one sample per 4x4 stratum and per
  * 1/16 row and column), the 16 together one per 16x16 stratum. */
 static void light_sets_are_nets(void **state) {
@@ -337,6 +459,7 @@ int main(void) {
       cmocka_unit_test(random_scenes),
       cmocka_unit_test(builtin_scene),
       cmocka_unit_test(fine_far_sphere),
+      cmocka_unit_test(shared_scenes),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
