@@ -228,6 +228,27 @@ static void random_scenes(void **state) {
   assert_true(tl.disagree * 1000 < tl.rays);
 }
 
+/* Shadow frusta for the 4x4 pixels at (bx, by): from each primary hit to the
+ * quad light at corner lc, as the workload engine makes them. */
+static void camera_shadow_batch(const fr_scene *s, const fr_camera *cam, int bx, int by, vec3 lc, vec3 centre,
+                                float eps, fr_mft_batch *b) {
+  memset(b, 0, sizeof *b);
+  for (int f = 0; f < 16; f++) {
+    int x = bx + (f & 3), y = by + (f >> 2);
+    fr_ray r = fr_camera_ray(cam, x, y);
+    fr_hit h;
+    fr_intersect1(s, &r, &h);
+    if (h.prim == FR_INVALID_ID) continue;
+    vec3 p = v3_add(v3_load(r.org), v3_scale(v3_load(r.dir), h.t)), st = v3_sub(lc, p);
+    b->org[0][f] = p.x; b->org[1][f] = p.y; b->org[2][f] = p.z;
+    b->start[0][f] = st.x; b->start[1][f] = st.y; b->start[2][f] = st.z;
+    b->tnear[f] = eps / v3_len(v3_sub(centre, p));
+    b->tfar[f] = 1.0f - 1e-4f;
+    b->set[f] = (uint8_t)fr_mft_light_set(x, y);
+    b->valid |= 1u << f;
+  }
+}
+
 /* The built-in scene: closed boxes and spheres on a floor, axis-aligned faces,
  * the shadows of its quad light seen from its view. */
 static void builtin_scene(void **state) {
@@ -249,24 +270,11 @@ static void builtin_scene(void **state) {
   float e1[3] = {0.2f * ext.x, 0, 0}, e2[3] = {0, 0, 0.2f * ext.z};
   fr_mft_sets_light(&T, e1, e2, 5, FR_LIGHT_SETS_SPREAD);
   vec3 lc = v3_add(c, v3(-0.1f * ext.x, 0.8f * ext.y, -0.1f * ext.z));
+  vec3 centre = v3_add(lc, v3(0.1f * ext.x, 0, 0.1f * ext.z));
   for (int by = 0; by < 96; by += 4)
     for (int bx = 0; bx < 96; bx += 24) {
       fr_mft_batch b;
-      memset(&b, 0, sizeof b);
-      for (int f = 0; f < 16; f++) {
-        int x = bx + (f & 3), y = by + (f >> 2);
-        fr_ray r = fr_camera_ray(&cam, x, y);
-        fr_hit h;
-        fr_intersect1(s, &r, &h);
-        if (h.prim == FR_INVALID_ID) continue;
-        vec3 p = v3_add(v3_load(r.org), v3_scale(v3_load(r.dir), h.t)), st = v3_sub(lc, p);
-        b.org[0][f] = p.x; b.org[1][f] = p.y; b.org[2][f] = p.z;
-        b.start[0][f] = st.x; b.start[1][f] = st.y; b.start[2][f] = st.z;
-        b.tnear[f] = 1e-4f * v3_len(ext) / v3_len(st);
-        b.tfar[f] = 1.0f - 1e-4f;
-        b.set[f] = (uint8_t)fr_mft_light_set(x, y);
-        b.valid |= 1u << f;
-      }
+      camera_shadow_batch(s, &cam, bx, by, lc, centre, 1e-4f * v3_len(ext), &b);
       check_shadows(s, &b, &T, &tl);
     }
   print_message("built-in scene: %ld rays, %ld disagreements (all at edges or range ends)\n", tl.rays, tl.disagree);
@@ -349,21 +357,7 @@ static void check_shared_scene(const char *path, tally *tl) {
     for (int by = kind * 2; by < SZ; by += 8)
       for (int bx = 0; bx < SZ; bx += 4) {
         fr_mft_batch b;
-        memset(&b, 0, sizeof b);
-        for (int f = 0; f < 16; f++) {
-          int x = bx + (f & 3), y = by + (f >> 2);
-          fr_ray r = fr_camera_ray(&cam, x, y);
-          fr_hit h;
-          fr_intersect1(s, &r, &h);
-          if (h.prim == FR_INVALID_ID) continue;
-          vec3 p = v3_add(v3_load(r.org), v3_scale(v3_load(r.dir), h.t)), st = v3_sub(v.area_c, p);
-          b.org[0][f] = p.x; b.org[1][f] = p.y; b.org[2][f] = p.z;
-          b.start[0][f] = st.x; b.start[1][f] = st.y; b.start[2][f] = st.z;
-          b.tnear[f] = eps / v3_len(v3_sub(centre, p));
-          b.tfar[f] = 1.0f - 1e-4f;
-          b.set[f] = (uint8_t)fr_mft_light_set(x, y);
-          b.valid |= 1u << f;
-        }
+        camera_shadow_batch(s, &cam, bx, by, v.area_c, centre, eps, &b);
         uint16_t pk[16];
         packet16_occluded(s, &b, &T, pk);
         check_shadows_vs(s, &b, &T, tl, pk);
