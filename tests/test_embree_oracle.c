@@ -3,7 +3,6 @@
  * every scene of ../shared/scenes, by the rule of rayfile.md: camera rays,
  * shadow rays from their hits, hemisphere rays, and random rays, at every ISA.
  */
-#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -163,35 +162,11 @@ static void check_scene(const char *path) {
 
 static void test_builtin(void **st) { (void)st; check_scene("--builtin"); }
 
+static void check_scene_path(const char *path, void *ctx) { (void)ctx; check_scene(path); }
+
 static void test_shared_scenes(void **st) {
   (void)st;
-  const char *root = getenv("FRUSTA_SHARED");
-  char dir[1024];
-  snprintf(dir, sizeof dir, "%s/scenes", root ? root : "../shared");
-  DIR *d = opendir(dir);
-  if (!d) fail_msg("cannot open %s: the shared scenes must sit beside the repository", dir);
-  int count = 0;
-  struct dirent *ent;
-  char names[64][256];
-  while ((ent = readdir(d)) && count < 64)
-    if (ent->d_name[0] != '.') snprintf(names[count++], 256, "%s", ent->d_name);
-  closedir(d);
-  int checked = 0;
-  for (int i = 0; i < count; i++) {
-    char sub[1400];
-    snprintf(sub, sizeof sub, "%s/%s", dir, names[i]);
-    DIR *sd = opendir(sub);
-    if (!sd) continue;
-    while ((ent = readdir(sd)))
-      if (strstr(ent->d_name, ".ply.zst")) {
-        char path[2000];
-        snprintf(path, sizeof path, "%s/%s", sub, ent->d_name);
-        check_scene(path);
-        checked++;
-      }
-    closedir(sd);
-  }
-  assert_true(checked >= 14);
+  assert_true(for_each_shared_scene(check_scene_path, NULL) >= 14);
 }
 
 int main(void) {

@@ -10,8 +10,6 @@
  * answer; every disagreement must be such a ray (brute force in double
  * precision), or lie within 1e-4 of tnear/tfar (rayfile.md's rule).
  */
-#include <dirent.h>
-#include <stdio.h>
 #include <string.h>
 #include "api/scene.h"
 #include "render/views.h"
@@ -366,35 +364,17 @@ static void check_shared_scene(const char *path, tally *tl) {
   fr_scene_release(s);
 }
 
+static void shared_scene_one(const char *path, void *ctx) {
+  tally *tl = ctx;
+  long before = tl->disagree;
+  check_shared_scene(path, tl);
+  print_message("%s: %ld disagreements so far (+%ld)\n", path, tl->disagree, tl->disagree - before);
+}
+
 static void shared_scenes(void **state) {
   (void)state;
-  const char *root = getenv("FRUSTA_SHARED");
-  char dir[1024];
-  snprintf(dir, sizeof dir, "%s/scenes", root ? root : "../shared");
-  DIR *d = opendir(dir);
-  if (!d) fail_msg("cannot open %s: the shared scenes must sit beside the repository", dir);
-  struct dirent *ent;
-  int checked = 0;
   tally tl = {0};
-  while ((ent = readdir(d))) {
-    if (ent->d_name[0] == '.') continue;
-    char sub[1400];
-    snprintf(sub, sizeof sub, "%s/%s", dir, ent->d_name);
-    DIR *sd = opendir(sub);
-    if (!sd) continue;
-    struct dirent *f;
-    while ((f = readdir(sd)))
-      if (strstr(f->d_name, ".ply.zst")) {
-        char path[2000];
-        snprintf(path, sizeof path, "%s/%s", sub, f->d_name);
-        long before = tl.disagree;
-        check_shared_scene(path, &tl);
-        print_message("%s: %ld disagreements so far (+%ld)\n", f->d_name, tl.disagree, tl.disagree - before);
-        checked++;
-      }
-    closedir(sd);
-  }
-  closedir(d);
+  int checked = for_each_shared_scene(shared_scene_one, &tl);
   print_message("shared scenes: %ld rays, %ld disagreements (all at edges or range ends)\n", tl.rays, tl.disagree);
   assert_true(checked >= 14);
   assert_true(tl.disagree * 1000 < tl.rays);

@@ -2,8 +2,12 @@
  * double-precision oracle. */
 #ifndef FR_TEST_UTIL_H
 #define FR_TEST_UTIL_H
+#include <dirent.h>
 #include <math.h>
 #include <setjmp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -53,6 +57,36 @@ static inline double brute_force(const float *pos, const uint32_t *idx, size_t n
   }
   return best;
 }
+/* Calls fn with the path of every .ply.zst of ../shared/scenes (or
+ * $FRUSTA_SHARED/scenes); returns how many. A missing folder fails the test. */
+static inline int for_each_shared_scene(void (*fn)(const char *path, void *ctx), void *ctx) {
+  const char *root = getenv("FRUSTA_SHARED");
+  char dir[1024];
+  snprintf(dir, sizeof dir, "%s/scenes", root ? root : "../shared");
+  DIR *d = opendir(dir);
+  if (!d) fail_msg("cannot open %s: the shared scenes must sit beside the repository", dir);
+  int count = 0;
+  struct dirent *ent;
+  while ((ent = readdir(d))) {
+    if (ent->d_name[0] == '.') continue;
+    char sub[1400];
+    snprintf(sub, sizeof sub, "%s/%s", dir, ent->d_name);
+    DIR *sd = opendir(sub);
+    if (!sd) continue;
+    struct dirent *f;
+    while ((f = readdir(sd)))
+      if (strstr(f->d_name, ".ply.zst")) {
+        char path[2000];
+        snprintf(path, sizeof path, "%s/%s", sub, f->d_name);
+        fn(path, ctx);
+        count++;
+      }
+    closedir(sd);
+  }
+  closedir(d);
+  return count;
+}
+
 /* Zero-area test on raw arrays, as the library's (double precision). */
 static inline int fr_mesh_degenerate_prim(const float *pos, const uint32_t *idx, uint32_t t) {
   const float *a = pos + 3 * (size_t)idx[3 * t], *b = pos + 3 * (size_t)idx[3 * t + 1], *c = pos + 3 * (size_t)idx[3 * t + 2];

@@ -161,6 +161,8 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
 static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, int tx, int ty) {
   const int W = w->cam.width, H = w->cam.height;
   int n = 0;
+  /* a full tile's camera rays come from the frusta tracer, made on demand */
+  const int frusta = t->intersect_frusta && tx + TILE <= W && ty + TILE <= H;
   /* pixels in 4x4 blocks, so groups of 16 rays are coherent */
   for (int by = 0; by < TILE; by += 4)
     for (int bx = 0; bx < TILE; bx += 4)
@@ -169,12 +171,14 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
           int X = tx + bx + x, Y = ty + by + y;
           if (X >= W || Y >= H) continue;
           B->px[n] = X; B->py[n] = Y;
-          B->prim_ray[n] = fr_camera_ray(&w->cam, X, Y);
-          B->rays[n] = B->prim_ray[n];
+          if (!frusta) {
+            B->prim_ray[n] = fr_camera_ray(&w->cam, X, Y);
+            B->rays[n] = B->prim_ray[n];
+          }
           n++;
         }
   uint64_t rays = (uint64_t)n;
-  if (t->intersect_frusta && n == TILE_PIX)
+  if (frusta)
     primary_frusta(w, t, B, w->camera_set, tx, ty);
   else
     t->intersect(t->ctx, B->rays, B->prim_hit, (size_t)n, 1);

@@ -300,6 +300,21 @@ FR_INLINE unsigned leaf_box_rays(frusta *F, const fr_bvh2_node *n, int k, int f,
 /* a subtree and the frusta that enter it; leaves keep their box's node and slot */
 typedef struct entry { uint32_t ref; unsigned mask; const fr_bvh2_node *parent; int slot; } entry;
 
+/* Entering leaf e: rays[f] gets the rays of frustum f (among base[f]) whose
+ * own box test reaches the leaf before tcur[f] (per ray; NULL: the frustum's
+ * tfar); returns the frusta of m left with any. */
+FR_INLINE unsigned leaf_rays(frusta *F, const entry *e, unsigned m, const unsigned *base, const float (*tcur)[16],
+                             unsigned rays[16]) {
+  for (unsigned g = m; g; g &= g - 1) {
+    int f = __builtin_ctz(g);
+    /* no parent: the root is a leaf, with no box to test */
+    rays[f] = e->parent ? leaf_box_rays(F, e->parent, e->slot, f, tcur ? vp_load(tcur[f]) : vp(F->tfar[f]), base[f])
+                        : base[f];
+    if (!rays[f]) m &= ~(1u << f);
+  }
+  return m;
+}
+
 /* Both children of a node; pushes the farther, returns the nearer in *next. */
 FR_INLINE int visit_node(const frusta *F, const fr_bvh2 *b, uint32_t ref, unsigned m, entry *stack, int *sp,
                          entry *next) {
@@ -350,12 +365,7 @@ static void occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_
         continue;
       }
       uint32_t first = e.ref & FR_BVH2_FIRST_MASK, count = (e.ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
-      unsigned m = e.mask & alive, rays[16];
-      for (unsigned g = m; g; g &= g - 1) {
-        int f = __builtin_ctz(g);
-        rays[f] = e.parent ? leaf_box_rays(&F, e.parent, e.slot, f, vp(F.tfar[f]), active[f]) : active[f];
-        if (!rays[f]) m &= ~(1u << f);
-      }
+      unsigned rays[16], m = leaf_rays(&F, &e, e.mask & alive, active, NULL, rays);
       for (uint32_t i = first; i < first + count && m; i++) {
         const fr_bvh2_tri *r = &b->tris[i];
         FR_COUNT(mft_tris, 1);
@@ -388,9 +398,10 @@ static void intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft
   frusta F;
   tri_frusta X;
   unsigned valid = B->valid & 0xFFFFu;
+  /* t starts at tfar: a hit must come nearer (reset to +inf for misses at the end) */
   for (int f = 0; f < 16; f++)
     for (int k = 0; k < 16; k++) {
-      H->t[f][k] = INFINITY;
+      H->t[f][k] = (valid >> f) & 1 ? B->tfar[f] : INFINITY;
       H->u[f][k] = H->v[f][k] = 0.0f;
       H->prim[f][k] = FR_INVALID_ID;
     }
@@ -398,8 +409,6 @@ static void intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft
   FR_COUNT(rays, 16 * __builtin_popcount(valid));
   if (!valid || !b->nodes) return;
   frusta_setup(&F, B, T, valid, 0);
-  for (int f = 0; f < 16; f++)
-    for (int k = 0; k < 16; k++) H->t[f][k] = (valid >> f) & 1 ? B->tfar[f] : INFINITY;
   entry stack[STACK];
   int sp = 0;
   stack[sp++] = (entry){b->root, valid, NULL, 0};
@@ -411,12 +420,9 @@ static void intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft
         continue;
       }
       uint32_t first = e.ref & FR_BVH2_FIRST_MASK, count = (e.ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
-      unsigned changed = 0, m = e.mask, rays[16];
-      for (unsigned g = m; g; g &= g - 1) {
-        int f = __builtin_ctz(g);
-        rays[f] = e.parent ? leaf_box_rays(&F, e.parent, e.slot, f, vp_load(H->t[f]), 0xFFFFu) : 0xFFFFu;
-        if (!rays[f]) m &= ~(1u << f);
-      }
+      static const unsigned all[16] = {0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu,
+                                       0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu};
+      unsigned changed = 0, rays[16], m = leaf_rays(&F, &e, e.mask, all, (const float(*)[16])H->t, rays);
       for (uint32_t i = first; i < first + count && m; i++) {
         const fr_bvh2_tri *r = &b->tris[i];
         FR_COUNT(mft_tris, 1);
