@@ -1,0 +1,327 @@
+#include "packet_bounds.h"
+#include <math.h>
+#include <string.h>
+
+/* Slack of every cull, relative to the coordinates' magnitude: the rays'
+ * own float tests round by about 2^-20 relative, so a box, triangle or
+ * sphere is grown by 1e-5 of its distance from the origin of the world
+ * (and of the packet's) before it may be culled. */
+#define SLACK 1e-5
+
+static const char *cull_names[FR_CULL_COUNT] = {"off", "ia", "planes", "corners"};
+
+const char *fr_cull_name(fr_cull c) { return c < FR_CULL_COUNT ? cull_names[c] : "?"; }
+
+int fr_cull_parse(const char *name, fr_cull *out) {
+  for (int i = 0; i < FR_CULL_COUNT; i++)
+    if (!strcmp(name, cull_names[i])) { *out = (fr_cull)i; return 1; }
+  return 0;
+}
+
+static double dmin(double a, double b) { return a < b ? a : b; }
+static double dmax(double a, double b) { return a > b ? a : b; }
+
+static int ray_valid(const fr_ray_soa *r, int i) {
+  return !r->mask || ((r->mask[i / 16] >> (i % 16)) & 1);
+}
+
+void fr_pbounds_build(fr_pbounds *b, const fr_ray_soa *r) {
+  memset(b, 0, sizeof *b);
+  double minfrac[3] = {INFINITY, INFINITY, INFINITY};
+  int count = 0;
+  for (int a = 0; a < 3; a++) {
+    b->olo[a] = b->dlo[a] = INFINITY;
+    b->ohi[a] = b->dhi[a] = -INFINITY;
+  }
+  b->tmin = INFINITY;
+  b->tmax = -INFINITY;
+  for (int i = 0; i < r->n; i++) {
+    if (!ray_valid(r, i)) continue;
+    double l1 = fabs((double)r->d[0][i]) + fabs((double)r->d[1][i]) + fabs((double)r->d[2][i]);
+    for (int a = 0; a < 3; a++) {
+      double o = r->o[a][i], d = r->d[a][i];
+      b->olo[a] = dmin(b->olo[a], o);
+      b->ohi[a] = dmax(b->ohi[a], o);
+      b->dlo[a] = dmin(b->dlo[a], d);
+      b->dhi[a] = dmax(b->dhi[a], d);
+      minfrac[a] = dmin(minfrac[a], l1 > 0.0 ? fabs(d) / l1 : 0.0);
+    }
+    b->tmin = dmin(b->tmin, r->tnear[i]);
+    b->tmax = dmax(b->tmax, r->tfar[i]);
+    count++;
+  }
+  if (!count) { b->empty = 1; return; }
+  int best = -1;
+  for (int a = 0; a < 3; a++) {
+    b->scale = dmax(b->scale, dmax(fabs(b->olo[a]), fabs(b->ohi[a])));
+    if (b->dlo[a] > 0.0 || b->dhi[a] < 0.0) {
+      b->uniform |= 1u << a;
+      /* 1/d is monotonic on an interval of one sign */
+      b->rlo[a] = 1.0 / b->dhi[a];
+      b->rhi[a] = 1.0 / b->dlo[a];
+      if (best < 0 || minfrac[a] > minfrac[best]) best = a;
+    }
+  }
+  if (best < 0) return;
+  /* bounding planes along the major axis: the axis whose directions stay
+   * farthest from 0 relative to their length, so the slopes stay small */
+  const int k = best, u = (k + 1) % 3, v = (k + 2) % 3;
+  b->has_planes = 1;
+  b->k = k; b->u = u; b->v = v;
+  b->sk = b->dlo[k] > 0.0 ? 1.0 : -1.0;
+  b->knear = INFINITY;
+  b->kfar = -INFINITY;
+  for (int i = 0; i < r->n; i++) {
+    if (!ray_valid(r, i)) continue;
+    double K = b->sk * r->o[k][i], dk = fabs((double)r->d[k][i]);
+    b->knear = dmin(b->knear, K + (double)r->tnear[i] * dk);
+    b->kfar = dmax(b->kfar, isinf(r->tfar[i]) ? INFINITY : K + (double)r->tfar[i] * dk);
+  }
+  b->ulo = b->vlo = b->sulo = b->svlo = INFINITY;
+  b->uhi = b->vhi = b->suhi = b->svhi = -INFINITY;
+  for (int i = 0; i < r->n; i++) {
+    if (!ray_valid(r, i)) continue;
+    double dk = fabs((double)r->d[k][i]), back = b->knear - b->sk * r->o[k][i];
+    double su = r->d[u][i] / dk, sv = r->d[v][i] / dk;
+    double pu = r->o[u][i] + back * su, pv = r->o[v][i] + back * sv;
+    b->ulo = dmin(b->ulo, pu); b->uhi = dmax(b->uhi, pu);
+    b->vlo = dmin(b->vlo, pv); b->vhi = dmax(b->vhi, pv);
+    b->sulo = dmin(b->sulo, su); b->suhi = dmax(b->suhi, su);
+    b->svlo = dmin(b->svlo, sv); b->svhi = dmax(b->svhi, sv);
+  }
+  b->scale = dmax(b->scale, fabs(b->knear));
+}
+
+/* ---- boxes ----------------------------------------------------------------- */
+
+static int cull_box_ia(const fr_pbounds *b, const double lo[3], const double hi[3]) {
+  double tn = b->tmin, tf = b->tmax;
+  for (int a = 0; a < 3; a++) {
+    if (!((b->uniform >> a) & 1)) continue; /* directions of both signs: no bound on this axis */
+    double nearp = b->dlo[a] > 0.0 ? lo[a] : hi[a], farp = b->dlo[a] > 0.0 ? hi[a] : lo[a];
+    /* (plane - o) / d over o and 1/d in their intervals: bilinear, extremes at the corners */
+    double n0 = nearp - b->olo[a], n1 = nearp - b->ohi[a], f0 = farp - b->olo[a], f1 = farp - b->ohi[a];
+    double enter = dmin(dmin(n0 * b->rlo[a], n0 * b->rhi[a]), dmin(n1 * b->rlo[a], n1 * b->rhi[a]));
+    double leave = dmax(dmax(f0 * b->rlo[a], f0 * b->rhi[a]), dmax(f1 * b->rlo[a], f1 * b->rhi[a]));
+    tn = dmax(tn, enter);
+    tf = dmin(tf, leave);
+  }
+  return tn > tf;
+}
+
+/* The box's K range clipped to the packet's [knear, kfar], as offsets from
+ * knear; 0 if they do not overlap. */
+static int clip_k(const fr_pbounds *b, const double lo[3], const double hi[3], double *da, double *db) {
+  double Klo = b->sk > 0.0 ? lo[b->k] : -hi[b->k], Khi = b->sk > 0.0 ? hi[b->k] : -lo[b->k];
+  double Ka = dmax(Klo, b->knear), Kb = dmin(Khi, b->kfar);
+  if (Ka > Kb) return 0;
+  *da = Ka - b->knear;
+  *db = Kb - b->knear;
+  return 1;
+}
+
+/* max / min of s x over x in [xa, xb], xb possibly +inf, xa finite */
+static double span_max(double s, double xa, double xb) { return s > 0.0 ? s * xb : s < 0.0 ? s * xa : 0.0; }
+static double span_min(double s, double xa, double xb) { return s > 0.0 ? s * xa : s < 0.0 ? s * xb : 0.0; }
+
+static int cull_box_planes(const fr_pbounds *b, const double lo[3], const double hi[3]) {
+  double da, db;
+  if (!clip_k(b, lo, hi, &da, &db)) return 1;
+  const int u = b->u, v = b->v;
+  return lo[u] > b->uhi + span_max(b->suhi, da, db) || hi[u] < b->ulo + span_min(b->sulo, da, db) ||
+         lo[v] > b->vhi + span_max(b->svhi, da, db) || hi[v] < b->vlo + span_min(b->svlo, da, db);
+}
+
+/* s x <= c narrows [*xa, *xb]; 0 when nothing is left */
+static int narrow(double s, double c, double *xa, double *xb) {
+  if (s > 0.0) *xb = dmin(*xb, c / s);
+  else if (s < 0.0) *xa = dmax(*xa, c / s);
+  else if (c < 0.0) return 0;
+  return *xa <= *xb;
+}
+
+/* The packet's cross section at K is the rectangle between the corner rays;
+ * it meets the box's (constant) cross section for K in an interval, found
+ * edge by edge: the exact test of the packet volume against the box. */
+static int cull_box_corners(const fr_pbounds *b, const double lo[3], const double hi[3]) {
+  double da, db;
+  if (!clip_k(b, lo, hi, &da, &db)) return 1;
+  const int u = b->u, v = b->v;
+  return !(narrow(b->sulo, hi[u] - b->ulo, &da, &db) && narrow(-b->suhi, b->uhi - lo[u], &da, &db) &&
+           narrow(b->svlo, hi[v] - b->vlo, &da, &db) && narrow(-b->svhi, b->vhi - lo[v], &da, &db));
+}
+
+static int cull_box_d(const fr_pbounds *b, fr_cull c, double lo[3], double hi[3]) {
+  if (b->empty) return 1;
+  double mag = 0.0;
+  for (int a = 0; a < 3; a++) mag = dmax(mag, dmax(fabs(lo[a]), fabs(hi[a])));
+  double tol = SLACK * (b->scale + mag);
+  for (int a = 0; a < 3; a++) { lo[a] -= tol; hi[a] += tol; }
+  switch (c) {
+  case FR_CULL_IA: return cull_box_ia(b, lo, hi);
+  case FR_CULL_PLANES: return b->has_planes ? cull_box_planes(b, lo, hi) : cull_box_ia(b, lo, hi);
+  case FR_CULL_CORNERS: return b->has_planes ? cull_box_corners(b, lo, hi) : cull_box_ia(b, lo, hi);
+  default: return 0;
+  }
+}
+
+int fr_pbounds_cull_box(const fr_pbounds *b, fr_cull c, const float lo[3], const float hi[3]) {
+  double l[3] = {lo[0], lo[1], lo[2]}, h[3] = {hi[0], hi[1], hi[2]};
+  return cull_box_d(b, c, l, h);
+}
+
+/* ---- triangles -------------------------------------------------------------- */
+
+typedef struct kuv { double K, u, v; } kuv;
+
+static kuv to_kuv(const fr_pbounds *b, const double p[3]) {
+  kuv r = {b->sk * p[b->k], p[b->u], p[b->v]};
+  return r;
+}
+
+static void from_kuv(const fr_pbounds *b, double K, double u, double v, double p[3]) {
+  p[b->k] = b->sk * K;
+  p[b->u] = u;
+  p[b->v] = v;
+}
+
+/* all points outside one of the six planes of the packet volume */
+static int points_outside_planes(const fr_pbounds *b, const kuv *p, int n, double tol) {
+  int out[6] = {1, 1, 1, 1, 1, 1};
+  for (int i = 0; i < n; i++) {
+    double dK = p[i].K - b->knear;
+    out[0] &= dK < -tol;
+    out[1] &= p[i].K > b->kfar + tol;
+    out[2] &= p[i].u > b->uhi + b->suhi * dK + tol;
+    out[3] &= p[i].u < b->ulo + b->sulo * dK - tol;
+    out[4] &= p[i].v > b->vhi + b->svhi * dK + tol;
+    out[5] &= p[i].v < b->vlo + b->svlo * dK - tol;
+  }
+  return out[0] | out[1] | out[2] | out[3] | out[4] | out[5];
+}
+
+static double dot3d(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static void cross3d(const double a[3], const double b[3], double r[3]) {
+  r[0] = a[1] * b[2] - a[2] * b[1];
+  r[1] = a[2] * b[0] - a[0] * b[2];
+  r[2] = a[0] * b[1] - a[1] * b[0];
+}
+static double norm1(const double a[3]) { return fabs(a[0]) + fabs(a[1]) + fabs(a[2]); }
+
+/* The packet volume entirely on one side of the triangle's plane: its
+ * corners at knear and kfar, or, unbounded, its corners at knear and the
+ * corner rays' directions. */
+static int volume_off_plane(const fr_pbounds *b, const double v0[3], const double n[3], double tol) {
+  const double us[2] = {b->ulo, b->uhi}, vs[2] = {b->vlo, b->vhi};
+  const double su[2] = {b->sulo, b->suhi}, sv[2] = {b->svlo, b->svhi};
+  const int bounded = isfinite(b->kfar);
+  const double dk = bounded ? b->kfar - b->knear : 0.0;
+  int above = 1, below = 1;
+  for (int j = 0; j < 4; j++) {
+    int iu = j & 1, iv = j >> 1;
+    double p[3], q[3];
+    from_kuv(b, b->knear, us[iu], vs[iv], p);
+    for (int a = 0; a < 3; a++) p[a] -= v0[a];
+    double f = dot3d(n, p);
+    above &= f > tol;
+    below &= f < -tol;
+    if (bounded) {
+      from_kuv(b, b->kfar, us[iu] + su[iu] * dk, vs[iv] + sv[iv] * dk, q);
+      for (int a = 0; a < 3; a++) q[a] -= v0[a];
+      f = dot3d(n, q);
+      above &= f > tol;
+      below &= f < -tol;
+    } else {
+      from_kuv(b, 1.0, su[iu], sv[iv], q);
+      f = dot3d(n, q);
+      above &= f >= 0.0;
+      below &= f <= 0.0;
+    }
+  }
+  return above | below;
+}
+
+/* Every ray's line passes outside one edge. The lines go through a point A
+ * of the packet's rectangle at knear and a point B of its rectangle at a
+ * later K1; an edge's Pluecker side D . ((P - A) x (Q - A)), D = B - A, is
+ * linear in each coordinate of A and of B, so its extremes are at the 16
+ * lines through the rectangles' corners (4 when the origins are shared).
+ * A line meets the triangle only if every side has the sign of D . n. */
+static int lines_outside_edge(const fr_pbounds *b, const double V[3][3], const double n[3]) {
+  const double K1 = b->knear + dmax(b->scale, 1e-6);
+  const double us[2] = {b->ulo, b->uhi}, vs[2] = {b->vlo, b->vhi};
+  const double su[2] = {b->sulo, b->suhi}, sv[2] = {b->svlo, b->svhi};
+  double side_max[3] = {-INFINITY, -INFINITY, -INFINITY};
+  int dn_sign = 0;
+  for (int j = 0; j < 16; j++) {
+    int au = j & 1, av = (j >> 1) & 1, bu = (j >> 2) & 1, bv = (j >> 3) & 1;
+    double A[3], B[3], D[3];
+    from_kuv(b, b->knear, us[au], vs[av], A);
+    double dk = K1 - b->knear;
+    from_kuv(b, K1, us[bu] + su[bu] * dk, vs[bv] + sv[bv] * dk, B);
+    for (int a = 0; a < 3; a++) D[a] = B[a] - A[a];
+    double dn = dot3d(D, n);
+    int s = dn > 0.0 ? 1 : dn < 0.0 ? -1 : 0;
+    if (s == 0 || (dn_sign && s != dn_sign)) return 0;
+    dn_sign = s;
+    for (int i = 0; i < 3; i++) {
+      const double *P = V[i], *Q = V[(i + 1) % 3];
+      double pa[3], qa[3], c[3];
+      for (int a = 0; a < 3; a++) { pa[a] = P[a] - A[a]; qa[a] = Q[a] - A[a]; }
+      cross3d(pa, qa, c);
+      double side = s * dot3d(D, c);
+      double guard = SLACK * norm1(D) * norm1(pa) * norm1(qa);
+      side_max[i] = dmax(side_max[i], side + guard);
+    }
+  }
+  return side_max[0] < 0.0 || side_max[1] < 0.0 || side_max[2] < 0.0;
+}
+
+int fr_pbounds_cull_tri(const fr_pbounds *b, fr_cull c, const float v0[3], const float v1[3], const float v2[3]) {
+  if (b->empty) return 1;
+  if (c == FR_CULL_OFF) return 0;
+  double V[3][3], lo[3], hi[3], mag = 0.0;
+  const float *src[3] = {v0, v1, v2};
+  for (int i = 0; i < 3; i++)
+    for (int a = 0; a < 3; a++) V[i][a] = src[i][a];
+  for (int a = 0; a < 3; a++) {
+    lo[a] = dmin(V[0][a], dmin(V[1][a], V[2][a]));
+    hi[a] = dmax(V[0][a], dmax(V[1][a], V[2][a]));
+    mag = dmax(mag, dmax(fabs(lo[a]), fabs(hi[a])));
+  }
+  if (c == FR_CULL_IA || !b->has_planes) return cull_box_d(b, FR_CULL_IA, lo, hi);
+  double tol = SLACK * (b->scale + mag);
+  kuv p[3] = {to_kuv(b, V[0]), to_kuv(b, V[1]), to_kuv(b, V[2])};
+  if (points_outside_planes(b, p, 3, tol)) return 1;
+  if (c != FR_CULL_CORNERS) return 0;
+  double e1[3], e2[3], n[3];
+  for (int a = 0; a < 3; a++) { e1[a] = V[1][a] - V[0][a]; e2[a] = V[2][a] - V[0][a]; }
+  cross3d(e1, e2, n);
+  if (n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0) return 0; /* degenerate: never hit anyway, not our call */
+  if (volume_off_plane(b, V[0], n, tol * norm1(n))) return 1;
+  return lines_outside_edge(b, V, n);
+}
+
+/* ---- spheres ----------------------------------------------------------------- */
+
+int fr_pbounds_cull_sphere(const fr_pbounds *b, fr_cull c, const float centre[3], float radius) {
+  if (b->empty) return 1;
+  if (c == FR_CULL_OFF) return 0;
+  double C[3] = {centre[0], centre[1], centre[2]}, r = fabs((double)radius), lo[3], hi[3], mag = 0.0;
+  for (int a = 0; a < 3; a++) {
+    lo[a] = C[a] - r;
+    hi[a] = C[a] + r;
+    mag = dmax(mag, fabs(C[a]) + r);
+  }
+  if (c == FR_CULL_IA || !b->has_planes) return cull_box_d(b, FR_CULL_IA, lo, hi);
+  double tol = SLACK * (b->scale + mag);
+  kuv p = to_kuv(b, C);
+  double dK = p.K - b->knear;
+  if (dK < -r - tol || p.K > b->kfar + r + tol) return 1;
+  /* distance from the centre to each side plane, in the (K, u) or (K, v) plane */
+  double R = r + tol;
+  return p.u - b->uhi - b->suhi * dK > R * sqrt(1.0 + b->suhi * b->suhi) ||
+         b->ulo + b->sulo * dK - p.u > R * sqrt(1.0 + b->sulo * b->sulo) ||
+         p.v - b->vhi - b->svhi * dK > R * sqrt(1.0 + b->svhi * b->svhi) ||
+         b->vlo + b->svlo * dK - p.v > R * sqrt(1.0 + b->svlo * b->svlo);
+}
