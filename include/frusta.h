@@ -63,6 +63,7 @@ typedef struct fr_material {
   float transmission[3]; /* Tf, or 1-d */
   float ior;             /* Ni */
   float emission[3];     /* Ke */
+  int illum;             /* MTL illumination model (3: mirror reflection), 0 if not given */
 } fr_material;
 
 /* Loads a scene file: PLY and OBJ(+MTL) by frusta's own readers (triangle

@@ -21,29 +21,6 @@
 static const fr_mft_fns *isa_fns[] = {&fr_mft_scalar, &fr_mft_avx2, &fr_mft_avx512};
 static const fr_isa isas[] = {FR_ISA_SCALAR, FR_ISA_AVX2, FR_ISA_AVX512};
 
-typedef struct mesh_ref { const float *pos; const uint32_t *idx; size_t nt; } mesh_ref;
-
-static mesh_ref scene_mesh(const fr_scene *s) {
-  mesh_ref m = {fr_scene_vertices(s), fr_scene_indices(s), fr_scene_triangle_count(s)};
-  return m;
-}
-
-/* 1 if a disagreement on this ray is excusable: its nearest hit (in double
- * precision, over a range widened by the tolerance) is within rounding of an
- * edge, or within 1e-4 max(1, |t|) of tnear or tfar. */
-static int ambiguous(const mesh_ref *m, const fr_ray *r) {
-  uint32_t prim;
-  double margin;
-  fr_ray wide = *r;
-  wide.tnear = r->tnear - 1e-4f * fmaxf(1.0f, fabsf(r->tnear));
-  wide.tfar = r->tfar + 1e-4f * fmaxf(1.0f, fabsf(r->tfar));
-  double t = brute_force(m->pos, m->idx, m->nt, &wide, &prim, &margin, 1);
-  if (margin < 1e-4) return 1;
-  if (t < INFINITY && (fabs(t - r->tnear) <= 1e-4 * fmax(1.0, fabs(t)) || fabs(t - r->tfar) <= 1e-4 * fmax(1.0, fabs(t))))
-    return 1;
-  return 0;
-}
-
 /* Soft-shadow frusta from random points of the scene to a quad light. */
 static void make_shadow_batch(fr_rng *r, const mesh_ref *m, vec3 lc, float eps, fr_mft_batch *b) {
   memset(b, 0, sizeof *b);

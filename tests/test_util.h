@@ -57,6 +57,29 @@ static inline double brute_force(const float *pos, const uint32_t *idx, size_t n
   }
   return best;
 }
+typedef struct mesh_ref { const float *pos; const uint32_t *idx; size_t nt; } mesh_ref;
+
+static inline mesh_ref scene_mesh(const fr_scene *s) {
+  mesh_ref m = {fr_scene_vertices(s), fr_scene_indices(s), fr_scene_triangle_count(s)};
+  return m;
+}
+
+/* 1 if a disagreement on this ray is excusable: its nearest hit (in double
+ * precision, over a range widened by the tolerance) is within rounding of an
+ * edge, or within 1e-4 max(1, |t|) of tnear or tfar. */
+static inline int ambiguous(const mesh_ref *m, const fr_ray *r) {
+  uint32_t prim;
+  double margin;
+  fr_ray wide = *r;
+  wide.tnear = r->tnear - 1e-4f * fmaxf(1.0f, fabsf(r->tnear));
+  wide.tfar = r->tfar + 1e-4f * fmaxf(1.0f, fabsf(r->tfar));
+  double t = brute_force(m->pos, m->idx, m->nt, &wide, &prim, &margin, 1);
+  if (margin < 1e-4) return 1;
+  if (t < INFINITY && (fabs(t - r->tnear) <= 1e-4 * fmax(1.0, fabs(t)) || fabs(t - r->tfar) <= 1e-4 * fmax(1.0, fabs(t))))
+    return 1;
+  return 0;
+}
+
 /* Calls fn with the path of every .ply.zst of ../shared/scenes (or
  * $FRUSTA_SHARED/scenes); returns how many. A missing folder fails the test. */
 static inline int for_each_shared_scene(void (*fn)(const char *path, void *ctx), void *ctx) {

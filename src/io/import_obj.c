@@ -167,6 +167,8 @@ fr_error fr_import_mtl(const char *path, const char *data, size_t size, fr_mesh 
       for (int i = 0; i < 3; i++) cur->transmission[i] = f[n == 3 ? i : 0];
     } else if (keyword(s, len, "Ns") && parse_floats(s + 2, e, f, 1) == 1) cur->shininess = f[0];
     else if (keyword(s, len, "Ni") && parse_floats(s + 2, e, f, 1) == 1) cur->ior = f[0];
+    else if (keyword(s, len, "illum") && parse_floats(s + 5, e, f, 1) == 1 && f[0] >= 0.0f && f[0] < 100.0f)
+      cur->illum = (int)f[0];
     else if (keyword(s, len, "d") && parse_floats(s + 1, e, f, 1) == 1) {
       if (cur->transmission[0] == 0 && cur->transmission[1] == 0 && cur->transmission[2] == 0)
         cur->transmission[0] = cur->transmission[1] = cur->transmission[2] = 1.0f - f[0];

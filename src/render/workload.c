@@ -13,7 +13,7 @@
 #define TILE_PIX (TILE * TILE)
 #define MAX_SEC 16 /* secondary rays per pixel */
 
-static const char *names[FR_WL_COUNT] = {"primary", "shadow", "soft16", "ao16", "diffuse8", "specular8"};
+static const char *names[FR_WL_COUNT] = {"primary", "shadow", "soft16", "ao16", "diffuse8", "specular8", "whitted"};
 
 const char *fr_workload_name(fr_workload_kind k) { return k < FR_WL_COUNT ? names[k] : "?"; }
 
@@ -311,18 +311,21 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
   fr_mft_sets_camera(&sets[1], &w->cam);
   run.light_sets = &sets[0];
   run.camera_set = &sets[1];
-  const int tiles_x = (w->cam.width + TILE - 1) / TILE, tiles_y = (w->cam.height + TILE - 1) / TILE;
+  const int whitted = w->kind == FR_WL_WHITTED, tile = whitted ? FR_WHITTED_TILE : TILE;
+  const int tiles_x = (w->cam.width + tile - 1) / tile, tiles_y = (w->cam.height + tile - 1) / tile;
   const int ntiles = tiles_x * tiles_y;
   uint64_t total = 0;
   int done = 0, last_pct = -1;
   double t0 = fr_seconds();
 #pragma omp parallel num_threads(w->threads) reduction(+ : total)
   {
-    buffers *B = malloc(sizeof(buffers));
+    buffers *B = whitted ? NULL : malloc(sizeof(buffers));
+    fr_whitted_scratch *WS = whitted ? fr_whitted_scratch_new() : NULL;
 #pragma omp for schedule(dynamic, 1)
     for (int i = 0; i < ntiles; i++) {
-      if (!B) continue;
-      total += run_tile(w, t, B, (i % tiles_x) * TILE, (i / tiles_x) * TILE);
+      int tx = (i % tiles_x) * tile, ty = (i / tiles_x) * tile;
+      if (WS) total += fr_whitted_tile(w, t, WS, tx, ty);
+      else if (B) total += run_tile(w, t, B, tx, ty);
       if (w->progress) {
         int d, pct;
 #pragma omp atomic capture
@@ -337,6 +340,7 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
       }
     }
     free(B);
+    fr_whitted_scratch_free(WS);
 #ifdef FRUSTA_COUNTERS
     fr_counters_flush();
 #endif
@@ -358,7 +362,7 @@ static void frusta_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int
 }
 
 fr_tracer fr_tracer_frusta(const fr_scene *s) {
-  fr_tracer t = {(void *)s, frusta_intersect, frusta_occluded, NULL, NULL};
+  fr_tracer t = {(void *)s, frusta_intersect, frusta_occluded, NULL, NULL, 0};
   return t;
 }
 
@@ -383,6 +387,47 @@ static void mft_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_s
 }
 
 fr_tracer fr_tracer_mft(const fr_mft_tracer *ctx) {
-  fr_tracer t = {(void *)ctx, mft_intersect, mft_occluded, mft_intersect_frusta, mft_occluded_frusta};
+  fr_tracer t = {(void *)ctx, mft_intersect, mft_occluded, mft_intersect_frusta, mft_occluded_frusta, 0};
+  return t;
+}
+
+/* one large packet per thread: about 100 KB, too big for the stack */
+static _Thread_local fr_lpacket *lp_packet;
+
+static fr_lpacket *thread_packet(void) {
+  if (!lp_packet) lp_packet = fr_alloc_aligned(sizeof(fr_lpacket), 64);
+  return lp_packet;
+}
+
+static void lp_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
+  const fr_lp_tracer *c = ctx;
+  fr_lpacket *p = thread_packet();
+  const size_t size = (size_t)c->side * (size_t)c->side;
+  (void)coherent;
+  for (size_t a = 0; a < n; a += size) {
+    int m = (int)(n - a < size ? n - a : size);
+    if (!p) { fr_intersect_stream(c->scene, rays + a, hits + a, (size_t)m); continue; }
+    fr_lpacket_load(p, rays + a, m);
+    fr_lp_active()->intersect(c->bvh, &c->opts, p);
+    fr_lpacket_hits(p, c->bvh, hits + a);
+  }
+}
+
+static void lp_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
+  const fr_lp_tracer *c = ctx;
+  fr_lpacket *p = thread_packet();
+  const size_t size = (size_t)c->side * (size_t)c->side;
+  (void)coherent;
+  for (size_t a = 0; a < n; a += size) {
+    int m = (int)(n - a < size ? n - a : size);
+    if (!p) { fr_occluded_stream(c->scene, rays + a, occ + a, (size_t)m); continue; }
+    fr_lpacket_load(p, rays + a, m);
+    fr_lp_active()->occluded(c->bvh, &c->opts, p);
+    for (int i = 0; i < m; i++) occ[a + (size_t)i] = (uint8_t)((p->occ[i / 16] >> (i % 16)) & 1);
+  }
+}
+
+fr_tracer fr_tracer_lp(const fr_lp_tracer *ctx) {
+  fr_tracer t = {(void *)ctx, lp_intersect, lp_occluded, NULL, NULL, ctx->side};
   return t;
 }

@@ -11,9 +11,10 @@
 #include "render/views.h"
 #include "render/mft_rays.h"
 #include "trace/mft.h"
+#include "trace/lpacket.h"
 
 typedef enum fr_workload_kind {
-  FR_WL_PRIMARY, FR_WL_SHADOW, FR_WL_SOFT16, FR_WL_AO16, FR_WL_DIFFUSE8, FR_WL_SPECULAR8, FR_WL_COUNT
+  FR_WL_PRIMARY, FR_WL_SHADOW, FR_WL_SOFT16, FR_WL_AO16, FR_WL_DIFFUSE8, FR_WL_SPECULAR8, FR_WL_WHITTED, FR_WL_COUNT
 } fr_workload_kind;
 
 const char *fr_workload_name(fr_workload_kind k);
@@ -26,13 +27,19 @@ int fr_workload_parse(const char *name, fr_workload_kind *k);
  * A multi-frusta tracer also takes whole frusta: camera rays of full 16x16
  * tiles, and the soft shadow rays of 16 pixels at a time (trace/mft.h). Where
  * these are NULL the engine makes the same rays (fr_mft_ray) and hands them to
- * intersect / occluded, so every tracer traces the same rays. */
+ * intersect / occluded, so every tracer traces the same rays.
+ *
+ * The Whitted workload hands each packet to intersect / occluded in its own
+ * call: the rays of one block of packet_side x packet_side pixels (or their
+ * reflection, refraction or shadow rays); packet_side 0 means blocks of
+ * 32x32, the whole tile. */
 typedef struct fr_tracer {
   void *ctx;
   void (*intersect)(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent);
   void (*occluded)(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent);
   void (*intersect_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *hits);
   void (*occluded_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[FR_MFT_FRUSTA]);
+  int packet_side;
 } fr_tracer;
 
 typedef enum fr_shade { FR_SHADE_NONE, FR_SHADE_EYELIGHT, FR_SHADE_NORMALS, FR_SHADE_LIGHT } fr_shade;
@@ -52,6 +59,9 @@ typedef struct fr_workload {
   /* optional per-pixel outputs (soft16): light visibility, primary hit
    * distance (+inf on a miss) and unit normal facing the camera */
   float *gbuf_vis, *gbuf_depth, *gbuf_normal, *gbuf_albedo;
+  /* whitted: which surfaces mirror and refract, recursion depth (0: 4) */
+  const struct fr_whitted_mats *mats;
+  int max_depth;
   /* set by fr_workload_run for its tiles */
   const fr_mft_sets *light_sets;  /* this frame's interleaved samples on the quad light */
   const fr_mft_sets *camera_set;  /* the 4x4 pixels of a block */
@@ -73,4 +83,21 @@ typedef struct fr_mft_tracer {
   fr_mft_opts opts;
 } fr_mft_tracer;
 fr_tracer fr_tracer_mft(const fr_mft_tracer *ctx);
+
+/* The large-packet tracer: every call's rays in packets of side x side
+ * (consecutive rays), traced through bvh as opts say. */
+typedef struct fr_lp_tracer {
+  const fr_scene *scene;
+  const fr_bvh2 *bvh;
+  fr_lp_opts opts;
+  int side;
+} fr_lp_tracer;
+fr_tracer fr_tracer_lp(const fr_lp_tracer *ctx);
+
+/* The Whitted workload's tiles (render/whitted.c): 32x32 pixels. */
+#define FR_WHITTED_TILE 32
+typedef struct fr_whitted_scratch fr_whitted_scratch;
+fr_whitted_scratch *fr_whitted_scratch_new(void);
+void fr_whitted_scratch_free(fr_whitted_scratch *s);
+uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_scratch *s, int tx, int ty);
 #endif

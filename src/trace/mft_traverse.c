@@ -18,12 +18,8 @@
  *   w_i = d . E_i,  E_0 = (v1-o) x (v2-o), E_1 = (v2-o) x (v0-o), E_2 = (v0-o) x (v1-o)
  *   hit when every w_i has the sign of det = (v0-o) . n, t = det / (d . n) in (tnear, tfar)
  *
- * An edge's cross product is computed as (P - o) x (Q - P) from its
- * lexicographically smaller vertex P: the error is then relative to the
- * triangle's size, not to its distance squared (tiny far triangles, as in
- * the dragon, would otherwise get their barycentrics wrong by 10%), and the
- * neighbouring triangle computes exactly the negated value, so no ray slips
- * between two triangles: the test is watertight at no extra cost.
+ * The cross products come from trace/tri_edges16.h: from each edge's
+ * smaller vertex, accurate for tiny far triangles and watertight.
  */
 #include <math.h>
 #include <string.h>
@@ -31,6 +27,7 @@
 #include "base/simd_packet.h"
 #include "trace/counters.h"
 #include "trace/mft.h"
+#include "trace/tri_edges16.h"
 
 #if P != 16
 #error "the frusta kernels are 16 wide"
@@ -150,9 +147,7 @@ static void frusta_setup(frusta *F, const fr_mft_batch *B, const fr_mft_sets *T,
   }
 }
 
-FR_INLINE vpf dot3(vpf ax, vpf ay, vpf az, vpf bx, vpf by, vpf bz) {
-  return vp_add(vp_add(vp_mul(ax, bx), vp_mul(ay, by)), vp_mul(az, bz));
-}
+#define dot3 fr_dot3v
 
 /* Child k of a node against the frusta in `m`; *tn: a lower bound of each
  * frustum's entry distance. */
@@ -195,31 +190,11 @@ typedef struct tri_frusta {
 /* The frusta of m that may hit triangle r; fills X. */
 FR_INLINE unsigned tri_cull(const frusta *F, const fr_bvh2_tri *r, unsigned m, int corner_rays, tri_frusta *X) {
   vpf o[3] = {vp_load(F->o[0]), vp_load(F->o[1]), vp_load(F->o[2])};
-  vpf A[3], B[3], C[3];
-  for (int a = 0; a < 3; a++) {
-    A[a] = vp_sub(vp(r->v0[a]), o[a]);
-    B[a] = vp_sub(vp(r->v1[a]), o[a]);
-    C[a] = vp_sub(vp(r->v2[a]), o[a]);
-  }
-  vpf nx = vp(r->n[0]), ny = vp(r->n[1]), nz = vp(r->n[2]);
-  vpf det = dot3(A[0], A[1], A[2], nx, ny, nz);
-  /* E_i = (P - o) x (Q - o) = (P - o) x (Q - P) for edge i from P to Q: the
-   * short edge vector keeps the rounding error relative to the triangle, not
-   * to its distance. From the smaller vertex, negated when flipped. */
-  const float *ends[3][2] = {{r->v1, r->v2}, {r->v2, r->v0}, {r->v0, r->v1}};
-  const vpf *from[3][2] = {{B, C}, {C, A}, {A, B}};
-  vpf E[3][3];
-  for (int i = 0; i < 3; i++) {
-    int flip = (r->edge_flip >> i) & 1;
-    const float *p = ends[i][flip], *q = ends[i][!flip];
-    const vpf *po = from[i][flip];
-    vpf dx = vp(q[0] - p[0]), dy = vp(q[1] - p[1]), dz = vp(q[2] - p[2]);
-    vpf sg = vp(flip ? -0.0f : 0.0f);
-    E[i][0] = vp_xor(vp_sub(vp_mul(po[1], dz), vp_mul(po[2], dy)), sg);
-    E[i][1] = vp_xor(vp_sub(vp_mul(po[2], dx), vp_mul(po[0], dz)), sg);
-    E[i][2] = vp_xor(vp_sub(vp_mul(po[0], dy), vp_mul(po[1], dx)), sg);
+  vpf E[3][3], det;
+  fr_tri_edges16(r, o, E, &det);
+  for (int i = 0; i < 3; i++)
     for (int a = 0; a < 3; a++) vp_store(X->e[i][a], E[i][a]);
-  }
+  vpf nx = vp(r->n[0]), ny = vp(r->n[1]), nz = vp(r->n[2]);
   vp_store(X->det, det);
   if (!corner_rays) return m;
   vpf sg = vp_and(det, vp(-0.0f)), zero = vp(0.0f), guard = vp_load(F->guard);
@@ -253,12 +228,11 @@ FR_INLINE unsigned ray_test(const frusta *F, const tri_frusta *X, const fr_bvh2_
   vpf dx = vp_add(vp(F->s[0][f]), vp_load(S->dx));
   vpf dy = vp_add(vp(F->s[1][f]), vp_load(S->dy));
   vpf dz = vp_add(vp(F->s[2][f]), vp_load(S->dz));
-  vpf w[3];
-  for (int i = 0; i < 3; i++) w[i] = dot3(dx, dy, dz, vp(X->e[i][0][f]), vp(X->e[i][1][f]), vp(X->e[i][2][f]));
+  vpf w[3], E[3][3];
+  for (int i = 0; i < 3; i++)
+    for (int a = 0; a < 3; a++) E[i][a] = vp(X->e[i][a][f]);
   float det = X->det[f];
-  vpf sg = vp(copysignf(0.0f, det)), zero = vp(0.0f);
-  unsigned m = rays & vpm_bits(vpm_and(vpm_and(vp_ge(vp_xor(w[0], sg), zero), vp_ge(vp_xor(w[1], sg), zero)),
-                                       vp_ge(vp_xor(w[2], sg), zero)));
+  unsigned m = fr_tri_edges16_inside(dx, dy, dz, E, vp(det), rays, w);
   if (!m) return 0;
   vpf den = dot3(dx, dy, dz, vp(r->n[0]), vp(r->n[1]), vp(r->n[2]));
   vpf t = vp_div(vp(det), den);

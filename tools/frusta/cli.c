@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "api/scene.h"
+#include "render/whitted.h"
 #include "render/workload.h"
 
 int cli_error(int code, const char *fmt, ...) {
@@ -160,5 +161,49 @@ int cli_workload_setup(const char *scene, const cli_view *v, int threads, fr_sce
   w->scene = *s;
   w->eps = cli_scene_eps(*s);
   w->threads = threads;
+  return 0;
+}
+
+void cli_whitted_default(cli_whitted *o) {
+  memset(o, 0, sizeof *o);
+  o->depth = 4;
+  o->lp.traversal = FR_LP_RANGED;
+  o->lp.cull = FR_CULL_OFF; /* measured: the culls cost more than they save (README) */
+  o->packet = 16;
+}
+
+int cli_whitted_flag(int argc, char **argv, int *i, cli_whitted *o) {
+  const char *a = argv[*i];
+  if (strcmp(a, "--mirror") && strcmp(a, "--glass") && strcmp(a, "--depth") && strcmp(a, "--traversal") &&
+      strcmp(a, "--cull") && strcmp(a, "--packet"))
+    return 0;
+  if (*i + 1 >= argc) { cli_error(CLI_USAGE_ERROR, "%s needs a value", a); return -1; }
+  const char *val = argv[++*i];
+  int ok = 1;
+  if (!strcmp(a, "--mirror")) o->mirror = val;
+  else if (!strcmp(a, "--glass")) o->glass = val;
+  else if (!strcmp(a, "--depth")) {
+    if (!(ok = cli_parse_int(val, 1, FR_WHITTED_MAX_DEPTH, &o->depth)))
+      cli_error(CLI_USAGE_ERROR, "--depth wants 1..%d, got '%s'", FR_WHITTED_MAX_DEPTH, val);
+  } else if (!strcmp(a, "--traversal")) {
+    if (!(ok = fr_lp_traversal_parse(val, &o->lp.traversal)))
+      cli_error(CLI_USAGE_ERROR, "--traversal is masked, ranged or partition, not '%s'", val);
+  } else if (!strcmp(a, "--cull")) {
+    if (!(ok = fr_cull_parse(val, &o->lp.cull)))
+      cli_error(CLI_USAGE_ERROR, "--cull is off, ia, planes or corners, not '%s'", val);
+  } else {
+    ok = cli_parse_int(val, 2, 32, &o->packet) && (o->packet & (o->packet - 1)) == 0;
+    if (!ok) cli_error(CLI_USAGE_ERROR, "--packet is 2, 4, 8, 16 or 32, not '%s'", val);
+  }
+  return ok ? 1 : -1;
+}
+
+int cli_whitted_setup(const fr_scene *s, const cli_whitted *o, fr_whitted_mats *mats, fr_workload *w) {
+  if (fr_whitted_mats_build(s, o->mirror, o->glass, mats)) return cli_error(CLI_USAGE_ERROR, "%s", fr_last_error());
+  size_t nm, ng;
+  fr_whitted_mats_census(s, mats, &nm, &ng);
+  printf("whitted depth=%d mirror_tris=%zu glass_tris=%zu\n", o->depth, nm, ng);
+  w->mats = mats;
+  w->max_depth = o->depth;
   return 0;
 }

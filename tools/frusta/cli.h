@@ -40,4 +40,21 @@ struct fr_workload;
  * from the flags; reports errors itself (returns the exit code). */
 int cli_workload_setup(const char *scene, const cli_view *v, int threads, fr_scene **s, struct fr_workload *w);
 const char *cli_scene_name(const fr_scene *s);
+
+/* Whitted and large-packet flags shared by render and bench:
+ * --mirror NAMES --glass NAMES --depth N --traversal T --cull C --packet N */
+#include "render/whitted.h"
+#include "trace/lpacket.h"
+typedef struct cli_whitted {
+  const char *mirror, *glass; /* NULL: the scene's defaults */
+  int depth;                  /* 1..FR_WHITTED_MAX_DEPTH, default 4 */
+  fr_lp_opts lp;              /* default ranged, corners */
+  int packet;                 /* render: packet side, default 16 */
+} cli_whitted;
+void cli_whitted_default(cli_whitted *o);
+/* As cli_view_flag: 1 consumed, 0 not one of these flags, -1 error (reported). */
+int cli_whitted_flag(int argc, char **argv, int *i, cli_whitted *o);
+/* Builds the Whitted materials into w (w->mats must point at *mats); reports
+ * errors itself and prints how many triangles mirror and refract. */
+int cli_whitted_setup(const fr_scene *s, const cli_whitted *o, struct fr_whitted_mats *mats, struct fr_workload *w);
 #endif

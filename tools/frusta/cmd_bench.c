@@ -17,16 +17,19 @@
 /* single: the default single-ray BVH (8-wide); single4: the MIC paper's BVH4;
  * packet8/packet16: packets alone; hybrid16: packets dropping to single rays;
  * auto: what fr_intersect_stream does by default; mft: camera rays and soft
- * shadows by multi-frusta tracing, the other rays as auto. */
-static const char *frusta_modes[] = {"single", "single4", "packet8", "packet16", "hybrid16", "auto", "mft"};
-#define N_FRUSTA_MODES 7
+ * shadows by multi-frusta tracing, the other rays as auto; packetNxN: large
+ * packets of N x N rays on the binary BVH (--traversal, --cull). */
+static const char *frusta_modes[] = {"single", "single4", "packet8", "packet16", "hybrid16", "auto", "mft",
+                                     "packet2x2", "packet4x4", "packet8x8", "packet16x16", "packet32x32"};
+#define N_FRUSTA_MODES 12
 #define MODE_MFT 6
+#define MODE_LARGE 7 /* packet2x2 .. packet32x32 */
 
 static void set_frusta_mode(fr_scene *s, int m, const fr_trace_options *base, int single_width) {
   static const fr_trace_mode modes[] = {FR_TRACE_SINGLE, FR_TRACE_SINGLE, FR_TRACE_PACKET8, FR_TRACE_PACKET16,
                                         FR_TRACE_HYBRID16, FR_TRACE_AUTO, FR_TRACE_AUTO};
   fr_trace_options o = *base;
-  o.mode = modes[m];
+  o.mode = m < MODE_LARGE ? modes[m] : FR_TRACE_AUTO;
   fr_scene_set_trace_options(s, &o);
   fr_scene_set_bvh_width(s, m == 0 ? 8 : m == 1 ? 4 : single_width);
 }
@@ -78,6 +81,14 @@ static void run(const fr_workload *w0, const fr_tracer *t, const char *scene, si
            (double)c.mailbox_hits / c.packets, (double)c.switches / c.packets,
            c.pk_box_tests ? (double)c.pk_box_lanes / c.pk_box_tests : 0.0,
            c.pk_tri_tests ? (double)c.pk_tri_lanes / c.pk_tri_tests : 0.0);
+  if (fr_counters_enabled() && c.lp_packets)
+    printf("counters tracer=%s mode=%s workload=%s packets=%llu per_packet rays=%.1f nodes=%.2f culled=%.2f "
+           "box_chunks=%.2f leaves=%.2f tris=%.2f tris_culled=%.2f tri_chunks=%.2f\n",
+           tracer, mode, fr_workload_name(w0->kind), (unsigned long long)c.lp_packets, (double)c.rays / c.lp_packets,
+           (double)c.lp_nodes / c.lp_packets, (double)c.lp_culled / c.lp_packets,
+           (double)c.lp_box_chunks / c.lp_packets, (double)c.lp_leaves / c.lp_packets,
+           (double)c.lp_tris / c.lp_packets, (double)c.lp_tri_culled / c.lp_packets,
+           (double)c.lp_tri_chunks / c.lp_packets);
   fflush(stdout);
 }
 
@@ -92,8 +103,11 @@ int cmd_bench(int argc, char **argv) {
   fr_mft_opts mopt = {1, 1};
   int mft_leaf = FR_BUILD_MAX_LEAF;
   fr_light_sets light_sets = FR_LIGHT_SETS_SPREAD;
+  cli_whitted wo;
+  cli_whitted_default(&wo);
   for (int i = 0; i < argc; i++) {
     int r = cli_view_flag(argc, argv, &i, &v);
+    if (r == 0) r = cli_whitted_flag(argc, argv, &i, &wo);
     if (r < 0) return CLI_USAGE_ERROR;
     if (r > 0) continue;
     const char *a = argv[i];
@@ -142,14 +156,14 @@ int cmd_bench(int argc, char **argv) {
   fr_workload_kind wk = FR_WL_PRIMARY;
   int all_wl = !strcmp(workload, "all");
   if (!all_wl && !fr_workload_parse(workload, &wk))
-    return cli_error(CLI_USAGE_ERROR, "unknown workload '%s' (primary, shadow, soft16, ao16, diffuse8, specular8, all)", workload);
+    return cli_error(CLI_USAGE_ERROR, "unknown workload '%s' (primary, shadow, soft16, ao16, diffuse8, specular8, whitted, all)", workload);
   int all_modes = !strcmp(mode, "all");
   ebr_mode em = EBR_SINGLE;
   int frusta_has_mode = all_modes;
   for (int m = 0; m < N_FRUSTA_MODES; m++) frusta_has_mode |= !strcmp(mode, frusta_modes[m]);
   int embree_has_mode = all_modes || ebr_mode_parse(mode, &em);
   if (use_frusta && !frusta_has_mode && !(use_embree && embree_has_mode))
-    return cli_error(CLI_USAGE_ERROR, "frusta has no mode '%s' (single, single4, packet8, packet16, hybrid16, auto, mft, all)", mode);
+    return cli_error(CLI_USAGE_ERROR, "frusta has no mode '%s' (single, single4, packet8, packet16, hybrid16, auto, mft, packet2x2 .. packet32x32, all)", mode);
   if (use_embree && !embree_has_mode && !(use_frusta && frusta_has_mode))
     return cli_error(CLI_USAGE_ERROR, "embree has no mode '%s' (single, packet4, packet8, packet16, stream, all)", mode);
 
@@ -184,11 +198,18 @@ int cmd_bench(int argc, char **argv) {
     printf("mft_bvh leaf=%d inner=%zu leaves=%zu sah=%.2f corner_rays=%s shrink=%s\n", mctx.bvh->max_leaf,
            mctx.bvh->nnodes, mctx.bvh->nleaves, fr_bvh2_sah(mctx.bvh), mopt.corner_rays ? "on" : "off",
            mopt.shrink ? "on" : "off");
+  fr_whitted_mats mats = {NULL, 0};
+  if ((all_wl || wk == FR_WL_WHITTED) && (rc = cli_whitted_setup(s, &wo, &mats, &w))) {
+    fr_bvh2_free(&shallow);
+    fr_scene_release(s);
+    return rc;
+  }
   ebr_scene *e = NULL;
   if (use_embree) {
     ebr_options o = {threads, 2, 0}; /* high quality, not robust: Embree's fastest tracing */
     if (ebr_create(s, o, &e)) {
       fr_bvh2_free(&shallow);
+      fr_whitted_mats_free(&mats);
       fr_scene_release(s);
       return cli_error(1, "embree: cannot build the scene");
     }
@@ -203,7 +224,15 @@ int cmd_bench(int argc, char **argv) {
       for (int m = 0; m < N_FRUSTA_MODES; m++)
         if (all_modes || !strcmp(mode, frusta_modes[m])) {
           set_frusta_mode(s, m, &topt, width);
-          run(&w, m == MODE_MFT ? &tm : &t, s->name, tris, "frusta", frusta_modes[m], repeat);
+          fr_lp_tracer lpc = {s, &s->bvh2, wo.lp, 2 << (m - MODE_LARGE)};
+          fr_tracer tl = m >= MODE_LARGE ? fr_tracer_lp(&lpc) : t;
+          char name[96];
+          if (m >= MODE_LARGE)
+            snprintf(name, sizeof name, "%s/%s/%s", frusta_modes[m], fr_lp_traversal_name(wo.lp.traversal),
+                     fr_cull_name(wo.lp.cull));
+          else
+            snprintf(name, sizeof name, "%s", frusta_modes[m]);
+          run(&w, m == MODE_MFT ? &tm : &tl, s->name, tris, "frusta", name, repeat);
         }
       fr_scene_set_bvh_width(s, width);
       fr_scene_set_trace_options(s, &topt);
@@ -217,6 +246,7 @@ int cmd_bench(int argc, char **argv) {
   }
   ebr_release(e);
   fr_bvh2_free(&shallow);
+  fr_whitted_mats_free(&mats);
   fr_scene_release(s);
   return 0;
 }

@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "io/image_write.h"
 #include "render/softshadow.h"
+#include "render/whitted.h"
 #include "render/workload.h"
 
 static int onoff(const char *flag, const char *val, int *out) {
@@ -72,8 +73,11 @@ int cmd_render(int argc, char **argv) {
   int threads = omp_get_num_procs(), mft = 1;
   const char *ref_out = NULL;
   fr_softshadow_opts so = {16, 1, FR_LIGHT_SETS_CELLS};
+  cli_whitted wo;
+  cli_whitted_default(&wo);
   for (int i = 0; i < argc; i++) {
     int r = cli_view_flag(argc, argv, &i, &v);
+    if (r == 0) r = cli_whitted_flag(argc, argv, &i, &wo);
     if (r < 0) return CLI_USAGE_ERROR;
     if (r > 0) continue;
     const char *a = argv[i];
@@ -108,7 +112,7 @@ int cmd_render(int argc, char **argv) {
   }
   if (!scene || !out)
     return cli_error(CLI_USAGE_ERROR, "usage: frusta render SCENE|--builtin --out FILE.png|.exr|.pfm "
-                                      "[--shade eyelight|normals|shadows|softshadow]");
+                                      "[--shade eyelight|normals|shadows|softshadow|whitted]");
   if (!fr_image_format_known(out)) return cli_error(CLI_USAGE_ERROR, "%s: unknown image format (use .png, .exr or .pfm)", out);
   if (ref_out && !fr_image_format_known(ref_out))
     return cli_error(CLI_USAGE_ERROR, "%s: unknown image format (use .png, .exr or .pfm)", ref_out);
@@ -118,7 +122,8 @@ int cmd_render(int argc, char **argv) {
   else if (strcmp(shade, "normals") == 0) { w.kind = FR_WL_PRIMARY; w.shade = FR_SHADE_NORMALS; }
   else if (strcmp(shade, "shadows") == 0) { w.kind = FR_WL_SHADOW; w.shade = FR_SHADE_LIGHT; }
   else if (strcmp(shade, "softshadow") == 0) { w.kind = FR_WL_SOFT16; w.shade = FR_SHADE_LIGHT; }
-  else return cli_error(CLI_USAGE_ERROR, "--shade is eyelight, normals, shadows or softshadow, not '%s'", shade);
+  else if (strcmp(shade, "whitted") == 0) { w.kind = FR_WL_WHITTED; w.shade = FR_SHADE_LIGHT; }
+  else return cli_error(CLI_USAGE_ERROR, "--shade is eyelight, normals, shadows, softshadow or whitted, not '%s'", shade);
 
   fr_scene *s;
   int rc = cli_workload_setup(scene, &v, threads, &s, &w);
@@ -130,9 +135,13 @@ int cmd_render(int argc, char **argv) {
     fr_scene_release(s);
     return rc;
   }
+  fr_whitted_mats mats = {NULL, 0};
+  if (w.kind == FR_WL_WHITTED && (rc = cli_whitted_setup(s, &wo, &mats, &w))) { fr_scene_release(s); return rc; }
   w.image = calloc((size_t)v.width * (size_t)v.height * 3, sizeof(float));
-  if (!w.image) { fr_scene_release(s); return cli_error(1, "out of memory for a %dx%d image", v.width, v.height); }
-  fr_tracer t = fr_tracer_frusta(s);
+  if (!w.image) { fr_whitted_mats_free(&mats); fr_scene_release(s); return cli_error(1, "out of memory for a %dx%d image", v.width, v.height); }
+  /* Whitted: large packets of --packet x --packet rays */
+  fr_lp_tracer lpc = {s, &s->bvh2, wo.lp, wo.packet};
+  fr_tracer t = w.kind == FR_WL_WHITTED ? fr_tracer_lp(&lpc) : fr_tracer_frusta(s);
   fr_workload_result r = fr_workload_run(&w, &t);
   if (fr_image_write(out, v.width, v.height, w.image)) rc = cli_error(1, "%s", fr_last_error());
   else
@@ -140,6 +149,7 @@ int cmd_render(int argc, char **argv) {
            s->name, fr_scene_triangle_count(s), v.width, v.height, shade, fr_isa_name(fr_get_isa()), threads,
            s->build_seconds, (unsigned long long)r.rays, r.seconds, (double)r.rays / r.seconds * 1e-6, out);
   free(w.image);
+  fr_whitted_mats_free(&mats);
   fr_scene_release(s);
   return rc;
 }

@@ -216,7 +216,7 @@ static void ebr_occluded(void *c, fr_ray *rays, uint8_t *occ, size_t n, int cohe
 }
 
 fr_tracer ebr_tracer(ebr_scene *e, ebr_mode m) {
-  fr_tracer t = {&e->ctx[m], ebr_intersect, ebr_occluded, NULL, NULL};
+  fr_tracer t = {&e->ctx[m], ebr_intersect, ebr_occluded, NULL, NULL, 0};
   return t;
 }
 

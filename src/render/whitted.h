@@ -1,0 +1,49 @@
+/*
+ * The Whitted workload and renderer: primary rays, a shadow ray to the point
+ * light at every hit that is not a pure mirror, mirror reflection, and
+ * refraction with Fresnel through dielectrics, to a settable depth (<= 4 by
+ * workloads.md; up to 8 here).
+ *
+ * Rays travel in generations: the camera rays of a 32x32 tile, then the
+ * shadow rays of their hits, then their reflection and refraction rays,
+ * and so on. Within a generation the rays stay grouped by the block of
+ * side x side pixels they descend from and by kind (reflection, refraction),
+ * so a packet tracer sees Overbeck's secondary packets: the rays of one
+ * primary packet that met mirrors, or glass.
+ */
+#ifndef FR_RENDER_WHITTED_H
+#define FR_RENDER_WHITTED_H
+#include <stdint.h>
+#include "frusta.h"
+
+#define FR_WHITTED_MAX_DEPTH 8
+
+typedef enum fr_surface { FR_SURF_DIFFUSE, FR_SURF_MIRROR, FR_SURF_GLASS } fr_surface;
+
+typedef struct fr_whitted_mat {
+  fr_surface kind;
+  float kd[3];   /* diffuse colour */
+  float ks[3];   /* Phong highlight, or the mirror's reflectance */
+  float ns;      /* Phong exponent */
+  float kt[3];   /* glass: transmitted fraction */
+  float ior;
+} fr_whitted_mat;
+
+/* One entry per scene material, and one more (the last) for triangles
+ * without a material. */
+typedef struct fr_whitted_mats {
+  fr_whitted_mat *mat;
+  size_t count;
+} fr_whitted_mats;
+
+/* Which materials mirror and which refract. mirror and glass are
+ * comma-separated material names ("all" for mirror: every surface reflects
+ * half the light), or NULL for the defaults: the scenes README's
+ * suggestions for kitchen and museum, else MTL illum 3 with a specular
+ * colour is a mirror and any transmission is glass. FR_ERR_ARG names an
+ * unknown material. */
+fr_error fr_whitted_mats_build(const fr_scene *s, const char *mirror, const char *glass, fr_whitted_mats *out);
+void fr_whitted_mats_free(fr_whitted_mats *m);
+/* how many of the scene's triangles are mirrors and glass */
+void fr_whitted_mats_census(const fr_scene *s, const fr_whitted_mats *m, size_t *mirror_tris, size_t *glass_tris);
+#endif

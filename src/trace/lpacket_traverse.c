@@ -1,0 +1,247 @@
+/*
+ * Large-packet traversal of the binary BVH (trace/lpacket.h), compiled once
+ * per ISA. A stack entry is a child reference, its box (the parent node and
+ * slot) and the parent's set of chunks; the box is tested when the entry is
+ * popped, first for the whole packet by its bounds (the cull), then chunk by
+ * chunk, which narrows the set the way the traversal mode says. Testing on
+ * pop is what lets the partition mode split its list in place: a subtree
+ * only reorders the prefix its sibling will read, never its contents.
+ *
+ * Triangles are tested 16 rays at a time with the watertight edge test of
+ * trace/tri_edges16.h, each ray from its own origin.
+ */
+#include <math.h>
+#include <string.h>
+#include <stdlib.h>
+#include "base/simd.h"
+#include "base/simd_packet.h"
+#include "trace/counters.h"
+#include "trace/lpacket.h"
+#include "trace/tri_edges16.h"
+
+#if P != 16
+#error "the large-packet kernels are 16 wide"
+#endif
+
+#define ROUND_UP (1.0f + 0x1p-20f)
+#define TINY 1e-18f
+#define STACK 256
+
+typedef struct entry {
+  uint32_t ref;
+  const fr_bvh2_node *parent; /* NULL for the root: no box to test */
+  int slot;
+  int depth;                  /* masked: the frame of the parent's masks */
+  int a, b;                   /* ranged: first and last chunk; partition: list length */
+} entry;
+
+/* the rays of chunk c whose slab test reaches box k of node n before their tfar */
+FR_INLINE unsigned box16(const fr_lpacket *p, int c, const fr_bvh2_node *n, int k) {
+  const float *lo[3] = {n->lo_x, n->lo_y, n->lo_z}, *hi[3] = {n->hi_x, n->hi_y, n->hi_z};
+  const int i = 16 * c;
+  vpf tn = vp_load(p->tnear + i), tf = vp_load(p->tfar + i);
+  for (int a = 0; a < 3; a++) {
+    vpf o = vp_load(p->o[a] + i), rd = vp_load(p->rd[a] + i);
+    vpf t0 = vp_mul(vp_sub(vp(lo[a][k]), o), rd), t1 = vp_mul(vp_sub(vp(hi[a][k]), o), rd);
+    tn = vp_max(tn, vp_min(t0, t1));
+    tf = vp_min(tf, vp_max(t0, t1));
+  }
+  FR_COUNT(lp_box_chunks, 1);
+  return vpm_bits(vp_le(tn, vp_mul(tf, vp(ROUND_UP))));
+}
+
+/* Chunk c's rays of m against triangle index ti; closest: keeps the nearer
+ * hits, else returns the rays that hit anything in range. */
+FR_INLINE unsigned tri16(fr_lpacket *p, int c, const fr_bvh2_tri *r, uint32_t ti, unsigned m, int closest) {
+  const int i = 16 * c;
+  vpf o[3] = {vp_load(p->o[0] + i), vp_load(p->o[1] + i), vp_load(p->o[2] + i)};
+  vpf dx = vp_load(p->d[0] + i), dy = vp_load(p->d[1] + i), dz = vp_load(p->d[2] + i);
+  vpf E[3][3], det, w[3];
+  FR_COUNT(lp_tri_chunks, 1);
+  fr_tri_edges16(r, o, E, &det);
+  m = fr_tri_edges16_inside(dx, dy, dz, E, det, m, w);
+  if (!m) return 0;
+  vpf tf = vp_load(p->tfar + i);
+  vpf t = vp_div(det, fr_dot3v(dx, dy, dz, vp(r->n[0]), vp(r->n[1]), vp(r->n[2])));
+  m &= vpm_bits(vpm_and(vp_gt(t, vp_load(p->tnear + i)), vp_lt(t, tf)));
+  if (!m || !closest) return m;
+  vpf inv = vp_div(vp(1.0f), vp_add(vp_add(w[0], w[1]), w[2]));
+  vpm hm = vpm_bits_to(m);
+  vp_store(p->tfar + i, vp_select(hm, t, tf));
+  vp_store(p->u + i, vp_select(hm, vp_mul(w[1], inv), vp_load(p->u + i)));
+  vp_store(p->v + i, vp_select(hm, vp_mul(w[2], inv), vp_load(p->v + i)));
+  for (unsigned mm = m; mm; mm &= mm - 1) p->tri[i + __builtin_ctz(mm)] = ti;
+  return m;
+}
+
+typedef struct state {
+  fr_lpacket *p;
+  const fr_bvh2 *b;
+  const fr_lp_opts *opt;
+  float dmean[3];
+  int live;      /* chunks with rays still alive (any hit) */
+} state;
+
+static void setup(state *S, fr_lpacket *p, const fr_bvh2 *b, const fr_lp_opts *opt) {
+  S->p = p;
+  S->b = b;
+  S->opt = opt;
+  S->live = 0;
+  double sum[3] = {0, 0, 0};
+  vpf tiny = vp(TINY);
+  for (int c = 0; c < p->nchunks; c++) {
+    const int i = 16 * c;
+    for (int a = 0; a < 3; a++) {
+      vpf d = vp_load(p->d[a] + i);
+      d = vp_select(vp_lt(vp_abs(d), tiny), vp_copysign(tiny, d), d);
+      vp_store(p->rd[a] + i, vp_div(vp(1.0f), d));
+    }
+    p->alive[c] = p->valid[c];
+    p->occ[c] = 0;
+    S->live += p->valid[c] != 0;
+    for (int k = 0; k < 16; k++) {
+      p->tri[i + k] = FR_INVALID_ID;
+      if ((p->valid[c] >> k) & 1)
+        for (int a = 0; a < 3; a++) sum[a] += p->d[a][i + k];
+    }
+  }
+  for (int a = 0; a < 3; a++) S->dmean[a] = (float)sum[a];
+  if (opt->cull != FR_CULL_OFF) {
+    fr_ray_soa soa = {{p->o[0], p->o[1], p->o[2]}, {p->d[0], p->d[1], p->d[2]}, p->tnear, p->tfar, p->valid, p->n};
+    fr_pbounds_build(&p->bounds, &soa);
+  }
+}
+
+/* Narrows the parent's set (entry e) to the chunks with a ray that hits e's
+ * box; fills the child set in *out. 0 when no chunk is left. */
+FR_INLINE int narrow(state *S, const entry *e, entry *out) {
+  fr_lpacket *p = S->p;
+  const fr_bvh2_node *n = e->parent;
+  const int k = e->slot;
+  switch (S->opt->traversal) {
+  case FR_LP_MASKED: {
+    const uint16_t *in = p->frames[e->depth];
+    if (e->depth + 1 >= FR_LP_FRAMES) {
+      /* deeper than the frames: keep the parent's masks (a superset) */
+      out->depth = e->depth;
+      return 1;
+    }
+    uint16_t *mo = p->frames[e->depth + 1];
+    unsigned any = 0;
+    for (int c = 0; c < p->nchunks; c++) {
+      unsigned m = in[c] & p->alive[c];
+      if (m) m &= box16(p, c, n, k);
+      mo[c] = (uint16_t)m;
+      any |= m;
+    }
+    out->depth = e->depth + 1;
+    return any != 0;
+  }
+  case FR_LP_RANGED: {
+    int first = -1, last = -1;
+    for (int c = e->a; c <= e->b; c++)
+      if (p->alive[c] && (box16(p, c, n, k) & p->alive[c])) { first = c; break; }
+    if (first < 0) return 0;
+    for (int c = e->b; c > first; c--)
+      if (p->alive[c] && (box16(p, c, n, k) & p->alive[c])) { last = c; break; }
+    out->a = first;
+    out->b = last < 0 ? first : last;
+    return 1;
+  }
+  default: {
+    uint8_t *l = p->list;
+    int hit = 0;
+    for (int j = 0; j < e->a; j++) {
+      int c = l[j];
+      if (p->alive[c] && (box16(p, c, n, k) & p->alive[c])) {
+        l[j] = l[hit];
+        l[hit++] = (uint8_t)c;
+      }
+    }
+    out->a = hit;
+    return hit > 0;
+  }
+  }
+}
+
+/* The leaf of entry e (its set already narrowed into e) against its triangles. */
+static void leaf(state *S, const entry *e, int closest) {
+  fr_lpacket *p = S->p;
+  const fr_bvh2 *b = S->b;
+  uint32_t ref = e->ref, first = ref & FR_BVH2_FIRST_MASK, count = (ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
+  FR_COUNT(lp_leaves, 1);
+  for (uint32_t j = 0; j < count; j++) {
+    const fr_bvh2_tri *r = &b->tris[first + j];
+    FR_COUNT(lp_tris, 1);
+    if (S->opt->cull != FR_CULL_OFF && fr_pbounds_cull_tri(&p->bounds, S->opt->cull, r->v0, r->v1, r->v2)) {
+      FR_COUNT(lp_tri_culled, 1);
+      continue;
+    }
+    int nc = S->opt->traversal == FR_LP_RANGED ? e->b - e->a + 1 : S->opt->traversal == FR_LP_PARTITION ? e->a : p->nchunks;
+    for (int jc = 0; jc < nc; jc++) {
+      int c = S->opt->traversal == FR_LP_RANGED ? e->a + jc : S->opt->traversal == FR_LP_PARTITION ? p->list[jc] : jc;
+      unsigned m = p->alive[c];
+      if (S->opt->traversal == FR_LP_MASKED) m &= p->frames[e->depth][c];
+      if (!m) continue;
+      unsigned hit = tri16(p, c, r, first + j, m, closest);
+      if (!closest && hit) {
+        p->occ[c] |= (uint16_t)hit;
+        p->alive[c] &= (uint16_t)~hit;
+        if (!p->alive[c] && --S->live == 0) return;
+      }
+    }
+  }
+}
+
+static void traverse(const fr_bvh2 *b, const fr_lp_opts *opt, fr_lpacket *p, int closest) {
+  state S;
+  FR_COUNT(lp_packets, 1);
+  setup(&S, p, b, opt);
+  FR_COUNT(rays, S.live ? p->n : 0);
+  if (!S.live || !b->nodes || b->nprims == 0) return;
+  entry stack[STACK];
+  int sp = 0;
+  entry root = {b->root, NULL, 0, 0, 0, p->nchunks - 1};
+  if (opt->traversal == FR_LP_MASKED) memcpy(p->frames[0], p->valid, sizeof p->valid);
+  if (opt->traversal == FR_LP_PARTITION) {
+    root.a = 0;
+    for (int c = 0; c < p->nchunks; c++)
+      if (p->valid[c]) p->list[root.a++] = (uint8_t)c;
+  }
+  stack[sp++] = root;
+  while (sp > 0) {
+    entry e = stack[--sp], in = e;
+    FR_COUNT(lp_nodes, 1);
+    if (e.parent) {
+      float lo[3] = {e.parent->lo_x[e.slot], e.parent->lo_y[e.slot], e.parent->lo_z[e.slot]};
+      float hi[3] = {e.parent->hi_x[e.slot], e.parent->hi_y[e.slot], e.parent->hi_z[e.slot]};
+      if (opt->cull != FR_CULL_OFF && fr_pbounds_cull_box(&p->bounds, opt->cull, lo, hi)) {
+        FR_COUNT(lp_culled, 1);
+        continue;
+      }
+      if (!narrow(&S, &in, &e)) continue;
+    }
+    if (e.ref & FR_BVH2_LEAF) {
+      leaf(&S, &e, closest);
+      if (!closest && S.live == 0) return;
+      continue;
+    }
+    if (sp + 2 > STACK) continue; /* cannot happen: the build caps the depth */
+    const fr_bvh2_node *n = &b->nodes[e.ref];
+    /* nearer child first along the packet's mean direction */
+    float s = 0.0f;
+    const float *lo[3] = {n->lo_x, n->lo_y, n->lo_z}, *hi[3] = {n->hi_x, n->hi_y, n->hi_z};
+    for (int a = 0; a < 3; a++) s += (lo[a][0] + hi[a][0] - lo[a][1] - hi[a][1]) * S.dmean[a];
+    int near = s > 0.0f;
+    entry c0 = e, c1 = e;
+    c0.ref = n->child[!near]; c0.parent = n; c0.slot = !near;
+    c1.ref = n->child[near]; c1.parent = n; c1.slot = near;
+    stack[sp++] = c0;
+    stack[sp++] = c1;
+  }
+}
+
+static void lp_intersect(const fr_bvh2 *b, const fr_lp_opts *opt, fr_lpacket *p) { traverse(b, opt, p, 1); }
+static void lp_occluded(const fr_bvh2 *b, const fr_lp_opts *opt, fr_lpacket *p) { traverse(b, opt, p, 0); }
+
+const fr_lp_fns FR_ISA_FN(fr_lp) = {lp_intersect, lp_occluded};
