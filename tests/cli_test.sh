@@ -121,6 +121,21 @@ expect 2 "$F" render --builtin --shade softshadow --filter maybe --out "$T/s3.pn
 expect 2 "$F" render --builtin --shade softshadow --light-sets grid --out "$T/s3.png"
 expect 2 "$F" render --builtin --shade softshadow --reference-out "$T/r.bmp" --out "$T/s3.png"
 [ ! -e "$T/s3.png" ] && ok || bad "a refused render left an output file"
+# Whitted: MTL mirrors and glass, large packets, their flags
+expect 0 "$F" render "$SHARED/scenes/museum/museum.obj.zst" --size 64x48 --shade whitted --out "$T/w.png"
+[ -s "$T/w.png" ] && grep -q 'mirror_tris=[1-9]' "$T/out" && ok || bad "whitted museum render"
+expect 0 "$F" render --builtin --size 40x40 --shade whitted --mirror all --depth 2 --packet 8 --traversal partition --cull corners --out "$T/w2.pfm"
+expect 2 "$F" render --builtin --shade whitted --mirror no_such --out "$T/w3.png"
+expect 2 "$F" render --builtin --shade whitted --glass all --out "$T/w3.png"
+expect 2 "$F" render --builtin --shade whitted --depth 0 --out "$T/w3.png"
+expect 2 "$F" render --builtin --shade whitted --packet 12 --out "$T/w3.png"
+expect 2 "$F" render --builtin --shade whitted --traversal sideways --out "$T/w3.png"
+expect 2 "$F" render --builtin --shade whitted --cull maybe --out "$T/w3.png"
+[ ! -e "$T/w3.png" ] && ok || bad "a failed whitted render left an output file"
+expect 0 "$F" bench --builtin --size 64x64 --workload whitted --mode packet4x4 --traversal masked --cull planes --repeat 1 --mirror all
+grep -q 'mode=packet4x4/masked/planes' "$T/out" && ok || bad "bench packet4x4 line"
+expect 0 "$F" bench "$SHARED/scenes/museum/museum.obj.zst" --size 64x64 --workload whitted --mode packet32x32 --tracer both --repeat 1
+grep -q 'tracer=embree' "$T/out" && grep -q 'workload=whitted tracer=frusta' "$T/out" && ok || bad "bench whitted both tracers"
 expect 0 "$F" bench --builtin --size 32x32 --workload soft16 --mode mft --repeat 1 --mft-leaf 8 --shrink off --light-sets cells
 grep -q 'mode=mft' "$T/out" && ok || bad "bench mft line"
 expect 2 "$F" bench --builtin --workload soft16 --mode mft --mft-leaf 16

@@ -1,0 +1,130 @@
+/*
+ * The Whitted renderer on kitchen and museum (their MTL mirrors and glass):
+ * every packet the engine hands to the large-packet tracer (camera,
+ * shadow, reflection and refraction packets) is traced again ray by ray by
+ * the single-ray kernel, and the answers must agree (a disagreement must be
+ * a ray within rounding of an edge or of tnear/tfar), for every packet size
+ * and traversal, culls on and off. The rays really are Whitted's: there
+ * are secondary rays of every kind.
+ */
+#include <string.h>
+#include "api/scene.h"
+#include "render/camera.h"
+#include "render/views.h"
+#include "render/whitted.h"
+#include "render/workload.h"
+#include "test_util.h"
+
+typedef struct checker {
+  fr_tracer inner;
+  const fr_scene *s;
+  long rays, occluded_rays, disagree;
+} checker;
+
+static void check_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
+  checker *c = ctx;
+  fr_ray *copy = malloc(n * sizeof *copy);
+  memcpy(copy, rays, n * sizeof *copy);
+  c->inner.intersect(c->inner.ctx, rays, hits, n, coherent);
+  mesh_ref m = scene_mesh(c->s);
+  for (size_t i = 0; i < n; i++) {
+    fr_hit h;
+    fr_intersect1(c->s, &copy[i], &h);
+    c->rays++;
+    if (h.prim == hits[i].prim && (h.prim == FR_INVALID_ID || fabsf(h.t - hits[i].t) <= 1e-4f * fmaxf(1.0f, h.t))) continue;
+    if (h.prim != FR_INVALID_ID && hits[i].prim != FR_INVALID_ID && fabsf(h.t - hits[i].t) <= 1e-4f * fmaxf(1.0f, h.t)) continue;
+    c->disagree++;
+    if (!ambiguous(&m, &copy[i]))
+      fail_msg("ray %zu of a packet of %zu: packet prim %u t %g, single prim %u t %g", i, n, hits[i].prim, hits[i].t,
+               h.prim, h.t);
+  }
+  free(copy);
+}
+
+static void check_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
+  checker *c = ctx;
+  fr_ray *copy = malloc(n * sizeof *copy);
+  memcpy(copy, rays, n * sizeof *copy);
+  c->inner.occluded(c->inner.ctx, rays, occ, n, coherent);
+  mesh_ref m = scene_mesh(c->s);
+  for (size_t i = 0; i < n; i++) {
+    c->occluded_rays++;
+    if (fr_occluded1(c->s, &copy[i]) == occ[i]) continue;
+    c->disagree++;
+    if (!ambiguous(&m, &copy[i])) fail_msg("shadow ray %zu of %zu: packet %d, single %d", i, n, occ[i], !occ[i]);
+  }
+  free(copy);
+}
+
+static void check_scene(const char *name) {
+  const char *root = getenv("FRUSTA_SHARED");
+  char path[1024];
+  snprintf(path, sizeof path, "%s/scenes/%s/%s.obj.zst", root ? root : "../shared", name, name);
+  fr_scene *s;
+  if (fr_scene_load(path, &s) != FR_OK) fail_msg("%s", fr_last_error());
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  fr_whitted_mats mats;
+  assert_int_equal(fr_whitted_mats_build(s, NULL, NULL, &mats), FR_OK);
+  size_t nm, ng;
+  fr_whitted_mats_census(s, &mats, &nm, &ng);
+  assert_true(nm > 0 && ng > 0);
+  fr_workload w;
+  memset(&w, 0, sizeof w);
+  w.kind = FR_WL_WHITTED;
+  w.scene = s;
+  assert_true(fr_view_lookup(name, &w.view));
+  assert_int_equal(fr_camera_setup(&w.cam, w.view.eye, w.view.at, w.view.up, w.view.fov, 192, 144), FR_OK);
+  float lo[3], hi[3];
+  fr_scene_bounds(s, lo, hi);
+  w.eps = 1e-4f * sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  w.threads = 1;
+  w.mats = &mats;
+  w.max_depth = 4;
+  static const struct { int side; fr_lp_traversal t; fr_cull c; } configs[] = {
+      {2, FR_LP_MASKED, FR_CULL_CORNERS}, {4, FR_LP_PARTITION, FR_CULL_PLANES}, {8, FR_LP_RANGED, FR_CULL_IA},
+      {16, FR_LP_RANGED, FR_CULL_OFF},    {16, FR_LP_PARTITION, FR_CULL_CORNERS}, {32, FR_LP_MASKED, FR_CULL_CORNERS}};
+  for (size_t k = 0; k < sizeof configs / sizeof configs[0]; k++) {
+    fr_lp_tracer lpc = {s, &s->bvh2, {configs[k].t, configs[k].c}, configs[k].side};
+    checker c = {fr_tracer_lp(&lpc), s, 0, 0, 0};
+    fr_tracer t = {&c, check_intersect, check_occluded, NULL, NULL, configs[k].side};
+    fr_workload_result r = fr_workload_run(&w, &t);
+    assert_int_equal(r.rays, (uint64_t)(c.rays + c.occluded_rays));
+    /* secondary rays: more closest-hit rays than pixels, and shadow rays */
+    assert_true(c.rays > 192 * 144 && c.occluded_rays > 0);
+    print_message("%s %dx%d %s/%s: %ld closest-hit rays, %ld shadow rays, %ld disagreements (all at edges or range ends)\n",
+                  name, configs[k].side, configs[k].side, fr_lp_traversal_name(configs[k].t), fr_cull_name(configs[k].c),
+                  c.rays, c.occluded_rays, c.disagree);
+  }
+  fr_whitted_mats_free(&mats);
+  fr_scene_release(s);
+}
+
+static void test_kitchen(void **state) { (void)state; check_scene("kitchen"); }
+static void test_museum(void **state) { (void)state; check_scene("museum"); }
+
+/* Material lists: unknown names are errors, "all" mirrors everything. */
+static void test_materials(void **state) {
+  (void)state;
+  fr_scene *s;
+  assert_int_equal(fr_scene_builtin(&s), FR_OK);
+  fr_whitted_mats m;
+  assert_int_equal(fr_whitted_mats_build(s, "no_such_material", NULL, &m), FR_ERR_ARG);
+  assert_non_null(strstr(fr_last_error(), "no_such_material"));
+  assert_int_equal(fr_whitted_mats_build(s, NULL, "all", &m), FR_ERR_ARG);
+  assert_int_equal(fr_whitted_mats_build(s, "all", NULL, &m), FR_OK);
+  size_t nm, ng;
+  fr_whitted_mats_census(s, &m, &nm, &ng);
+  assert_int_equal(nm, fr_scene_triangle_count(s));
+  assert_int_equal(ng, 0);
+  fr_whitted_mats_free(&m);
+  fr_scene_release(s);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_materials),
+      cmocka_unit_test(test_kitchen),
+      cmocka_unit_test(test_museum),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
