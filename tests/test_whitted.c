@@ -21,10 +21,17 @@ typedef struct checker {
   long rays, occluded_rays, disagree;
 } checker;
 
+/* the tracer may overwrite its rays: keep a copy to re-trace */
+static fr_ray *copy_rays(const fr_ray *rays, size_t n) {
+  fr_ray *copy = malloc(n * sizeof *copy);
+  assert_non_null(copy);
+  memcpy(copy, rays, n * sizeof *copy);
+  return copy;
+}
+
 static void check_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
   checker *c = ctx;
-  fr_ray *copy = malloc(n * sizeof *copy);
-  memcpy(copy, rays, n * sizeof *copy);
+  fr_ray *copy = copy_rays(rays, n);
   c->inner.intersect(c->inner.ctx, rays, hits, n, coherent);
   mesh_ref m = scene_mesh(c->s);
   for (size_t i = 0; i < n; i++) {
@@ -43,8 +50,7 @@ static void check_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int
 
 static void check_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
   checker *c = ctx;
-  fr_ray *copy = malloc(n * sizeof *copy);
-  memcpy(copy, rays, n * sizeof *copy);
+  fr_ray *copy = copy_rays(rays, n);
   c->inner.occluded(c->inner.ctx, rays, occ, n, coherent);
   mesh_ref m = scene_mesh(c->s);
   for (size_t i = 0; i < n; i++) {

@@ -399,32 +399,36 @@ static fr_lpacket *thread_packet(void) {
   return lp_packet;
 }
 
-static void lp_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
-  const fr_lp_tracer *c = ctx;
+/* consecutive packets of side x side rays; closest hits into hits, or any hits into occ */
+static void lp_trace(const fr_lp_tracer *c, fr_ray *rays, fr_hit *hits, uint8_t *occ, size_t n) {
   fr_lpacket *p = thread_packet();
   const size_t size = (size_t)c->side * (size_t)c->side;
-  (void)coherent;
   for (size_t a = 0; a < n; a += size) {
     int m = (int)(n - a < size ? n - a : size);
-    if (!p) { fr_intersect_stream(c->scene, rays + a, hits + a, (size_t)m); continue; }
+    if (!p) { /* no memory for the packet: the same answers from the streams */
+      if (occ) fr_occluded_stream(c->scene, rays + a, occ + a, (size_t)m);
+      else fr_intersect_stream(c->scene, rays + a, hits + a, (size_t)m);
+      continue;
+    }
     fr_lpacket_load(p, rays + a, m);
-    fr_lp_active()->intersect(c->bvh, &c->opts, p);
-    fr_lpacket_hits(p, c->bvh, hits + a);
+    if (occ) {
+      fr_lp_active()->occluded(c->bvh, &c->opts, p);
+      for (int i = 0; i < m; i++) occ[a + (size_t)i] = (uint8_t)((p->occ[i / 16] >> (i % 16)) & 1);
+    } else {
+      fr_lp_active()->intersect(c->bvh, &c->opts, p);
+      fr_lpacket_hits(p, c->bvh, hits + a);
+    }
   }
 }
 
-static void lp_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
-  const fr_lp_tracer *c = ctx;
-  fr_lpacket *p = thread_packet();
-  const size_t size = (size_t)c->side * (size_t)c->side;
+static void lp_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
   (void)coherent;
-  for (size_t a = 0; a < n; a += size) {
-    int m = (int)(n - a < size ? n - a : size);
-    if (!p) { fr_occluded_stream(c->scene, rays + a, occ + a, (size_t)m); continue; }
-    fr_lpacket_load(p, rays + a, m);
-    fr_lp_active()->occluded(c->bvh, &c->opts, p);
-    for (int i = 0; i < m; i++) occ[a + (size_t)i] = (uint8_t)((p->occ[i / 16] >> (i % 16)) & 1);
-  }
+  lp_trace(ctx, rays, hits, NULL, n);
+}
+
+static void lp_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
+  (void)coherent;
+  lp_trace(ctx, rays, NULL, occ, n);
 }
 
 fr_tracer fr_tracer_lp(const fr_lp_tracer *ctx) {
