@@ -12,7 +12,6 @@
  */
 #include <math.h>
 #include <string.h>
-#include <stdlib.h>
 #include "base/simd.h"
 #include "base/simd_packet.h"
 #include "trace/counters.h"
