@@ -224,7 +224,7 @@ int cmd_bench(int argc, char **argv) {
       for (int m = 0; m < N_FRUSTA_MODES; m++)
         if (all_modes || !strcmp(mode, frusta_modes[m])) {
           set_frusta_mode(s, m, &topt, width);
-          fr_lp_tracer lpc = {s, &s->bvh2, wo.lp, 2 << (m - MODE_LARGE)};
+          fr_lp_tracer lpc = {s, &s->bvh2, wo.lp, m >= MODE_LARGE ? 2 << (m - MODE_LARGE) : 0};
           fr_tracer tl = m >= MODE_LARGE ? fr_tracer_lp(&lpc) : t;
           char name[96];
           if (m >= MODE_LARGE)
