@@ -220,6 +220,15 @@ FR_INLINE unsigned tri_cull(const frusta *F, const fr_bvh2_tri *r, unsigned m, i
   return m & ~cull;
 }
 
+/* tri_cull for a leaf's triangle, counted (the paper's Table 1) */
+FR_INLINE unsigned leaf_tri_cull(const frusta *F, const fr_bvh2_tri *r, unsigned m, int corner_rays, tri_frusta *X) {
+  FR_COUNT(mft_tris, 1);
+  FR_COUNT(mft_tri_frusta, __builtin_popcount(m));
+  unsigned left = tri_cull(F, r, m, corner_rays, X);
+  FR_COUNT(mft_tri_left, __builtin_popcount(left));
+  return left;
+}
+
 /* Frustum f's 16 rays against the triangle of X: the rays hit in (tnear,
  * tcur); *t, *u, *v their hits. */
 FR_INLINE unsigned ray_test(const frusta *F, const tri_frusta *X, const fr_bvh2_tri *r, int f, vpf tcur,
@@ -342,10 +351,7 @@ static void occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_
       unsigned rays[16], m = leaf_rays(&F, &e, e.mask & alive, active, NULL, rays);
       for (uint32_t i = first; i < first + count && m; i++) {
         const fr_bvh2_tri *r = &b->tris[i];
-        FR_COUNT(mft_tris, 1);
-        FR_COUNT(mft_tri_frusta, __builtin_popcount(m));
-        unsigned left = tri_cull(&F, r, m, opt->corner_rays, &X);
-        FR_COUNT(mft_tri_left, __builtin_popcount(left));
+        unsigned left = leaf_tri_cull(&F, r, m, opt->corner_rays, &X);
         for (; left; left &= left - 1) {
           int f = __builtin_ctz(left);
           unsigned hit = ray_test(&F, &X, r, f, vp(F.tfar[f]), rays[f] & active[f], NULL, NULL, NULL);
@@ -399,10 +405,7 @@ static void intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft
       unsigned changed = 0, rays[16], m = leaf_rays(&F, &e, e.mask, all, (const float(*)[16])H->t, rays);
       for (uint32_t i = first; i < first + count && m; i++) {
         const fr_bvh2_tri *r = &b->tris[i];
-        FR_COUNT(mft_tris, 1);
-        FR_COUNT(mft_tri_frusta, __builtin_popcount(m));
-        unsigned left = tri_cull(&F, r, m, opt->corner_rays, &X);
-        FR_COUNT(mft_tri_left, __builtin_popcount(left));
+        unsigned left = leaf_tri_cull(&F, r, m, opt->corner_rays, &X);
         for (; left; left &= left - 1) {
           int f = __builtin_ctz(left);
           vpf tb = vp_load(H->t[f]), t, u, v;
