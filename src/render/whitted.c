@@ -127,22 +127,22 @@ typedef struct fr_whitted_scratch {
   vec3 colour[WT_PIX];
 } fr_whitted_scratch;
 
+/* realloc that keeps the old block on failure */
+static int grow(void **p, size_t bytes) {
+  void *q = realloc(*p, bytes);
+  if (!q) return 0;
+  *p = q;
+  return 1;
+}
+
 static int reserve(fr_whitted_scratch *S, size_t n) {
   if (n <= S->cap) return 1;
   size_t cap = S->cap ? S->cap : 4096;
   while (cap < n) cap *= 2;
-  wray *c = realloc(S->cur, cap * sizeof *c), *nx = c ? realloc(S->next, cap * sizeof *nx) : NULL;
-  if (c) S->cur = c;
-  if (nx) S->next = nx;
-  wray *sh = nx ? realloc(S->shadow, cap * sizeof *sh) : NULL;
-  if (sh) S->shadow = sh;
-  fr_ray *r = sh ? realloc(S->rays, cap * sizeof *r) : NULL;
-  if (r) S->rays = r;
-  fr_hit *h = r ? realloc(S->hits, cap * sizeof *h) : NULL;
-  if (h) S->hits = h;
-  uint8_t *o = h ? realloc(S->occ, cap) : NULL;
-  if (o) S->occ = o;
-  if (!o) return 0;
+  if (!grow((void **)&S->cur, cap * sizeof *S->cur) || !grow((void **)&S->next, cap * sizeof *S->next) ||
+      !grow((void **)&S->shadow, cap * sizeof *S->shadow) || !grow((void **)&S->rays, cap * sizeof *S->rays) ||
+      !grow((void **)&S->hits, cap * sizeof *S->hits) || !grow((void **)&S->occ, cap))
+    return 0;
   S->cap = cap;
   return 1;
 }
