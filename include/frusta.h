@@ -76,7 +76,31 @@ fr_error fr_scene_builtin(fr_scene **out);
 /* A scene from arrays (copied). idx holds 3 indices per triangle. */
 fr_error fr_scene_from_arrays(const float *xyz, size_t nverts, const uint32_t *idx,
                               size_t ntris, fr_scene **out);
+/* An empty scene, for adding spheres and materials to. */
+fr_error fr_scene_new(fr_scene **out);
 void fr_scene_release(fr_scene *s);
+
+/* ---- spheres -------------------------------------------------------------------
+ * Analytic spheres beside the triangles, added before fr_scene_commit. A hit
+ * on sphere i reports prim = fr_scene_triangle_count(s) + i, u = v = 0 and
+ * ng = hit point - centre (length: the radius); from inside a sphere a ray
+ * hits its far side. Every tracing call sees them. The multi-frusta kernels
+ * (frusta bench --mode mft, render --shade softshadow) do not, and refuse
+ * scenes with spheres. */
+fr_error fr_scene_add_sphere(fr_scene *s, const float center[3], float radius, uint32_t material);
+size_t fr_scene_sphere_count(const fr_scene *s);
+int fr_scene_sphere(const fr_scene *s, size_t i, float center[3], float *radius); /* 0 if out of range */
+/* Adds a material (or overwrites the one of the same name); its index in *index. */
+fr_error fr_scene_add_material(fr_scene *s, const fr_material *m, uint32_t *index);
+/* Material of any hit prim, triangle or sphere (FR_INVALID_ID if none). */
+uint32_t fr_scene_prim_material(const fr_scene *s, uint32_t prim);
+/* Unnormalized geometric normal of prim at point p (p matters for spheres);
+ * 0 if prim is not in the scene. */
+int fr_scene_geometric_normal(const fr_scene *s, uint32_t prim, const float p[3], float n[3]);
+/* The procedural sphereflake (after Haines' SPD "balls"): depth 3 gives 820
+ * spheres (mirror material "flake") above a floor of two triangles (material
+ * "floor"), seen with spd_balls' view. depth 0..5. */
+fr_error fr_scene_builtin_sphereflake(int depth, fr_scene **out);
 
 /* Builds the acceleration structures; must be called before tracing. */
 fr_error fr_scene_commit(fr_scene *s);

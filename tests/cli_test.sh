@@ -123,7 +123,7 @@ expect 2 "$F" render --builtin --shade softshadow --reference-out "$T/r.bmp" --o
 [ ! -e "$T/s3.png" ] && ok || bad "a refused render left an output file"
 # Whitted: MTL mirrors and glass, large packets, their flags
 expect 0 "$F" render "$SHARED/scenes/museum/museum.obj.zst" --size 64x48 --shade whitted --out "$T/w.png"
-[ -s "$T/w.png" ] && grep -q 'mirror_tris=[1-9]' "$T/out" && ok || bad "whitted museum render"
+[ -s "$T/w.png" ] && grep -q 'mirror_prims=[1-9]' "$T/out" && ok || bad "whitted museum render"
 expect 0 "$F" render --builtin --size 40x40 --shade whitted --mirror all --depth 2 --packet 8 --traversal partition --cull corners --out "$T/w2.pfm"
 expect 2 "$F" render --builtin --shade whitted --mirror no_such --out "$T/w3.png"
 expect 2 "$F" render --builtin --shade whitted --glass all --out "$T/w3.png"
@@ -136,6 +136,14 @@ expect 0 "$F" bench --builtin --size 64x64 --workload whitted --mode packet4x4 -
 grep -q 'mode=packet4x4/masked/planes' "$T/out" && ok || bad "bench packet4x4 line"
 expect 0 "$F" bench "$SHARED/scenes/museum/museum.obj.zst" --size 64x64 --workload whitted --mode packet32x32 --tracer both --repeat 1
 grep -q 'tracer=embree' "$T/out" && grep -q 'workload=whitted tracer=frusta' "$T/out" && ok || bad "bench whitted both tracers"
+# analytic spheres: the sphereflake; multi-frusta tracing refuses them
+expect 0 "$F" render --builtin=sphereflake --size 48x48 --shade whitted --glass flake --out "$T/sf.png"
+[ -s "$T/sf.png" ] && grep -q 'glass_prims=820' "$T/out" && ok || bad "sphereflake whitted render"
+expect 0 "$F" bench --builtin=sphereflake --size 32x32 --workload whitted --mode all --tracer both --repeat 1
+grep -q 'scene=sphereflake.*tracer=embree' "$T/out" && ok || bad "sphereflake bench with embree"
+expect 2 "$F" bench --builtin=sphereflake --size 32x32 --workload primary --mode mft --repeat 1
+expect 2 "$F" render --builtin=cubes --out "$T/sf2.png"
+[ ! -e "$T/sf2.png" ] && ok || bad "an unknown built-in scene left an output file"
 expect 0 "$F" bench --builtin --size 32x32 --workload soft16 --mode mft --repeat 1 --mft-leaf 8 --shrink off --light-sets cells
 grep -q 'mode=mft' "$T/out" && ok || bad "bench mft line"
 expect 2 "$F" bench --builtin --workload soft16 --mode mft --mft-leaf 16

@@ -1,6 +1,6 @@
 /*
- * Ray-by-ray agreement with Embree (robust mode) on the built-in scene and on
- * every scene of ../shared/scenes, by the rule of rayfile.md: camera rays,
+ * Ray-by-ray agreement with Embree (robust mode) on the built-in scene, the
+ * sphereflake (analytic spheres), and every scene of ../shared/scenes, by the rule of rayfile.md: camera rays,
  * shadow rays from their hits, hemisphere rays, and random rays, at every ISA.
  */
 #include <stdio.h>
@@ -100,7 +100,9 @@ static long check_packet_modes(fr_scene *s, const fr_ray *rays, size_t n, const 
 
 static void check_scene(const char *path) {
   fr_scene *s;
-  fr_error e = strcmp(path, "--builtin") == 0 ? fr_scene_builtin(&s) : fr_scene_load(path, &s);
+  fr_error e = strcmp(path, "--builtin") == 0               ? fr_scene_builtin(&s)
+               : strcmp(path, "--builtin=sphereflake") == 0 ? fr_scene_builtin_sphereflake(3, &s)
+                                                            : fr_scene_load(path, &s);
   if (e) fail_msg("%s: %s", path, fr_last_error());
   assert_int_equal(fr_scene_commit(s), FR_OK);
   ebr_scene *eb;
@@ -161,6 +163,8 @@ static void check_scene(const char *path) {
 }
 
 static void test_builtin(void **st) { (void)st; check_scene("--builtin"); }
+/* analytic spheres against Embree's sphere points */
+static void test_sphereflake(void **st) { (void)st; check_scene("--builtin=sphereflake"); }
 
 static void check_scene_path(const char *path, void *ctx) { (void)ctx; check_scene(path); }
 
@@ -170,6 +174,7 @@ static void test_shared_scenes(void **st) {
 }
 
 int main(void) {
-  const struct CMUnitTest tests[] = {cmocka_unit_test(test_builtin), cmocka_unit_test(test_shared_scenes)};
+  const struct CMUnitTest tests[] = {cmocka_unit_test(test_builtin), cmocka_unit_test(test_sphereflake),
+                                     cmocka_unit_test(test_shared_scenes)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -24,6 +24,11 @@ typedef struct tally { long rays, packets, disagree, self; } tally;
 
 static fr_lpacket *lp;
 
+static fr_lp_scene geom(const fr_scene *s) {
+  fr_lp_scene g = {&s->bvh2, &s->sphere_bvh, fr_scene_sphere_base(s)};
+  return g;
+}
+
 /* A ray that starts on a surface (tnear > 0) and meets a surface within a
  * few tnear of its start in one test and not in the other: a grazing ray
  * leaving its own triangle, where t is the rounding error of the plane
@@ -36,8 +41,9 @@ static int self_hit(const fr_scene *s, const fr_ray *r) {
   fr_hit h;
   fr_lp_opts o = {FR_LP_MASKED, FR_CULL_OFF};
   fr_lpacket_load(lp, r, 1);
-  fr_lp_scalar.intersect(&s->bvh2, &o, lp);
-  fr_lpacket_hits(lp, &s->bvh2, &h);
+  fr_lp_scene g = geom(s);
+  fr_lp_scalar.intersect(&g, &o, lp);
+  fr_lpacket_hits(lp, &g, &h);
   fr_hit h1;
   fr_intersect1(s, r, &h1);
   return fminf(h.t, h1.t) < 10.0f * r->tnear;
@@ -95,9 +101,10 @@ static void check_packet(const fr_scene *s, const fr_ray *rays, int n, int occlu
       for (int i = 0; i < 3; i++) {
         if (!fr_isa_supported(isas[i])) continue;
         fr_lp_opts o = {(fr_lp_traversal)t, (fr_cull)c};
+        fr_lp_scene g = geom(s);
         fr_lpacket_load(lp, rays, n);
         if (occluded) {
-          isa_fns[i]->occluded(&s->bvh2, &o, lp);
+          isa_fns[i]->occluded(&g, &o, lp);
           for (int k = 0; k < n; k++) {
             int bit = (lp->occ[k / 16] >> (k % 16)) & 1;
             if (first) ref_occ[k] = (uint8_t)bit;
@@ -106,8 +113,8 @@ static void check_packet(const fr_scene *s, const fr_ray *rays, int n, int occlu
                        fr_cull_name(o.cull), fr_isa_name(isas[i]), k, n, bit, ref_occ[k]);
           }
         } else {
-          isa_fns[i]->intersect(&s->bvh2, &o, lp);
-          fr_lpacket_hits(lp, &s->bvh2, first ? ref : hits);
+          isa_fns[i]->intersect(&g, &o, lp);
+          fr_lpacket_hits(lp, &g, first ? ref : hits);
           if (!first)
             for (int k = 0; k < n; k++)
               if (hits[k].prim != ref[k].prim || memcmp(&hits[k].t, &ref[k].t, sizeof(float)))
@@ -209,10 +216,87 @@ static void test_builtin(void **state) {
   fr_free_aligned(lp);
 }
 
+/* Spheres: the sphereflake, and random spheres among random triangles (some
+ * rays start inside a sphere, some on one). Sphere tests are the same float
+ * operations in both paths, so a sphere hit must agree exactly. */
+static void test_spheres(void **state) {
+  (void)state;
+  lp = fr_alloc_aligned(sizeof *lp, 64);
+  fr_rng g = fr_rng_seed(17, 0);
+  tally tl = {0, 0, 0, 0};
+  fr_scene *s;
+  assert_int_equal(fr_scene_builtin_sphereflake(3, &s), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  fr_camera cam;
+  fr_camera_setup(&cam, v3(2.1f, 1.3f, 1.7f), v3(0, 0, 0), v3(0, 0, 1), 45.0f, 128, 128);
+  for (int k = 0; k < 4; k++) coherent_packets(s, &cam, v3(4, 3, 2), 1e-4f, &g, &tl);
+  fr_scene_release(s);
+  for (int sc = 0; sc < 4; sc++) {
+    vec3 center = sc == 3 ? v3(1000, -2000, 500) : v3(0, 0, 0);
+    scene_data sd = make_scene(&g, 300, center, 1.0f);
+    s = commit_scene_with(&sd, 0);
+    for (int i = 0; i < 200; i++) {
+      float c[3] = {center.x + 2.0f * fr_rng_float(&g) - 1.0f, center.y + 2.0f * fr_rng_float(&g) - 1.0f,
+                    center.z + 2.0f * fr_rng_float(&g) - 1.0f};
+      assert_int_equal(fr_scene_add_sphere(s, c, 0.01f + 0.2f * fr_rng_float(&g), FR_INVALID_ID), FR_OK);
+    }
+    assert_int_equal(fr_scene_commit(s), FR_OK);
+    static fr_ray rays[FR_LP_MAX];
+    for (int k = 0; k < 6; k++) {
+      int n = 1 + (int)(fr_rng_u32(&g) % FR_LP_MAX);
+      for (int i = 0; i < n; i++) {
+        uint32_t src;
+        rays[i] = random_ray(&g, center, 1.0f, &sd, (int)(fr_rng_u32(&g) % 4), &src);
+      }
+      check_packet(s, rays, n, k & 1, &tl);
+    }
+    fr_camera_setup(&cam, v3_add(center, v3(2.5f, 1.5f, 3.0f)), center, v3(0, 1, 0), 50.0f, 64, 64);
+    coherent_packets(s, &cam, v3_add(center, v3(-1, 3, 1)), 1e-4f, &g, &tl);
+    fr_scene_release(s);
+    free_scene(&sd);
+  }
+  print_message("spheres among triangles: %ld packets, %ld rays, %ld disagreements with single rays (at triangle edges)\n",
+                tl.packets, tl.rays, tl.disagree);
+  /* spheres alone (the triangle trees are empty): no edges, so no
+   * disagreement at all, for rays from anywhere, from inside spheres and
+   * from their surfaces */
+  tally ts = {0, 0, 0, 0};
+  assert_int_equal(fr_scene_new(&s), FR_OK);
+  fr_sphere sp[300];
+  for (int i = 0; i < 300; i++) {
+    sp[i] = (fr_sphere){{2.0f * fr_rng_float(&g) - 1.0f, 2.0f * fr_rng_float(&g) - 1.0f, 2.0f * fr_rng_float(&g) - 1.0f},
+                        0.001f + 0.2f * fr_rng_float(&g)};
+    assert_int_equal(fr_scene_add_sphere(s, sp[i].c, sp[i].r, FR_INVALID_ID), FR_OK);
+  }
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  assert_int_equal(fr_scene_triangle_count(s), 0);
+  static fr_ray rays[FR_LP_MAX];
+  for (int k = 0; k < 12; k++) {
+    int n = 1 + (int)(fr_rng_u32(&g) % FR_LP_MAX);
+    for (int i = 0; i < n; i++) {
+      vec3 d = v3(2.0f * fr_rng_float(&g) - 1.0f, 2.0f * fr_rng_float(&g) - 1.0f, 2.0f * fr_rng_float(&g) - 1.0f);
+      vec3 o = v3(3.0f * fr_rng_float(&g) - 1.5f, 3.0f * fr_rng_float(&g) - 1.5f, 3.0f * fr_rng_float(&g) - 1.5f);
+      const fr_sphere *q = &sp[fr_rng_u32(&g) % 300];
+      int kind = (int)(fr_rng_u32(&g) % 3);
+      if (kind == 1) o = v3(q->c[0], q->c[1], q->c[2]); /* from inside */
+      if (kind == 2) o = v3_add(v3(q->c[0], q->c[1], q->c[2]), v3_scale(v3_norm(d), q->r)); /* from the surface */
+      rays[i] = (fr_ray){{o.x, o.y, o.z}, kind == 2 ? 1e-4f : 0.0f, {d.x, d.y, d.z}, k % 3 ? INFINITY : 0.7f};
+    }
+    check_packet(s, rays, n, k & 1, &ts);
+  }
+  fr_camera_setup(&cam, v3(2.5f, 1.5f, 3.0f), v3(0, 0, 0), v3(0, 1, 0), 50.0f, 64, 64);
+  coherent_packets(s, &cam, v3(-1, 3, 1), 1e-4f, &g, &ts);
+  assert_int_equal(ts.disagree, 0);
+  fr_scene_release(s);
+  print_message("spheres alone: %ld packets, %ld rays, %ld disagreements\n", ts.packets, ts.rays, ts.disagree);
+  fr_free_aligned(lp);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_random_scenes),
       cmocka_unit_test(test_builtin),
+      cmocka_unit_test(test_spheres),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -62,18 +62,14 @@ static void check_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int 
   free(copy);
 }
 
-static void check_scene(const char *name) {
-  const char *root = getenv("FRUSTA_SHARED");
-  char path[1024];
-  snprintf(path, sizeof path, "%s/scenes/%s/%s.obj.zst", root ? root : "../shared", name, name);
-  fr_scene *s;
-  if (fr_scene_load(path, &s) != FR_OK) fail_msg("%s", fr_last_error());
-  assert_int_equal(fr_scene_commit(s), FR_OK);
+/* Whitted on scene s (view of name) with its materials as mirror and glass
+ * say (NULL: the defaults), which must give mirrors and, if want_glass, glass. */
+static void check_whitted(fr_scene *s, const char *name, const char *mirror, const char *glass, int want_glass) {
   fr_whitted_mats mats;
-  assert_int_equal(fr_whitted_mats_build(s, NULL, NULL, &mats), FR_OK);
+  assert_int_equal(fr_whitted_mats_build(s, mirror, glass, &mats), FR_OK);
   size_t nm, ng;
   fr_whitted_mats_census(s, &mats, &nm, &ng);
-  assert_true(nm > 0 && ng > 0);
+  assert_true((nm > 0 || !mirror) && (ng > 0 || !want_glass));
   fr_workload w;
   memset(&w, 0, sizeof w);
   w.kind = FR_WL_WHITTED;
@@ -90,7 +86,7 @@ static void check_scene(const char *name) {
       {2, FR_LP_MASKED, FR_CULL_CORNERS}, {4, FR_LP_PARTITION, FR_CULL_PLANES}, {8, FR_LP_RANGED, FR_CULL_IA},
       {16, FR_LP_RANGED, FR_CULL_OFF},    {16, FR_LP_PARTITION, FR_CULL_CORNERS}, {32, FR_LP_MASKED, FR_CULL_CORNERS}};
   for (size_t k = 0; k < sizeof configs / sizeof configs[0]; k++) {
-    fr_lp_tracer lpc = {s, &s->bvh2, {configs[k].t, configs[k].c}, configs[k].side};
+    fr_lp_tracer lpc = {s, {&s->bvh2, &s->sphere_bvh, fr_scene_sphere_base(s)}, {configs[k].t, configs[k].c}, configs[k].side};
     checker c = {fr_tracer_lp(&lpc), s, 0, 0, 0};
     fr_tracer t = {&c, check_intersect, check_occluded, NULL, NULL, configs[k].side};
     fr_workload_result r = fr_workload_run(&w, &t);
@@ -102,11 +98,32 @@ static void check_scene(const char *name) {
                   c.rays, c.occluded_rays, c.disagree);
   }
   fr_whitted_mats_free(&mats);
+}
+
+static void check_scene(const char *name) {
+  const char *root = getenv("FRUSTA_SHARED");
+  char path[1024];
+  snprintf(path, sizeof path, "%s/scenes/%s/%s.obj.zst", root ? root : "../shared", name, name);
+  fr_scene *s;
+  if (fr_scene_load(path, &s) != FR_OK) fail_msg("%s", fr_last_error());
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  check_whitted(s, name, NULL, NULL, 1);
   fr_scene_release(s);
 }
 
 static void test_kitchen(void **state) { (void)state; check_scene("kitchen"); }
 static void test_museum(void **state) { (void)state; check_scene("museum"); }
+
+/* Analytic spheres: the sphereflake as mirrors, then as glass. */
+static void test_sphereflake(void **state) {
+  (void)state;
+  fr_scene *s;
+  assert_int_equal(fr_scene_builtin_sphereflake(3, &s), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  check_whitted(s, "sphereflake", "flake", NULL, 0);
+  check_whitted(s, "sphereflake", NULL, "flake", 1);
+  fr_scene_release(s);
+}
 
 /* Material lists: unknown names are errors, "all" mirrors everything. */
 static void test_materials(void **state) {
@@ -131,6 +148,7 @@ int main(void) {
       cmocka_unit_test(test_materials),
       cmocka_unit_test(test_kitchen),
       cmocka_unit_test(test_museum),
+      cmocka_unit_test(test_sphereflake),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -31,16 +31,16 @@ fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_le
   size_t inner = t->nprims;
   out->nodes = fr_alloc_aligned(fr_mul_size(inner, sizeof(fr_bvh2_node)), 64);
   out->prims = fr_alloc_aligned(fr_mul_size(t->nprims, sizeof(uint32_t)), 64);
-  out->tris = fr_alloc_aligned(fr_mul_size(t->nprims, sizeof(fr_bvh2_tri)), 64);
-  if (!out->nodes || !out->prims || !out->tris) {
+  if (m) out->tris = fr_alloc_aligned(fr_mul_size(t->nprims, sizeof(fr_bvh2_tri)), 64);
+  if (!out->nodes || !out->prims || (m && !out->tris)) {
     fr_bvh2_free(out);
     return fr_fail(FR_ERR_NOMEM, "BVH2: out of memory");
   }
   memset(out->nodes, 0, inner * sizeof(fr_bvh2_node));
-  memcpy(out->prims, t->prims, t->nprims * sizeof(uint32_t));
+  if (t->nprims) memcpy(out->prims, t->prims, t->nprims * sizeof(uint32_t));
   out->nprims = t->nprims;
   out->max_leaf = max_leaf;
-  for (size_t i = 0; i < t->nprims; i++) {
+  for (size_t i = 0; m && i < t->nprims; i++) {
     fr_bvh2_tri *r = &out->tris[i];
     const uint32_t *ix = m->idx + 3 * (size_t)t->prims[i];
     float *dst[3] = {r->v0, r->v1, r->v2};
@@ -67,6 +67,7 @@ void fr_bvh2_free(fr_bvh2 *b) {
   fr_free_aligned(b->nodes);
   fr_free_aligned(b->prims);
   fr_free_aligned(b->tris);
+  fr_free_aligned(b->spheres);
   memset(b, 0, sizeof *b);
 }
 

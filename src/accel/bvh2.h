@@ -9,6 +9,7 @@
 #include <stdint.h>
 #include "accel/bvh_build.h"
 #include "geom/mesh.h"
+#include "geom/sphere.h"
 
 /* child reference: inner node index, or FR_BVH2_LEAF | count << 27 | first */
 #define FR_BVH2_LEAF 0x80000000u
@@ -48,12 +49,14 @@ typedef struct fr_bvh2 {
   aabb bounds;
   uint32_t *prims;   /* triangle ids in leaf order */
   fr_bvh2_tri *tris; /* the same triangles, ready for the frusta kernels */
+  fr_sphere *spheres; /* a sphere tree (accel/sphere_bvh.h) has these instead */
   size_t nprims;
   int max_leaf;
 } fr_bvh2;
 
 /* Leaves are cut where a subtree has at most max_leaf triangles (4: the
- * regular tree; more: the shallow tree the frusta kernels may prefer). */
+ * regular tree; more: the shallow tree the frusta kernels may prefer).
+ * Without a mesh (m NULL) only the nodes and prims are made. */
 fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_leaf, fr_bvh2 *out);
 void fr_bvh2_free(fr_bvh2 *b);
 double fr_bvh2_sah(const fr_bvh2 *b);

@@ -238,7 +238,13 @@ static int job_cmp(const void *x, const void *y) {
 
 fr_error fr_build_sah(const aabb *boxes, const uint32_t *ids, size_t n, fr_build_tree *out) {
   memset(out, 0, sizeof *out);
-  if (n == 0) return fr_fail(FR_ERR_ARG, "BVH build: no primitives");
+  if (n == 0) { /* one empty leaf: a scene of spheres only has no triangles */
+    out->nodes = malloc(sizeof(fr_build_node));
+    if (!out->nodes) return fr_fail(FR_ERR_NOMEM, "BVH build: out of memory");
+    out->nodes[0] = (fr_build_node){aabb_empty(), -1, -1, 0, 0};
+    out->nnodes = 1;
+    return FR_OK;
+  }
   builder bd;
   bd.refs = malloc(fr_mul_size(n, sizeof(ref)));
   bd.nodes = malloc(fr_mul_size(2 * n, sizeof(fr_build_node)));

@@ -98,9 +98,10 @@ fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width,
   if (width != 4 && width != 8) return fr_fail(FR_ERR_ARG, "BVH width %d (4 or 8)", width);
   out->width = width;
   size_t node_bytes = width == 4 ? sizeof(fr_bvh4_node) : sizeof(fr_bvh8_node);
-  out->nodes = fr_alloc_aligned(fr_mul_size(t->nprims, node_bytes), 64);
-  out->tris = fr_alloc_aligned(fr_mul_size(t->nprims, sizeof(fr_tri4)), 64);
-  out->shev = fr_alloc_aligned(fr_mul_size(t->nprims, 4 * sizeof(fr_tri_shevtsov)), 64);
+  size_t np = t->nprims ? t->nprims : 1; /* an empty tree is one empty leaf */
+  out->nodes = fr_alloc_aligned(fr_mul_size(np, node_bytes), 64);
+  out->tris = fr_alloc_aligned(fr_mul_size(np, sizeof(fr_tri4)), 64);
+  out->shev = fr_alloc_aligned(fr_mul_size(np, 4 * sizeof(fr_tri_shevtsov)), 64);
   if (!out->nodes || !out->tris || !out->shev) {
     fr_bvhn_free(out);
     return fr_fail(FR_ERR_NOMEM, "BVH%d: out of memory", width);

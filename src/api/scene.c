@@ -10,6 +10,8 @@
 #include "io/import.h"
 #include "trace/bvh2_reference.h"
 #include "trace/kernels.h"
+#include "trace/sphere_traverse.h"
+#include "accel/sphere_bvh.h"
 
 static fr_scene *scene_new(void) {
   fr_scene *s = calloc(1, sizeof *s);
@@ -87,9 +89,32 @@ fr_error fr_scene_from_arrays(const float *xyz, size_t nverts, const uint32_t *i
   return FR_OK;
 }
 
+fr_error fr_scene_new(fr_scene **out) {
+  if (!out) return fr_fail(FR_ERR_ARG, "fr_scene_new: out is NULL");
+  *out = scene_new();
+  if (!*out) return fr_fail(FR_ERR_NOMEM, "out of memory");
+  snprintf((*out)->name, sizeof (*out)->name, "api");
+  return FR_OK;
+}
+
+fr_error fr_scene_builtin_sphereflake(int depth, fr_scene **out) {
+  if (!out) return fr_fail(FR_ERR_ARG, "fr_scene_builtin_sphereflake: out is NULL");
+  *out = NULL;
+  if (depth < 0 || depth > 5) return fr_fail(FR_ERR_ARG, "sphereflake depth %d (0..5)", depth);
+  fr_scene *s = scene_new();
+  if (!s) return fr_fail(FR_ERR_NOMEM, "out of memory");
+  fr_error e = fr_builtin_sphereflake(depth, &s->mesh, &s->spheres);
+  if (e) { fr_scene_release(s); return e; }
+  snprintf(s->name, sizeof s->name, "sphereflake");
+  *out = s;
+  return FR_OK;
+}
+
 void fr_scene_release(fr_scene *s) {
   if (!s) return;
   fr_mesh_free(&s->mesh);
+  fr_spheres_free(&s->spheres);
+  fr_bvh2_free(&s->sphere_bvh);
   fr_bvh2_free(&s->bvh2);
   fr_bvhn_free(&s->bvh4);
   fr_bvhn_free(&s->bvh8);
@@ -113,7 +138,11 @@ static fr_error build_tree(fr_scene *s, fr_build_tree *tree, size_t *count) {
     s->bounds = aabb_merge(s->bounds, b);
   }
   *count = n;
-  if (n == 0) { free(boxes); free(ids); return fr_fail(FR_ERR_FORMAT, "%s: every triangle is degenerate", s->name); }
+  if (n == 0 && s->spheres.n == 0) {
+    free(boxes);
+    free(ids);
+    return fr_fail(FR_ERR_FORMAT, "%s: %s", s->name, m->ntris ? "every triangle is degenerate" : "no triangles and no spheres");
+  }
   fr_error e = fr_build_sah(boxes, ids, n, tree);
   free(boxes);
   free(ids);
@@ -144,8 +173,13 @@ fr_error fr_scene_commit(fr_scene *s) {
   e = fr_bvh2_from_build(&tree, m, FR_BUILD_MAX_LEAF, &s->bvh2);
   if (!e) e = fr_bvhn_from_build(&tree, m, 4, &s->bvh4);
   if (!e) e = fr_bvhn_from_build(&tree, m, 8, &s->bvh8);
+  if (!e) e = fr_sphere_bvh_build(&s->spheres, &s->sphere_bvh);
   fr_build_tree_free(&tree);
-  if (e) { fr_bvh2_free(&s->bvh2); fr_bvhn_free(&s->bvh4); fr_bvhn_free(&s->bvh8); return e; }
+  if (e) {
+    fr_bvh2_free(&s->bvh2); fr_bvhn_free(&s->bvh4); fr_bvhn_free(&s->bvh8); fr_bvh2_free(&s->sphere_bvh);
+    return e;
+  }
+  s->bounds = aabb_merge(s->bounds, s->sphere_bvh.bounds);
   s->build_seconds = fr_seconds() - t0;
   s->committed = 1;
   return FR_OK;
@@ -164,11 +198,69 @@ uint32_t fr_scene_triangle_material(const fr_scene *s, uint32_t prim) {
   return s->mesh.mat[prim];
 }
 
+uint32_t fr_scene_prim_material(const fr_scene *s, uint32_t prim) {
+  if (!s || prim == FR_INVALID_ID) return FR_INVALID_ID;
+  if (prim < s->mesh.ntris) return fr_scene_triangle_material(s, prim);
+  size_t i = prim - s->mesh.ntris;
+  return i < s->spheres.n ? s->spheres.mat[i] : FR_INVALID_ID;
+}
+
+fr_error fr_scene_add_sphere(fr_scene *s, const float center[3], float radius, uint32_t material) {
+  if (!s || !center) return fr_fail(FR_ERR_ARG, "fr_scene_add_sphere: NULL argument");
+  if (s->committed) return fr_fail(FR_ERR_STATE, "fr_scene_add_sphere: scene already committed");
+  if (material != FR_INVALID_ID && material >= s->mesh.nmats)
+    return fr_fail(FR_ERR_ARG, "fr_scene_add_sphere: material %u of %zu", material, s->mesh.nmats);
+  return fr_spheres_add(&s->spheres, center, radius, material);
+}
+
+fr_error fr_scene_add_material(fr_scene *s, const fr_material *mat, uint32_t *index) {
+  if (!s || !mat) return fr_fail(FR_ERR_ARG, "fr_scene_add_material: NULL argument");
+  if (s->committed) return fr_fail(FR_ERR_STATE, "fr_scene_add_material: scene already committed");
+  char name[sizeof mat->name];
+  memcpy(name, mat->name, sizeof name);
+  name[sizeof name - 1] = 0;
+  uint32_t i;
+  fr_error e = fr_mesh_material(&s->mesh, name, &i);
+  if (e) return e;
+  s->mesh.mats[i] = *mat;
+  memcpy(s->mesh.mats[i].name, name, sizeof name);
+  if (index) *index = i;
+  return FR_OK;
+}
+
+size_t fr_scene_sphere_count(const fr_scene *s) { return s ? s->spheres.n : 0; }
+
+int fr_scene_sphere(const fr_scene *s, size_t i, float center[3], float *radius) {
+  if (!s || i >= s->spheres.n) return 0;
+  for (int a = 0; a < 3; a++) center[a] = s->spheres.s[i].c[a];
+  *radius = s->spheres.s[i].r;
+  return 1;
+}
+
+int fr_scene_geometric_normal(const fr_scene *s, uint32_t prim, const float p[3], float n[3]) {
+  n[0] = n[1] = n[2] = 0.0f;
+  if (!s || prim == FR_INVALID_ID) return 0;
+  if (prim < s->mesh.ntris) {
+    const uint32_t *ix = s->mesh.idx + 3 * (size_t)prim;
+    vec3 a = v3_load(s->mesh.pos + 3 * (size_t)ix[0]), b = v3_load(s->mesh.pos + 3 * (size_t)ix[1]);
+    vec3 c = v3_load(s->mesh.pos + 3 * (size_t)ix[2]);
+    vec3 g = v3_cross(v3_sub(b, a), v3_sub(c, a));
+    n[0] = g.x; n[1] = g.y; n[2] = g.z;
+    return 1;
+  }
+  size_t i = prim - s->mesh.ntris;
+  if (i >= s->spheres.n) return 0;
+  for (int a = 0; a < 3; a++) n[a] = p[a] - s->spheres.s[i].c[a];
+  return 1;
+}
+
 void fr_scene_bounds(const fr_scene *s, float lower[3], float upper[3]) {
   aabb b = aabb_empty();
   if (s && s->committed) b = s->bounds;
-  else if (s)
+  else if (s) {
     for (size_t i = 0; i < s->mesh.nverts; i++) b = aabb_grow(b, v3_load(s->mesh.pos + 3 * i));
+    for (size_t i = 0; i < s->spheres.n; i++) b = aabb_merge(b, fr_sphere_box(&s->spheres.s[i]));
+  }
   lower[0] = b.lo.x; lower[1] = b.lo.y; lower[2] = b.lo.z;
   upper[0] = b.hi.x; upper[1] = b.hi.y; upper[2] = b.hi.z;
 }
@@ -197,8 +289,14 @@ fr_error fr_scene_stats(const fr_scene *s, fr_bvh_stats *st) {
 void fr_intersect1_reference(const fr_scene *s, const fr_ray *ray, fr_hit *hit) {
   if (!s->committed) { fr_hit_miss(hit); return; }
   fr_bvh2_intersect_reference(&s->bvh2, &s->mesh, ray, hit);
+  fr_spheres_intersect1_brute(&s->sphere_bvh, fr_scene_sphere_base(s), ray, hit);
 }
 
 int fr_occluded1_reference(const fr_scene *s, const fr_ray *ray) {
-  return s->committed ? fr_bvh2_occluded_reference(&s->bvh2, &s->mesh, ray) : 0;
+  if (!s->committed) return 0;
+  if (fr_bvh2_occluded_reference(&s->bvh2, &s->mesh, ray)) return 1;
+  fr_hit h;
+  fr_hit_miss(&h);
+  fr_spheres_intersect1_brute(&s->sphere_bvh, fr_scene_sphere_base(s), ray, &h);
+  return h.prim != FR_INVALID_ID;
 }

@@ -4,6 +4,7 @@
 #include "base/error.h"
 #include "scene.h"
 #include "trace/kernels.h"
+#include "trace/sphere_traverse.h"
 
 void fr_trace_options_default(fr_trace_options *o) {
   o->mode = FR_TRACE_AUTO;
@@ -50,17 +51,36 @@ static const fr_packet_fns *packet_fns(const fr_scene *s, int size, int threshol
   return w8 ? k->p16w8 : k->p16w4;
 }
 
+/* Spheres are traced after the triangles, ray by ray, their closest hit
+ * bounded by the triangles'; a scene without spheres skips this. */
+static inline int has_spheres(const fr_scene *s) { return s->sphere_bvh.nprims != 0; }
+
+static void spheres_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
+  for (size_t i = 0; i < n; i++) fr_spheres_intersect1(&s->sphere_bvh, fr_scene_sphere_base(s), &rays[i], &hits[i]);
+}
+
+static void spheres_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
+  for (size_t i = 0; i < n; i++)
+    if (!occ[i]) occ[i] = (uint8_t)fr_spheres_occluded1(&s->sphere_bvh, &rays[i]);
+}
+
+static fr_ray lane_ray(const fr_ray16 *r, int i) {
+  fr_ray o = {{r->org_x[i], r->org_y[i], r->org_z[i]}, r->tnear[i], {r->dir_x[i], r->dir_y[i], r->dir_z[i]}, r->tfar[i]};
+  return o;
+}
+
 /* Tracing on an uncommitted scene finds nothing rather than crashing. */
 void fr_intersect1(const fr_scene *s, const fr_ray *ray, fr_hit *hit) {
   if (!s->committed) { fr_hit_miss(hit); return; }
   const fr_bvhn *b;
   single_fns(s, &b)->intersect1(b, ray, hit);
+  if (has_spheres(s)) fr_spheres_intersect1(&s->sphere_bvh, fr_scene_sphere_base(s), ray, hit);
 }
 
 int fr_occluded1(const fr_scene *s, const fr_ray *ray) {
   if (!s->committed) return 0;
   const fr_bvhn *b;
-  return single_fns(s, &b)->occluded1(b, ray);
+  return single_fns(s, &b)->occluded1(b, ray) || (has_spheres(s) && fr_spheres_occluded1(&s->sphere_bvh, ray));
 }
 
 static void hit16_miss(unsigned valid, fr_hit16 *h) {
@@ -78,13 +98,29 @@ void fr_intersect16(const fr_scene *s, unsigned valid, const fr_ray16 *rays, fr_
   fr_packet_opts po;
   const fr_bvhn *b;
   packet_fns(s, 16, s->trace.hybrid_threshold, &po, &b)->intersect(b, &po, valid & 0xFFFF, rays, hits);
+  if (!has_spheres(s)) return;
+  for (unsigned m = valid & 0xFFFF; m; m &= m - 1) {
+    int i = __builtin_ctz(m);
+    fr_ray r = lane_ray(rays, i);
+    fr_hit h = {hits->t[i], hits->u[i], hits->v[i], hits->prim[i], {hits->ng_x[i], hits->ng_y[i], hits->ng_z[i]}};
+    fr_spheres_intersect1(&s->sphere_bvh, fr_scene_sphere_base(s), &r, &h);
+    hits->t[i] = h.t; hits->u[i] = h.u; hits->v[i] = h.v; hits->prim[i] = h.prim;
+    hits->ng_x[i] = h.ng[0]; hits->ng_y[i] = h.ng[1]; hits->ng_z[i] = h.ng[2];
+  }
 }
 
 unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays) {
   if (!s->committed) return 0;
   fr_packet_opts po;
   const fr_bvhn *b;
-  return packet_fns(s, 16, s->trace.hybrid_threshold, &po, &b)->occluded(b, &po, valid & 0xFFFF, rays);
+  unsigned occ = packet_fns(s, 16, s->trace.hybrid_threshold, &po, &b)->occluded(b, &po, valid & 0xFFFF, rays);
+  if (has_spheres(s))
+    for (unsigned m = valid & 0xFFFF & ~occ; m; m &= m - 1) {
+      int i = __builtin_ctz(m);
+      fr_ray r = lane_ray(rays, i);
+      occ |= (unsigned)fr_spheres_occluded1(&s->sphere_bvh, &r) << i;
+    }
+  return occ;
 }
 
 /* ---- streams ----
@@ -170,7 +206,11 @@ void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, si
   if (!s->committed) { for (size_t i = 0; i < n; i++) fr_hit_miss(&hits[i]); return; }
   const fr_bvhn *sb;
   const fr_trace_fns *single = single_fns(s, &sb);
-  if (s->trace.mode == FR_TRACE_SINGLE) { single->intersect_stream(sb, rays, hits, n); return; }
+  if (s->trace.mode == FR_TRACE_SINGLE) {
+    single->intersect_stream(sb, rays, hits, n);
+    if (has_spheres(s)) spheres_stream(s, rays, hits, n);
+    return;
+  }
   fr_ray16 r16 __attribute__((aligned(64)));
   fr_hit16 h16 __attribute__((aligned(64)));
   FOR_EACH_GROUP(s, rays, n, {
@@ -186,13 +226,18 @@ void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, si
   }, {
     for (size_t i = 0; i < m; i++) single->intersect1(sb, &rays[c0 + idx[i]], &hits[c0 + idx[i]]);
   });
+  if (has_spheres(s)) spheres_stream(s, rays, hits, n);
 }
 
 void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
   if (!s->committed) { memset(occ, 0, n); return; }
   const fr_bvhn *sb;
   const fr_trace_fns *single = single_fns(s, &sb);
-  if (s->trace.mode == FR_TRACE_SINGLE) { single->occluded_stream(sb, rays, occ, n); return; }
+  if (s->trace.mode == FR_TRACE_SINGLE) {
+    single->occluded_stream(sb, rays, occ, n);
+    if (has_spheres(s)) spheres_occluded_stream(s, rays, occ, n);
+    return;
+  }
   fr_ray16 r16 __attribute__((aligned(64)));
   FOR_EACH_GROUP(s, rays, n, {
     fr_packet_opts po;
@@ -203,4 +248,5 @@ void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, siz
   }, {
     for (size_t i = 0; i < m; i++) occ[c0 + idx[i]] = (uint8_t)single->occluded1(sb, &rays[c0 + idx[i]]);
   });
+  if (has_spheres(s)) spheres_occluded_stream(s, rays, occ, n);
 }

@@ -13,6 +13,7 @@
 #ifndef FR_BASE_SIMD_PACKET_H
 #define FR_BASE_SIMD_PACKET_H
 #include "base/simd.h"
+#include <math.h>
 
 #ifndef FR_PACKET
 #error "define FR_PACKET (8 or 16)"
@@ -46,6 +47,7 @@ FR_INLINE vpm vpm_bits_to(unsigned b) { vpm r = {(fr_vp_kmask)b}; return r; }
 FR_INLINE unsigned vpm_bits(vpm a) { return a.m; }
 FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r = {(fr_vp_kmask)(a.m & b.m)}; return r; }
 FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) { vpf r = {FR_VP_OP(mask_blend_ps)(m.m, f.v, t.v)}; return r; }
+FR_INLINE vpf vp_sqrt(vpf a) { vpf r = {FR_VP_OP(sqrt_ps)(a.v)}; return r; }
 #if P == 16
 FR_INLINE float vp_reduce_min(vpf a) { return _mm512_reduce_min_ps(a.v); }
 FR_INLINE float vp_reduce_max(vpf a) { return _mm512_reduce_max_ps(a.v); }
@@ -81,6 +83,7 @@ FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) { vpf r; for (int h = 0; h < FR_VP_
 FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r; for (int h = 0; h < FR_VP_HALVES; h++) r.m[h] = _mm256_and_ps(a.m[h], b.m[h]); return r; }
 FR_VP_BIN(vp_and, _mm256_and_ps) FR_VP_BIN(vp_or, _mm256_or_ps) FR_VP_BIN(vp_xor, _mm256_xor_ps)
 FR_INLINE vpf vp_loadu(const float *p) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_loadu_ps(p + 8 * h); return r; }
+FR_INLINE vpf vp_sqrt(vpf a) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_sqrt_ps(a.v[h]); return r; }
 
 #else /* scalar */
 typedef struct vpf { float f[P]; } vpf;
@@ -121,6 +124,7 @@ FR_INLINE float fr_vp_bits_xor(float a, float b) {
 FR_VP_BIN(vp_and, fr_vp_bits_and(a.f[i], b.f[i])) FR_VP_BIN(vp_or, fr_vp_bits_or(a.f[i], b.f[i]))
 FR_VP_BIN(vp_xor, fr_vp_bits_xor(a.f[i], b.f[i]))
 FR_INLINE vpf vp_loadu(const float *p) FR_VP_LANES(p[i])
+FR_INLINE vpf vp_sqrt(vpf a) FR_VP_LANES(sqrtf(a.f[i]))
 FR_INLINE float vp_reduce_min(vpf a) { float r = a.f[0]; for (int i = 1; i < P; i++) r = a.f[i] < r ? a.f[i] : r; return r; }
 FR_INLINE float vp_reduce_max(vpf a) { float r = a.f[0]; for (int i = 1; i < P; i++) r = a.f[i] > r ? a.f[i] : r; return r; }
 #endif

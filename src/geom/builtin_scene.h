@@ -3,5 +3,10 @@
 #ifndef FR_GEOM_BUILTIN_SCENE_H
 #define FR_GEOM_BUILTIN_SCENE_H
 #include "geom/mesh.h"
+#include "geom/sphere.h"
 fr_error fr_builtin_scene(fr_mesh *m);
+/* A sphereflake of analytic spheres (builtin_sphereflake.c): a sphere of
+ * radius 0.5 at the origin, nine children a third its size on each sphere
+ * down to depth levels, above a floor quad at z = -0.5. */
+fr_error fr_builtin_sphereflake(int depth, fr_mesh *m, fr_spheres *spheres);
 #endif

@@ -94,16 +94,17 @@ void fr_whitted_mats_free(fr_whitted_mats *m) {
 }
 
 static const fr_whitted_mat *mat_of(const fr_scene *s, const fr_whitted_mats *m, uint32_t prim) {
-  uint32_t i = fr_scene_triangle_material(s, prim);
+  uint32_t i = fr_scene_prim_material(s, prim);
   return &m->mat[i == FR_INVALID_ID || i + 1 >= m->count ? m->count - 1 : i];
 }
 
-void fr_whitted_mats_census(const fr_scene *s, const fr_whitted_mats *m, size_t *mirror_tris, size_t *glass_tris) {
-  *mirror_tris = *glass_tris = 0;
-  for (size_t t = 0; t < fr_scene_triangle_count(s); t++) {
+void fr_whitted_mats_census(const fr_scene *s, const fr_whitted_mats *m, size_t *mirror_prims, size_t *glass_prims) {
+  *mirror_prims = *glass_prims = 0;
+  size_t n = fr_scene_triangle_count(s) + fr_scene_sphere_count(s);
+  for (size_t t = 0; t < n; t++) {
     fr_surface k = mat_of(s, m, (uint32_t)t)->kind;
-    *mirror_tris += k == FR_SURF_MIRROR;
-    *glass_tris += k == FR_SURF_GLASS;
+    *mirror_prims += k == FR_SURF_MIRROR;
+    *glass_prims += k == FR_SURF_GLASS;
   }
 }
 
@@ -214,10 +215,9 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
       }
       const fr_whitted_mat *m = mat_of(sc, w->mats, h->prim);
       vec3 d = v3_load(g->r.dir), p = v3_add(v3_load(g->r.org), v3_scale(d, h->t));
-      const float *pos = fr_scene_vertices(sc);
-      const uint32_t *ix = fr_scene_indices(sc) + 3 * (size_t)h->prim;
-      vec3 a = v3_load(pos + 3 * (size_t)ix[0]), bb = v3_load(pos + 3 * (size_t)ix[1]), c = v3_load(pos + 3 * (size_t)ix[2]);
-      vec3 ng = v3_norm(v3_cross(v3_sub(bb, a), v3_sub(c, a)));
+      float gn[3], pp[3] = {p.x, p.y, p.z};
+      fr_scene_geometric_normal(sc, h->prim, pp, gn);
+      vec3 ng = v3_norm(v3_load(gn));
       int entering = v3_dot(ng, d) < 0.0f;
       vec3 nf = entering ? ng : v3_scale(ng, -1.0f);
       vec3 kd = v3(m->kd[0], m->kd[1], m->kd[2]), ks = v3(m->ks[0], m->ks[1], m->ks[2]);

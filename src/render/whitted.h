@@ -44,6 +44,6 @@ typedef struct fr_whitted_mats {
  * unknown material. */
 fr_error fr_whitted_mats_build(const fr_scene *s, const char *mirror, const char *glass, fr_whitted_mats *out);
 void fr_whitted_mats_free(fr_whitted_mats *m);
-/* how many of the scene's triangles are mirrors and glass */
-void fr_whitted_mats_census(const fr_scene *s, const fr_whitted_mats *m, size_t *mirror_tris, size_t *glass_tris);
+/* How many prims (triangles and spheres) are mirrors and glass. */
+void fr_whitted_mats_census(const fr_scene *s, const fr_whitted_mats *m, size_t *mirror_prims, size_t *glass_prims);
 #endif

@@ -35,16 +35,16 @@ typedef struct buffers {
 
 /* Unit geometric normal of a hit, facing the ray; taken from the scene so that
  * every tracer shades with the same normals. */
-static vec3 facing_normal(const fr_scene *s, const fr_hit *h, vec3 d) {
-  const float *p = fr_scene_vertices(s);
-  const uint32_t *ix = fr_scene_indices(s) + 3 * (size_t)h->prim;
-  vec3 a = v3_load(p + 3 * (size_t)ix[0]), b = v3_load(p + 3 * (size_t)ix[1]), c = v3_load(p + 3 * (size_t)ix[2]);
-  vec3 n = v3_norm(v3_cross(v3_sub(b, a), v3_sub(c, a)));
-  return v3_dot(n, d) > 0.0f ? v3_scale(n, -1.0f) : n;
-}
-
 static vec3 hit_point(const fr_ray *r, const fr_hit *h) {
   return v3_add(v3_load(r->org), v3_scale(v3_load(r->dir), h->t));
+}
+
+static vec3 facing_normal(const fr_scene *s, const fr_hit *h, const fr_ray *r) {
+  vec3 p = hit_point(r, h), d = v3_load(r->dir);
+  float g[3], pp[3] = {p.x, p.y, p.z};
+  fr_scene_geometric_normal(s, h->prim, pp, g);
+  vec3 n = v3_norm(v3_load(g));
+  return v3_dot(n, d) > 0.0f ? v3_scale(n, -1.0f) : n;
 }
 
 static void onb(vec3 n, vec3 *t, vec3 *b) {
@@ -69,7 +69,7 @@ static fr_ray make_ray(vec3 o, vec3 d, float tnear, float tfar) {
 }
 
 static vec3 albedo(const fr_scene *s, uint32_t prim) {
-  uint32_t m = fr_scene_triangle_material(s, prim);
+  uint32_t m = fr_scene_prim_material(s, prim);
   const fr_material *mat = m == FR_INVALID_ID ? NULL : fr_scene_material(s, m);
   return mat ? v3(mat->diffuse[0], mat->diffuse[1], mat->diffuse[2]) : v3(0.8f, 0.8f, 0.8f);
 }
@@ -199,7 +199,7 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
     for (int i = 0; i < n; i++) {
       const fr_hit *h = &B->prim_hit[i];
       if (h->prim == FR_INVALID_ID) continue;
-      vec3 d = v3_load(B->prim_ray[i].dir), p = hit_point(&B->prim_ray[i], h), nn = facing_normal(w->scene, h, d);
+      vec3 p = hit_point(&B->prim_ray[i], h), nn = facing_normal(w->scene, h, &B->prim_ray[i]);
       fr_rng rng = fr_rng_seed(w->seed, (uint64_t)B->py[i] * (uint64_t)W + (uint64_t)B->px[i]);
       for (int k = 0; k < per; k++) {
         vec3 dir;
@@ -241,7 +241,7 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
     for (int bounce = 0; bounce < 8 && na > 0; bounce++) {
       for (int a = 0; a < na; a++) {
         int i = alive[a];
-        vec3 d = v3_load(cur[i].dir), p = hit_point(&cur[i], &ch[i]), nn = facing_normal(w->scene, &ch[i], d);
+        vec3 d = v3_load(cur[i].dir), p = hit_point(&cur[i], &ch[i]), nn = facing_normal(w->scene, &ch[i], &cur[i]);
         vec3 nd = w->kind == FR_WL_DIFFUSE8 ? cosine_dir(nn, fr_rng_float(&rng[i]), fr_rng_float(&rng[i]))
                                             : v3_sub(d, v3_scale(nn, 2.0f * v3_dot(d, nn)));
         cur[i] = make_ray(p, nd, w->eps, INFINITY);
@@ -269,7 +269,7 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
       size_t px = (size_t)B->py[i] * (size_t)W + (size_t)B->px[i];
       const fr_hit *h = &B->prim_hit[i];
       vec3 nn = v3(0, 0, 0);
-      if (h->prim != FR_INVALID_ID) nn = facing_normal(w->scene, h, v3_load(B->prim_ray[i].dir));
+      if (h->prim != FR_INVALID_ID) nn = facing_normal(w->scene, h, &B->prim_ray[i]);
       w->gbuf_vis[px] = h->prim == FR_INVALID_ID ? 0.0f : lit[i];
       w->gbuf_depth[px] = h->prim == FR_INVALID_ID ? INFINITY : h->t;
       w->gbuf_normal[3 * px] = nn.x; w->gbuf_normal[3 * px + 1] = nn.y; w->gbuf_normal[3 * px + 2] = nn.z;
@@ -282,7 +282,7 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
       float *px = w->image + 3 * ((size_t)B->py[i] * (size_t)W + (size_t)B->px[i]);
       const fr_hit *h = &B->prim_hit[i];
       if (h->prim == FR_INVALID_ID) { px[0] = px[1] = px[2] = 0.05f; continue; }
-      vec3 d = v3_load(B->prim_ray[i].dir), nn = facing_normal(w->scene, h, d), c;
+      vec3 d = v3_load(B->prim_ray[i].dir), nn = facing_normal(w->scene, h, &B->prim_ray[i]), c;
       float cosv = fabsf(v3_dot(nn, d));
       if (w->shade == FR_SHADE_NORMALS) {
         c = v3_scale(v3_add(nn, v3(1, 1, 1)), 0.5f);
@@ -403,6 +403,7 @@ static fr_lpacket *thread_packet(void) {
 static void lp_trace(const fr_lp_tracer *c, fr_ray *rays, fr_hit *hits, uint8_t *occ, size_t n) {
   fr_lpacket *p = thread_packet();
   const size_t size = (size_t)c->side * (size_t)c->side;
+  const fr_lp_scene *g = &c->geom;
   for (size_t a = 0; a < n; a += size) {
     int m = (int)(n - a < size ? n - a : size);
     if (!p) { /* no memory for the packet: the same answers from the streams */
@@ -412,11 +413,11 @@ static void lp_trace(const fr_lp_tracer *c, fr_ray *rays, fr_hit *hits, uint8_t 
     }
     fr_lpacket_load(p, rays + a, m);
     if (occ) {
-      fr_lp_active()->occluded(c->bvh, &c->opts, p);
+      fr_lp_active()->occluded(g, &c->opts, p);
       for (int i = 0; i < m; i++) occ[a + (size_t)i] = (uint8_t)((p->occ[i / 16] >> (i % 16)) & 1);
     } else {
-      fr_lp_active()->intersect(c->bvh, &c->opts, p);
-      fr_lpacket_hits(p, c->bvh, hits + a);
+      fr_lp_active()->intersect(g, &c->opts, p);
+      fr_lpacket_hits(p, g, hits + a);
     }
   }
 }

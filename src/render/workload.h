@@ -85,10 +85,10 @@ typedef struct fr_mft_tracer {
 fr_tracer fr_tracer_mft(const fr_mft_tracer *ctx);
 
 /* The large-packet tracer: every call's rays in packets of side x side
- * (consecutive rays), traced through bvh as opts say. */
+ * (consecutive rays), traced through the scene's trees (geom) as opts say. */
 typedef struct fr_lp_tracer {
   const fr_scene *scene;
-  const fr_bvh2 *bvh;
+  fr_lp_scene geom;
   fr_lp_opts opts;
   int side;
 } fr_lp_tracer;

@@ -16,7 +16,9 @@
  * corner-ray cull (each pair left is one 16-ray test). Large packets
  * (lp_*): packets, stack entries popped, boxes culled for the whole packet,
  * 16-ray box tests, leaves, triangles reached, triangles culled for the
- * whole packet, 16-ray triangle tests. */
+ * whole packet, 16-ray triangle tests. Spheres: single-ray box and sphere
+ * tests in the sphere tree (sp_*), spheres culled for a whole large packet,
+ * 16-ray sphere tests. */
 #define FR_COUNTER_FIELDS(X)                                                   \
   X(rays) X(nodes) X(box_tests) X(leaves) X(tri_tests)                         \
   X(packets) X(pk_nodes) X(pk_box_tests) X(pk_box_lanes) X(pk_tri_tests)       \
@@ -24,7 +26,8 @@
   X(mft_batches) X(mft_nodes) X(mft_box_tests) X(mft_box_lanes) X(mft_tris)   \
   X(mft_tri_frusta) X(mft_tri_left)                                         \
   X(lp_packets) X(lp_nodes) X(lp_culled) X(lp_box_chunks) X(lp_leaves) X(lp_tris) \
-  X(lp_tri_culled) X(lp_tri_chunks)
+  X(lp_tri_culled) X(lp_tri_chunks)                                          \
+  X(sp_box_tests) X(sp_tests) X(lp_sph_culled) X(lp_sph_chunks)
 
 typedef struct fr_counters {
 #define FR_COUNTER_DECL(f) uint64_t f;

@@ -37,7 +37,8 @@ void fr_lpacket_load(fr_lpacket *p, const fr_ray *rays, int n) {
   }
 }
 
-void fr_lpacket_hits(const fr_lpacket *p, const fr_bvh2 *b, fr_hit *hits) {
+void fr_lpacket_hits(const fr_lpacket *p, const fr_lp_scene *g, fr_hit *hits) {
+  const fr_bvh2 *b = g->tris;
   for (int i = 0; i < p->n; i++) {
     fr_hit *h = &hits[i];
     uint32_t t = p->tri[i];
@@ -46,6 +47,15 @@ void fr_lpacket_hits(const fr_lpacket *p, const fr_bvh2 *b, fr_hit *hits) {
       h->u = h->v = 0.0f;
       h->prim = FR_INVALID_ID;
       h->ng[0] = h->ng[1] = h->ng[2] = 0.0f;
+      continue;
+    }
+    if (t & FR_LP_SPHERE) { /* the same operations as fr_spheres_hit */
+      uint32_t li = t & ~FR_LP_SPHERE;
+      const fr_sphere *s = &g->spheres->spheres[li];
+      h->t = p->tfar[i];
+      h->u = h->v = 0.0f;
+      h->prim = g->sphere_base + g->spheres->prims[li];
+      for (int a = 0; a < 3; a++) h->ng[a] = p->o[a][i] + h->t * p->d[a][i] - s->c[a];
       continue;
     }
     const fr_bvh2_tri *r = &b->tris[t];

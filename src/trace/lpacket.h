@@ -49,7 +49,7 @@ typedef struct fr_lpacket {
   float tfar[FR_LP_MAX] __attribute__((aligned(64)));  /* closest hit: becomes the hit's t */
   float u[FR_LP_MAX] __attribute__((aligned(64)));
   float v[FR_LP_MAX] __attribute__((aligned(64)));
-  uint32_t tri[FR_LP_MAX] __attribute__((aligned(64))); /* hit triangle in leaf order, or FR_INVALID_ID */
+  uint32_t tri[FR_LP_MAX] __attribute__((aligned(64))); /* hit in leaf order (| FR_LP_SPHERE), or FR_INVALID_ID */
   uint16_t valid[FR_LP_CHUNKS];
   uint16_t alive[FR_LP_CHUNKS];  /* valid and not yet occluded */
   uint16_t occ[FR_LP_CHUNKS];    /* any hit: bit set when occluded */
@@ -59,14 +59,24 @@ typedef struct fr_lpacket {
   fr_pbounds bounds;
 } fr_lpacket;
 
+#define FR_LP_SPHERE 0x80000000u /* fr_lpacket.tri: a sphere's leaf-order index */
+
+/* What a packet traverses: the triangles' binary BVH, then the spheres'
+ * (NULL or empty if none; sphere prims count from sphere_base). */
+typedef struct fr_lp_scene {
+  const fr_bvh2 *tris;
+  const fr_bvh2 *spheres;
+  uint32_t sphere_base;
+} fr_lp_scene;
+
 /* Loads n <= FR_LP_MAX rays; the rest of the last chunk is invalid. */
 void fr_lpacket_load(fr_lpacket *p, const fr_ray *rays, int n);
 /* Closest hits (after intersect) as fr_hit, with the geometric normal. */
-void fr_lpacket_hits(const fr_lpacket *p, const fr_bvh2 *b, fr_hit *hits);
+void fr_lpacket_hits(const fr_lpacket *p, const fr_lp_scene *g, fr_hit *hits);
 
 typedef struct fr_lp_fns {
-  void (*intersect)(const fr_bvh2 *b, const fr_lp_opts *o, fr_lpacket *p);
-  void (*occluded)(const fr_bvh2 *b, const fr_lp_opts *o, fr_lpacket *p);
+  void (*intersect)(const fr_lp_scene *g, const fr_lp_opts *o, fr_lpacket *p);
+  void (*occluded)(const fr_lp_scene *g, const fr_lp_opts *o, fr_lpacket *p);
 } fr_lp_fns;
 
 extern const fr_lp_fns fr_lp_avx512, fr_lp_avx2, fr_lp_scalar;

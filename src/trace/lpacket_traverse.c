@@ -73,6 +73,39 @@ FR_INLINE unsigned tri16(fr_lpacket *p, int c, const fr_bvh2_tri *r, uint32_t ti
   return m;
 }
 
+/* Chunk c's rays of m against the sphere at leaf index li: fr_sphere_roots'
+ * operations lane by lane, so the answers are fr_intersect1's bit for bit. */
+FR_INLINE unsigned sphere16(fr_lpacket *p, int c, const fr_sphere *s, uint32_t li, unsigned m, int closest) {
+  const int i = 16 * c;
+  vpf dx = vp_load(p->d[0] + i), dy = vp_load(p->d[1] + i), dz = vp_load(p->d[2] + i);
+  vpf fx = vp_sub(vp_load(p->o[0] + i), vp(s->c[0]));
+  vpf fy = vp_sub(vp_load(p->o[1] + i), vp(s->c[1]));
+  vpf fz = vp_sub(vp_load(p->o[2] + i), vp(s->c[2]));
+  FR_COUNT(lp_sph_chunks, 1);
+  vpf a = vp_add(vp_add(vp_mul(dx, dx), vp_mul(dy, dy)), vp_mul(dz, dz));
+  vpf b = vp_xor(vp_add(vp_add(vp_mul(fx, dx), vp_mul(fy, dy)), vp_mul(fz, dz)), vp(-0.0f));
+  vpf tc = vp_div(b, a);
+  vpf lx = vp_add(fx, vp_mul(tc, dx)), ly = vp_add(fy, vp_mul(tc, dy)), lz = vp_add(fz, vp_mul(tc, dz));
+  vpf r2 = vp(s->r * s->r);
+  vpf h = vp_sub(r2, vp_add(vp_add(vp_mul(lx, lx), vp_mul(ly, ly)), vp_mul(lz, lz)));
+  m &= vpm_bits(vp_ge(h, vp(0.0f)));
+  if (!m) return 0;
+  vpf cc = vp_sub(vp_add(vp_add(vp_mul(fx, fx), vp_mul(fy, fy)), vp_mul(fz, fz)), r2);
+  vpf q = vp_add(b, vp_copysign(vp_sqrt(vp_mul(a, h)), b));
+  vpf t1 = vp_div(q, a), t2 = vp_select(vp_eq(q, vp(0.0f)), t1, vp_div(cc, q));
+  vpf tn = vp_load(p->tnear + i), tf = vp_load(p->tfar + i);
+  vpf near = vp_min(t1, t2), far = vp_max(t2, t1);
+  vpf t = vp_select(vp_gt(near, tn), near, far);
+  m &= vpm_bits(vpm_and(vp_gt(t, tn), vp_lt(t, tf)));
+  if (!m || !closest) return m;
+  vpm hm = vpm_bits_to(m);
+  vp_store(p->tfar + i, vp_select(hm, t, tf));
+  vp_store(p->u + i, vp_select(hm, vp(0.0f), vp_load(p->u + i)));
+  vp_store(p->v + i, vp_select(hm, vp(0.0f), vp_load(p->v + i)));
+  for (unsigned mm = m; mm; mm &= mm - 1) p->tri[i + __builtin_ctz(mm)] = FR_LP_SPHERE | li;
+  return m;
+}
+
 typedef struct state {
   fr_lpacket *p;
   const fr_bvh2 *b;
@@ -81,9 +114,8 @@ typedef struct state {
   int live;      /* chunks with rays still alive (any hit) */
 } state;
 
-static void setup(state *S, fr_lpacket *p, const fr_bvh2 *b, const fr_lp_opts *opt) {
+static void setup(state *S, fr_lpacket *p, const fr_lp_opts *opt) {
   S->p = p;
-  S->b = b;
   S->opt = opt;
   S->live = 0;
   double sum[3] = {0, 0, 0};
@@ -163,17 +195,22 @@ FR_INLINE int narrow(state *S, const entry *e, entry *out) {
   }
 }
 
-/* The leaf of entry e (its set already narrowed into e) against its triangles. */
+/* The leaf of entry e (its set already narrowed into e) against its
+ * triangles, or its spheres in the sphere tree. */
 static void leaf(state *S, const entry *e, int closest) {
   fr_lpacket *p = S->p;
   const fr_bvh2 *b = S->b;
   uint32_t ref = e->ref, first = ref & FR_BVH2_FIRST_MASK, count = (ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
   FR_COUNT(lp_leaves, 1);
   for (uint32_t j = 0; j < count; j++) {
-    const fr_bvh2_tri *r = &b->tris[first + j];
+    const fr_bvh2_tri *r = b->spheres ? NULL : &b->tris[first + j];
+    const fr_sphere *sp = b->spheres ? &b->spheres[first + j] : NULL;
     FR_COUNT(lp_tris, 1);
-    if (S->opt->cull != FR_CULL_OFF && fr_pbounds_cull_tri(&p->bounds, S->opt->cull, r->v0, r->v1, r->v2)) {
-      FR_COUNT(lp_tri_culled, 1);
+    if (S->opt->cull != FR_CULL_OFF &&
+        (sp ? fr_pbounds_cull_sphere(&p->bounds, S->opt->cull, sp->c, sp->r)
+            : fr_pbounds_cull_tri(&p->bounds, S->opt->cull, r->v0, r->v1, r->v2))) {
+      if (sp) FR_COUNT(lp_sph_culled, 1);
+      else FR_COUNT(lp_tri_culled, 1);
       continue;
     }
     int nc = S->opt->traversal == FR_LP_RANGED ? e->b - e->a + 1 : S->opt->traversal == FR_LP_PARTITION ? e->a : p->nchunks;
@@ -182,7 +219,7 @@ static void leaf(state *S, const entry *e, int closest) {
       unsigned m = p->alive[c];
       if (S->opt->traversal == FR_LP_MASKED) m &= p->frames[e->depth][c];
       if (!m) continue;
-      unsigned hit = tri16(p, c, r, first + j, m, closest);
+      unsigned hit = sp ? sphere16(p, c, sp, first + j, m, closest) : tri16(p, c, r, first + j, m, closest);
       if (!closest && hit) {
         p->occ[c] |= (uint16_t)hit;
         p->alive[c] &= (uint16_t)~hit;
@@ -192,12 +229,12 @@ static void leaf(state *S, const entry *e, int closest) {
   }
 }
 
-static void traverse(const fr_bvh2 *b, const fr_lp_opts *opt, fr_lpacket *p, int closest) {
-  state S;
-  FR_COUNT(lp_packets, 1);
-  setup(&S, p, b, opt);
-  FR_COUNT(rays, S.live ? p->n : 0);
-  if (!S.live || !b->nodes || b->nprims == 0) return;
+/* The packet through one tree (triangles or spheres). */
+static void walk(state *S0, const fr_bvh2 *b, int closest) {
+  state S = *S0;
+  fr_lpacket *p = S.p;
+  const fr_lp_opts *opt = S.opt;
+  S.b = b;
   entry stack[STACK];
   int sp = 0;
   entry root = {b->root, NULL, 0, 0, 0, p->nchunks - 1};
@@ -222,7 +259,7 @@ static void traverse(const fr_bvh2 *b, const fr_lp_opts *opt, fr_lpacket *p, int
     }
     if (e.ref & FR_BVH2_LEAF) {
       leaf(&S, &e, closest);
-      if (!closest && S.live == 0) return;
+      if (!closest && S.live == 0) break;
       continue;
     }
     if (sp + 2 > STACK) continue; /* cannot happen: the build caps the depth */
@@ -238,9 +275,20 @@ static void traverse(const fr_bvh2 *b, const fr_lp_opts *opt, fr_lpacket *p, int
     stack[sp++] = c0;
     stack[sp++] = c1;
   }
+  S0->live = S.live;
 }
 
-static void lp_intersect(const fr_bvh2 *b, const fr_lp_opts *opt, fr_lpacket *p) { traverse(b, opt, p, 1); }
-static void lp_occluded(const fr_bvh2 *b, const fr_lp_opts *opt, fr_lpacket *p) { traverse(b, opt, p, 0); }
+static void traverse(const fr_lp_scene *g, const fr_lp_opts *opt, fr_lpacket *p, int closest) {
+  state S;
+  FR_COUNT(lp_packets, 1);
+  setup(&S, p, opt);
+  FR_COUNT(rays, S.live ? p->n : 0);
+  if (!S.live) return;
+  if (g->tris && g->tris->nodes && g->tris->nprims) walk(&S, g->tris, closest);
+  if (g->spheres && g->spheres->nprims && S.live) walk(&S, g->spheres, closest);
+}
+
+static void lp_intersect(const fr_lp_scene *g, const fr_lp_opts *opt, fr_lpacket *p) { traverse(g, opt, p, 1); }
+static void lp_occluded(const fr_lp_scene *g, const fr_lp_opts *opt, fr_lpacket *p) { traverse(g, opt, p, 0); }
 
 const fr_lp_fns FR_ISA_FN(fr_lp) = {lp_intersect, lp_occluded};

@@ -130,8 +130,14 @@ fr_view cli_resolve_view(const fr_scene *s, const cli_view *v) {
   return view;
 }
 
+int cli_is_builtin(const char *arg) { return strcmp(arg, "--builtin") == 0 || strncmp(arg, "--builtin=", 10) == 0; }
+
 int cli_load_scene(const char *arg, fr_scene **s) {
-  fr_error e = strcmp(arg, "--builtin") == 0 ? fr_scene_builtin(s) : fr_scene_load(arg, s);
+  fr_error e;
+  if (strcmp(arg, "--builtin") == 0 || strcmp(arg, "--builtin=default") == 0) e = fr_scene_builtin(s);
+  else if (strcmp(arg, "--builtin=sphereflake") == 0) e = fr_scene_builtin_sphereflake(3, s);
+  else if (cli_is_builtin(arg)) return cli_error(CLI_USAGE_ERROR, "unknown built-in scene '%s' (default or sphereflake)", arg + 10);
+  else e = fr_scene_load(arg, s);
   if (e) return cli_error(1, "%s", fr_last_error());
   e = fr_scene_commit(*s);
   if (e) { fr_scene_release(*s); *s = NULL; return cli_error(1, "%s", fr_last_error()); }
@@ -150,8 +156,14 @@ int cli_set_isa(const char *name) {
 float cli_scene_eps(const fr_scene *s) { return 1e-4f * v3_len(v3_sub(s->bounds.hi, s->bounds.lo)); }
 const char *cli_scene_name(const fr_scene *s) { return s->name; }
 
+fr_lp_scene cli_lp_scene(const fr_scene *s) {
+  fr_lp_scene g = {&s->bvh2, &s->sphere_bvh, fr_scene_sphere_base(s)};
+  return g;
+}
+
 int cli_workload_setup(const char *scene, const cli_view *v, int threads, fr_scene **s, fr_workload *w) {
-  if (cli_load_scene(scene, s)) return 1;
+  int rc = cli_load_scene(scene, s);
+  if (rc) return rc;
   w->view = cli_resolve_view(*s, v);
   if (fr_camera_setup(&w->cam, w->view.eye, w->view.at, w->view.up, w->view.fov, v->width, v->height)) {
     fr_scene_release(*s);
@@ -202,7 +214,7 @@ int cli_whitted_setup(const fr_scene *s, const cli_whitted *o, fr_whitted_mats *
   if (fr_whitted_mats_build(s, o->mirror, o->glass, mats)) return cli_error(CLI_USAGE_ERROR, "%s", fr_last_error());
   size_t nm, ng;
   fr_whitted_mats_census(s, mats, &nm, &ng);
-  printf("whitted depth=%d mirror_tris=%zu glass_tris=%zu\n", o->depth, nm, ng);
+  printf("whitted depth=%d mirror_prims=%zu glass_prims=%zu\n", o->depth, nm, ng);
   w->mats = mats;
   w->max_depth = o->depth;
   return 0;

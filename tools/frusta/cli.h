@@ -30,10 +30,13 @@ int cli_view_flag(int argc, char **argv, int *i, cli_view *v);
 fr_view cli_resolve_view(const fr_scene *s, const cli_view *v);
 
 /* Loads "--builtin" or a file and commits it; reports errors itself. */
+/* A scene argument: a file, --builtin, or --builtin=NAME (default, sphereflake). */
+int cli_is_builtin(const char *arg);
 int cli_load_scene(const char *arg, fr_scene **s);
 /* Applies FRUSTA_ISA / --isa; reports errors itself. */
 int cli_set_isa(const char *name);
 float cli_scene_eps(const fr_scene *s);
+
 
 struct fr_workload;
 /* Loads and commits the scene and fills w's view, camera, eps and threads
@@ -45,6 +48,8 @@ const char *cli_scene_name(const fr_scene *s);
  * --mirror NAMES --glass NAMES --depth N --traversal T --cull C --packet N */
 #include "render/whitted.h"
 #include "trace/lpacket.h"
+/* The scene's trees as the large-packet kernels take them. */
+fr_lp_scene cli_lp_scene(const fr_scene *s);
 typedef struct cli_whitted {
   const char *mirror, *glass; /* NULL: the scene's defaults */
   int depth;                  /* 1..FR_WHITTED_MAX_DEPTH, default 4 */

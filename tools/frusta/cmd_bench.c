@@ -143,7 +143,7 @@ int cmd_bench(int argc, char **argv) {
       else if (!strcmp(a, "--isa")) { if (cli_set_isa(val)) return 1; }
       else if (!strcmp(a, "--threads")) { if (!cli_parse_int(val, 1, 1024, &threads)) return cli_error(CLI_USAGE_ERROR, "--threads wants 1..1024, got '%s'", val); }
       else if (!cli_parse_int(val, 1, 64, &repeat)) return cli_error(CLI_USAGE_ERROR, "--repeat wants 1..64, got '%s'", val);
-    } else if (!strcmp(a, "--builtin") || a[0] != '-') {
+    } else if (cli_is_builtin(a) || a[0] != '-') {
       if (scene) return cli_error(CLI_USAGE_ERROR, "bench takes one scene");
       scene = a;
     } else return cli_error(CLI_USAGE_ERROR, "bench: unknown option '%s'", a);
@@ -186,6 +186,11 @@ int cmd_bench(int argc, char **argv) {
          st.build_seconds, s->name, tris, threads, fr_isa_name(fr_get_isa()), st.single_width, ws->sah,
          (double)(ws->node_bytes + ws->tri_bytes) / (double)tris, topt.packet_bvh_width,
          (double)(wp->node_bytes + wp->tri_bytes + wp->packet_tri_bytes) / (double)tris);
+  if (use_frusta && !strcmp(mode, "mft") && fr_scene_sphere_count(s)) {
+    size_t ns = fr_scene_sphere_count(s);
+    fr_scene_release(s);
+    return cli_error(CLI_USAGE_ERROR, "--mode mft: multi-frusta tracing does not trace spheres (this scene has %zu)", ns);
+  }
   /* multi-frusta tracing: the scene's binary BVH, or a shallower one */
   fr_bvh2 shallow;
   memset(&shallow, 0, sizeof shallow);
@@ -222,9 +227,9 @@ int cmd_bench(int argc, char **argv) {
       fr_tracer t = fr_tracer_frusta(s), tm = fr_tracer_mft(&mctx);
       int width = st.single_width;
       for (int m = 0; m < N_FRUSTA_MODES; m++)
-        if (all_modes || !strcmp(mode, frusta_modes[m])) {
+        if ((all_modes || !strcmp(mode, frusta_modes[m])) && !(m == MODE_MFT && fr_scene_sphere_count(s))) {
           set_frusta_mode(s, m, &topt, width);
-          fr_lp_tracer lpc = {s, &s->bvh2, wo.lp, m >= MODE_LARGE ? 2 << (m - MODE_LARGE) : 0};
+          fr_lp_tracer lpc = {s, cli_lp_scene(s), wo.lp, m >= MODE_LARGE ? 2 << (m - MODE_LARGE) : 0};
           fr_tracer tl = m >= MODE_LARGE ? fr_tracer_lp(&lpc) : t;
           char name[96];
           if (m >= MODE_LARGE)

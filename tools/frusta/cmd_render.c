@@ -105,7 +105,7 @@ int cmd_render(int argc, char **argv) {
       if (a[2] == 'o') out = val;
       else if (a[2] == 's') shade = val;
       else if (!cli_parse_int(val, 1, 1024, &threads)) return cli_error(CLI_USAGE_ERROR, "--threads wants 1..1024, got '%s'", val);
-    } else if (strcmp(a, "--builtin") == 0 || a[0] != '-') {
+    } else if (cli_is_builtin(a) || a[0] != '-') {
       if (scene) return cli_error(CLI_USAGE_ERROR, "render takes one scene");
       scene = a;
     } else return cli_error(CLI_USAGE_ERROR, "render: unknown option '%s'", a);
@@ -131,7 +131,8 @@ int cmd_render(int argc, char **argv) {
   w.seed = 1;
   w.progress = 1;
   if (w.kind == FR_WL_SOFT16) {
-    rc = render_soft(s, &w, &so, mft, out, ref_out, threads);
+    /* multi-frusta tracing does not see spheres: such scenes go the packet way */
+    rc = render_soft(s, &w, &so, mft && !fr_scene_sphere_count(s), out, ref_out, threads);
     fr_scene_release(s);
     return rc;
   }
@@ -140,7 +141,7 @@ int cmd_render(int argc, char **argv) {
   w.image = calloc((size_t)v.width * (size_t)v.height * 3, sizeof(float));
   if (!w.image) { fr_whitted_mats_free(&mats); fr_scene_release(s); return cli_error(1, "out of memory for a %dx%d image", v.width, v.height); }
   /* Whitted: large packets of --packet x --packet rays */
-  fr_lp_tracer lpc = {s, &s->bvh2, wo.lp, wo.packet};
+  fr_lp_tracer lpc = {s, cli_lp_scene(s), wo.lp, wo.packet};
   fr_tracer t = w.kind == FR_WL_WHITTED ? fr_tracer_lp(&lpc) : fr_tracer_frusta(s);
   fr_workload_result r = fr_workload_run(&w, &t);
   if (fr_image_write(out, v.width, v.height, w.image)) rc = cli_error(1, "%s", fr_last_error());

@@ -73,7 +73,7 @@ int cmd_stats(int argc, char **argv) {
     }
     else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
       if (!cli_parse_int(argv[++i], 1, 1024, &threads)) return cli_error(CLI_USAGE_ERROR, "--threads wants 1..1024");
-    } else if (strcmp(argv[i], "--builtin") == 0 || argv[i][0] != '-') {
+    } else if (cli_is_builtin(argv[i]) || argv[i][0] != '-') {
       if (path) return cli_error(CLI_USAGE_ERROR, "stats takes one scene");
       path = argv[i];
     } else return cli_error(CLI_USAGE_ERROR, "stats: unknown option '%s'", argv[i]);
@@ -83,7 +83,8 @@ int cmd_stats(int argc, char **argv) {
   omp_set_num_threads(threads);
   if (workload) return table5(path, &v, threads, workload, threshold, width);
   fr_scene *s;
-  if (cli_load_scene(path, &s)) return 1;
+  int lrc = cli_load_scene(path, &s);
+  if (lrc) return lrc;
   fr_bvh_stats st;
   fr_scene_stats(s, &st);
   size_t nt = fr_scene_triangle_count(s);

@@ -30,7 +30,7 @@ int cmd_trace(int argc, char **argv) {
           if (strcmp(v, mode_names[m]) == 0) mode = m;
         if (mode < 0) return cli_error(CLI_USAGE_ERROR, "--mode is single, packet8, packet16, hybrid16 or auto, not '%s'", v);
       } else if (cli_set_isa(v)) return 1;
-    } else if (a[0] == '-' && strcmp(a, "--builtin") != 0) {
+    } else if (a[0] == '-' && !cli_is_builtin(a)) {
       return cli_error(CLI_USAGE_ERROR, "trace: unknown option '%s'", a);
     } else if (!scene) scene = a;
     else if (!rays_path) rays_path = a;
@@ -47,7 +47,8 @@ int cmd_trace(int argc, char **argv) {
   size_t n;
   if (fr_rays_read(rays_path, &rays, &n)) return cli_error(1, "%s", fr_last_error());
   fr_scene *s;
-  if (cli_load_scene(scene, &s)) { free(rays); return 1; }
+  int lrc = cli_load_scene(scene, &s);
+  if (lrc) { free(rays); return lrc; }
   fr_trace_options topt;
   fr_trace_options_default(&topt);
   topt.mode = (fr_trace_mode)mode;

@@ -13,6 +13,7 @@ struct ebr_scene {
   RTCDevice dev;
   RTCScene scene;
   double build_seconds;
+  uint32_t sphere_base;   /* frusta's prim of Embree's sphere 0 (geometry 1) */
   _Atomic long long bytes;
   struct ebr_ctx { struct ebr_scene *e; ebr_mode mode; } ctx[EBR_MODE_COUNT];
 };
@@ -44,17 +45,32 @@ fr_error ebr_create(const fr_scene *s, ebr_options opt, ebr_scene **out) {
   e->scene = rtcNewScene(e->dev);
   rtcSetSceneFlags(e->scene, opt.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
   rtcSetSceneBuildQuality(e->scene, opt.quality == 2 ? RTC_BUILD_QUALITY_HIGH : opt.quality == 0 ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM);
-  RTCGeometry g = rtcNewGeometry(e->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-  size_t nv = fr_scene_vertex_count(s), nt = fr_scene_triangle_count(s);
-  /* Embree reads 16 bytes per vertex: pad the last one */
-  float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv + 1);
-  unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt);
-  memcpy(vb, fr_scene_vertices(s), nv * 3 * sizeof(float));
-  memcpy(ib, fr_scene_indices(s), nt * 3 * sizeof(unsigned));
-  rtcSetGeometryBuildQuality(g, opt.quality == 2 ? RTC_BUILD_QUALITY_HIGH : opt.quality == 0 ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM);
-  rtcCommitGeometry(g);
-  rtcAttachGeometry(e->scene, g);
-  rtcReleaseGeometry(g);
+  enum RTCBuildQuality quality = opt.quality == 2 ? RTC_BUILD_QUALITY_HIGH : opt.quality == 0 ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM;
+  size_t nv = fr_scene_vertex_count(s), nt = fr_scene_triangle_count(s), ns = fr_scene_sphere_count(s);
+  e->sphere_base = (uint32_t)nt;
+  if (nt) { /* geometry 0: the triangles */
+    RTCGeometry g = rtcNewGeometry(e->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    /* Embree reads 16 bytes per vertex: pad the last one */
+    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv + 1);
+    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt);
+    if (!vb || !ib) { rtcReleaseGeometry(g); ebr_release(e); return FR_ERR_NOMEM; }
+    memcpy(vb, fr_scene_vertices(s), nv * 3 * sizeof(float));
+    memcpy(ib, fr_scene_indices(s), nt * 3 * sizeof(unsigned));
+    rtcSetGeometryBuildQuality(g, quality);
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(e->scene, g, 0);
+    rtcReleaseGeometry(g);
+  }
+  if (ns) { /* geometry 1: the spheres, as Embree's sphere points (x, y, z, r) */
+    RTCGeometry g = rtcNewGeometry(e->dev, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+    float *pb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), ns);
+    if (!pb) { rtcReleaseGeometry(g); ebr_release(e); return FR_ERR_NOMEM; }
+    for (size_t i = 0; i < ns; i++) fr_scene_sphere(s, i, pb + 4 * i, pb + 4 * i + 3);
+    rtcSetGeometryBuildQuality(g, quality);
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(e->scene, g, 1);
+    rtcReleaseGeometry(g);
+  }
   atomic_store(&e->bytes, 0); /* count the acceleration structure, not the copied buffers */
   double t0 = fr_seconds();
   rtcCommitScene(e->scene);
@@ -84,12 +100,14 @@ static void to_rayhit1(const fr_ray *r, struct RTCRayHit *rh) {
   rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
 }
 
-static void from_hit(float tfar, unsigned geom, unsigned prim, float u, float v, float nx, float ny, float nz, fr_hit *h) {
+static void from_hit(const ebr_scene *e, float tfar, unsigned geom, unsigned prim, float u, float v, float nx, float ny,
+                     float nz, fr_hit *h) {
   if (geom == RTC_INVALID_GEOMETRY_ID) {
     h->t = INFINITY; h->u = h->v = 0; h->prim = FR_INVALID_ID; h->ng[0] = h->ng[1] = h->ng[2] = 0;
     return;
   }
-  h->t = tfar; h->u = u; h->v = v; h->prim = prim; h->ng[0] = nx; h->ng[1] = ny; h->ng[2] = nz;
+  h->t = tfar; h->u = u; h->v = v; h->prim = geom == 1 ? e->sphere_base + prim : prim;
+  h->ng[0] = nx; h->ng[1] = ny; h->ng[2] = nz;
 }
 
 void ebr_intersect1(ebr_scene *e, const fr_ray *r, fr_hit *h) {
@@ -98,7 +116,7 @@ void ebr_intersect1(ebr_scene *e, const fr_ray *r, fr_hit *h) {
   struct RTCRayHit rh;
   to_rayhit1(r, &rh);
   rtcIntersect1(e->scene, &ctx, &rh);
-  from_hit(rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z, h);
+  from_hit(e, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z, h);
 }
 
 int ebr_occluded1(ebr_scene *e, const fr_ray *r) {
@@ -127,7 +145,7 @@ int ebr_occluded1(ebr_scene *e, const fr_ray *r) {
       }                                                                                                   \
       rtcIntersect##W(valid, e->scene, ctx, &rh);                                                         \
       for (int i = 0; i < W && b + (size_t)i < n; i++)                                                    \
-        from_hit(rh.ray.tfar[i], rh.hit.geomID[i], rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i],           \
+        from_hit(e, rh.ray.tfar[i], rh.hit.geomID[i], rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i],           \
                  rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i], &h[b + (size_t)i]);                      \
     }                                                                                                     \
   }                                                                                                       \
@@ -173,7 +191,7 @@ static void ebr_intersect(void *c, fr_ray *rays, fr_hit *hits, size_t n, int coh
       for (size_t i = 0; i < m; i++) to_rayhit1(&rays[b + i], &rh[i]);
       rtcIntersect1M(e->scene, &ctx, rh, (unsigned)m, sizeof(struct RTCRayHit));
       for (size_t i = 0; i < m; i++)
-        from_hit(rh[i].ray.tfar, rh[i].hit.geomID, rh[i].hit.primID, rh[i].hit.u, rh[i].hit.v, rh[i].hit.Ng_x, rh[i].hit.Ng_y, rh[i].hit.Ng_z, &hits[b + i]);
+        from_hit(e, rh[i].ray.tfar, rh[i].hit.geomID, rh[i].hit.primID, rh[i].hit.u, rh[i].hit.v, rh[i].hit.Ng_x, rh[i].hit.Ng_y, rh[i].hit.Ng_z, &hits[b + i]);
     }
     return;
   }
@@ -182,7 +200,7 @@ static void ebr_intersect(void *c, fr_ray *rays, fr_hit *hits, size_t n, int coh
       struct RTCRayHit rh;
       to_rayhit1(&rays[i], &rh);
       rtcIntersect1(e->scene, &ctx, &rh);
-      from_hit(rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z, &hits[i]);
+      from_hit(e, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z, &hits[i]);
     }
   }
 }
