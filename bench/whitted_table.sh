@@ -3,16 +3,25 @@
 # each traversal (masked, ranged, partition), the culls (off, ia, planes,
 # corners) at 2x2 and 16x16, frusta's hybrid16 and auto, and Embree's modes,
 # all on the same Whitted rays, 2 threads, 1024x1024. kitchen and museum
-# with their MTL mirrors and glass, spd_rings with every surface a mirror.
+# with their MTL mirrors and glass, spd_rings with every surface a mirror,
+# and the analytic sphereflake (--builtin=sphereflake: 820 mirror spheres).
 # Raw lines go to bench/results/whitted-raw.txt; with a counters build in
 # build-count/ the packet counters go to bench/results/whitted-counters.txt.
-# env: SIZE (1024x1024) REPEAT (3) THREADS (2)
+# env: SIZE (1024x1024) REPEAT (3) THREADS (2) SCENES ("kitchen museum
+# spd_rings sphereflake") RAW COUNT (the output files)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SIZE=${SIZE:-1024x1024}; REPEAT=${REPEAT:-3}; THREADS=${THREADS:-2}
-RAW=bench/results/whitted-raw.txt
-COUNT=bench/results/whitted-counters.txt
-scene_file() { case $1 in kitchen|museum) echo "../shared/scenes/$1/$1.obj.zst" ;; spd_rings) echo "../shared/scenes/spd_rings/rings.ply.zst" ;; esac; }
+SCENES=${SCENES:-kitchen museum spd_rings sphereflake}
+RAW=${RAW:-bench/results/whitted-raw.txt}
+COUNT=${COUNT:-bench/results/whitted-counters.txt}
+scene_file() {
+  case $1 in
+  kitchen|museum) echo "../shared/scenes/$1/$1.obj.zst" ;;
+  spd_rings) echo "../shared/scenes/spd_rings/rings.ply.zst" ;;
+  sphereflake) echo "--builtin=sphereflake" ;;
+  esac
+}
 scene_args() { case $1 in spd_rings) echo "--mirror all" ;; *) echo "" ;; esac; }
 bench() { # binary scene args...
   local bin=$1 s=$2; shift 2
@@ -23,7 +32,7 @@ bench() { # binary scene args...
 mkdir -p bench/results
 : >"$RAW"
 [ -x build-count/frusta ] && : >"$COUNT"
-for s in kitchen museum spd_rings; do
+for s in $SCENES; do
   bench ./build/frusta "$s" --mode hybrid16 --tracer both >>"$RAW"
   bench ./build/frusta "$s" --mode all --tracer embree >>"$RAW"
   bench ./build/frusta "$s" --mode auto >>"$RAW"

@@ -15,7 +15,7 @@
  * triangles fetched by leaves, frustum-triangle pairs before and after the
  * corner-ray cull (each pair left is one 16-ray test). Large packets
  * (lp_*): packets, stack entries popped, boxes culled for the whole packet,
- * 16-ray box tests, leaves, triangles reached, triangles culled for the
+ * 16-ray box tests, leaves, prims (triangles and spheres) reached, triangles culled for the
  * whole packet, 16-ray triangle tests. Spheres: single-ray box and sphere
  * tests in the sphere tree (sp_*), spheres culled for a whole large packet,
  * 16-ray sphere tests. */

@@ -83,12 +83,13 @@ static void run(const fr_workload *w0, const fr_tracer *t, const char *scene, si
            c.pk_tri_tests ? (double)c.pk_tri_lanes / c.pk_tri_tests : 0.0);
   if (fr_counters_enabled() && c.lp_packets)
     printf("counters tracer=%s mode=%s workload=%s packets=%llu per_packet rays=%.1f nodes=%.2f culled=%.2f "
-           "box_chunks=%.2f leaves=%.2f tris=%.2f tris_culled=%.2f tri_chunks=%.2f\n",
+           "box_chunks=%.2f leaves=%.2f prims=%.2f tris_culled=%.2f tri_chunks=%.2f spheres_culled=%.2f sphere_chunks=%.2f\n",
            tracer, mode, fr_workload_name(w0->kind), (unsigned long long)c.lp_packets, (double)c.rays / c.lp_packets,
            (double)c.lp_nodes / c.lp_packets, (double)c.lp_culled / c.lp_packets,
            (double)c.lp_box_chunks / c.lp_packets, (double)c.lp_leaves / c.lp_packets,
            (double)c.lp_tris / c.lp_packets, (double)c.lp_tri_culled / c.lp_packets,
-           (double)c.lp_tri_chunks / c.lp_packets);
+           (double)c.lp_tri_chunks / c.lp_packets, (double)c.lp_sph_culled / c.lp_packets,
+           (double)c.lp_sph_chunks / c.lp_packets);
   fflush(stdout);
 }
 
