@@ -202,15 +202,11 @@ static int chunk_order(const fr_scene *s, const fr_ray *rays, size_t n, uint32_t
     }                                                                                             \
   } while (0)
 
-void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
-  if (!s->committed) { for (size_t i = 0; i < n; i++) fr_hit_miss(&hits[i]); return; }
+/* The triangles of a stream; the spheres follow in the public calls. */
+static void triangles_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
   const fr_bvhn *sb;
   const fr_trace_fns *single = single_fns(s, &sb);
-  if (s->trace.mode == FR_TRACE_SINGLE) {
-    single->intersect_stream(sb, rays, hits, n);
-    if (has_spheres(s)) spheres_stream(s, rays, hits, n);
-    return;
-  }
+  if (s->trace.mode == FR_TRACE_SINGLE) { single->intersect_stream(sb, rays, hits, n); return; }
   fr_ray16 r16 __attribute__((aligned(64)));
   fr_hit16 h16 __attribute__((aligned(64)));
   FOR_EACH_GROUP(s, rays, n, {
@@ -226,18 +222,12 @@ void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, si
   }, {
     for (size_t i = 0; i < m; i++) single->intersect1(sb, &rays[c0 + idx[i]], &hits[c0 + idx[i]]);
   });
-  if (has_spheres(s)) spheres_stream(s, rays, hits, n);
 }
 
-void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
-  if (!s->committed) { memset(occ, 0, n); return; }
+static void triangles_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
   const fr_bvhn *sb;
   const fr_trace_fns *single = single_fns(s, &sb);
-  if (s->trace.mode == FR_TRACE_SINGLE) {
-    single->occluded_stream(sb, rays, occ, n);
-    if (has_spheres(s)) spheres_occluded_stream(s, rays, occ, n);
-    return;
-  }
+  if (s->trace.mode == FR_TRACE_SINGLE) { single->occluded_stream(sb, rays, occ, n); return; }
   fr_ray16 r16 __attribute__((aligned(64)));
   FOR_EACH_GROUP(s, rays, n, {
     fr_packet_opts po;
@@ -248,5 +238,16 @@ void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, siz
   }, {
     for (size_t i = 0; i < m; i++) occ[c0 + idx[i]] = (uint8_t)single->occluded1(sb, &rays[c0 + idx[i]]);
   });
+}
+
+void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
+  if (!s->committed) { for (size_t i = 0; i < n; i++) fr_hit_miss(&hits[i]); return; }
+  triangles_intersect_stream(s, rays, hits, n);
+  if (has_spheres(s)) spheres_stream(s, rays, hits, n);
+}
+
+void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
+  if (!s->committed) { memset(occ, 0, n); return; }
+  triangles_occluded_stream(s, rays, occ, n);
   if (has_spheres(s)) spheres_occluded_stream(s, rays, occ, n);
 }

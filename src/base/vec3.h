@@ -25,6 +25,14 @@ static inline vec3 v3_norm(vec3 a) {
   float l = v3_len(a);
   return l > 0.0f ? v3_scale(a, 1.0f / l) : a;
 }
+/* Two unit vectors t, b completing unit n to an orthonormal basis (Duff et
+ * al., "Building an Orthonormal Basis, Revisited": no branch, no singularity). */
+static inline void v3_onb(vec3 n, vec3 *t, vec3 *b) {
+  float sign = copysignf(1.0f, n.z);
+  float a = -1.0f / (sign + n.z), bb = n.x * n.y * a;
+  *t = v3(1.0f + sign * n.x * n.x * a, sign * bb, -sign * n.x);
+  *b = v3(bb, sign + n.y * n.y * a, -n.y);
+}
 static inline float v3_get(vec3 a, int axis) { return axis == 0 ? a.x : axis == 1 ? a.y : a.z; }
 static inline int v3_finite(vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 

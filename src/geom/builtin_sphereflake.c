@@ -10,26 +10,18 @@
 
 #define RATIO (1.0f / 3.0f)
 
-typedef struct frame { vec3 u, v, w; } frame;
-
-/* Duff et al., "Building an Orthonormal Basis, Revisited" */
-static frame frame_of(vec3 w) {
-  float sign = copysignf(1.0f, w.z), a = -1.0f / (sign + w.z), b = w.x * w.y * a;
-  frame f = {v3(1.0f + sign * w.x * w.x * a, sign * b, -sign * w.x), v3(b, sign + w.y * w.y * a, -w.y), w};
-  return f;
-}
-
 static fr_error flake(fr_spheres *set, vec3 c, float r, vec3 axis, int depth, uint32_t mat) {
   float cc[3] = {c.x, c.y, c.z};
   fr_error e = fr_spheres_add(set, cc, r, mat);
   if (e || depth == 0) return e;
-  frame f = frame_of(axis);
+  vec3 u, v;
+  v3_onb(axis, &u, &v);
   float rc = r * RATIO, dist = r + rc;
   for (int k = 0; k < 9 && !e; k++) {
     /* six on the equator every 60 degrees, three at 50 degrees up between them */
     float az = k < 6 ? (float)k * (float)M_PI / 3.0f : ((float)(k - 6) * 2.0f + 0.5f) * (float)M_PI / 3.0f;
     float el = k < 6 ? 0.0f : 50.0f * (float)M_PI / 180.0f;
-    vec3 d = v3_add(v3_add(v3_scale(f.u, cosf(el) * cosf(az)), v3_scale(f.v, cosf(el) * sinf(az))), v3_scale(f.w, sinf(el)));
+    vec3 d = v3_add(v3_add(v3_scale(u, cosf(el) * cosf(az)), v3_scale(v, cosf(el) * sinf(az))), v3_scale(axis, sinf(el)));
     d = v3_norm(d);
     e = flake(set, v3_add(c, v3_scale(d, dist)), rc, d, depth - 1, mat);
   }

@@ -47,17 +47,9 @@ static vec3 facing_normal(const fr_scene *s, const fr_hit *h, const fr_ray *r) {
   return v3_dot(n, d) > 0.0f ? v3_scale(n, -1.0f) : n;
 }
 
-static void onb(vec3 n, vec3 *t, vec3 *b) {
-  /* Duff et al., "Building an Orthonormal Basis, Revisited" */
-  float sign = copysignf(1.0f, n.z);
-  float a = -1.0f / (sign + n.z), bb = n.x * n.y * a;
-  *t = v3(1.0f + sign * n.x * n.x * a, sign * bb, -sign * n.x);
-  *b = v3(bb, sign + n.y * n.y * a, -n.y);
-}
-
 static vec3 cosine_dir(vec3 n, float u1, float u2) {
   vec3 t, b;
-  onb(n, &t, &b);
+  v3_onb(n, &t, &b);
   float r = sqrtf(u1), phi = 2.0f * (float)M_PI * u2;
   float x = r * cosf(phi), y = r * sinf(phi), z = sqrtf(fmaxf(0.0f, 1.0f - u1));
   return v3_add(v3_add(v3_scale(t, x), v3_scale(b, y)), v3_scale(n, z));
