@@ -51,6 +51,9 @@ expect 2 "$F" bench --builtin --workload nope --mode single
 expect 2 "$F" bench --builtin --workload primary --mode packet99 --tracer frusta
 expect 2 "$F" bench --builtin --workload primary --mode hybrid16 --threshold 17
 expect 2 "$F" bench --builtin --workload primary --mode hybrid16 --mailbox maybe
+expect 2 "$F" bench --builtin --workload primary --mode single --prefetch maybe
+expect 0 "$F" bench --builtin --workload diffuse8 --mode single --prefetch off --size 32x32 --repeat 1
+grep -q ' prefetch=off ' "$T/out" && ok || bad "bench does not report prefetch=off"
 expect 0 "$F" bench --builtin --workload ao16 --mode hybrid16 --threshold 3 --packet-width 4 --size 32x32 --repeat 1
 grep -q 'workload=ao16 tracer=frusta mode=hybrid16 ' "$T/out" && ok || bad "no hybrid16 line"
 expect 2 "$F" bench --builtin --workload primary --mode single --threads 0

@@ -246,6 +246,10 @@ static void test_options(void **st) {
   o.hybrid_threshold = 7;
   o.packet_bvh_width = 6;
   assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  o.packet_bvh_width = 8;
+  assert_int_equal(o.prefetch, -1);
+  o.prefetch = 2;
+  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
   /* an uncommitted scene: misses, nothing occluded */
   fr_ray16 r16;
   memset(&r16, 0, sizeof r16);

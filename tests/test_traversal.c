@@ -29,11 +29,16 @@ static void check_scene(vec3 center, float size, uint64_t seed) {
      * ray's t there is ill-conditioned), either answer is right. */
     int clear = margin >= 1e-4 && (src == FR_INVALID_ID || ref.prim != src);
     int first_isa = 1;
-    for (int k = 0; k < 6; k++) {
+    for (int k = 0; k < 9; k++) {
       int isa = k % 3;
       if (!fr_isa_supported((fr_isa)isa)) continue;
       assert_int_equal(fr_set_isa((fr_isa)isa), FR_OK);
       assert_int_equal(fr_scene_set_bvh_width(s, k < 3 ? 4 : 8), FR_OK);
+      /* the BVH8 once more with prefetching, which this small scene leaves off by default */
+      fr_trace_options o;
+      fr_scene_get_trace_options(s, &o);
+      o.prefetch = k < 6 ? -1 : 1;
+      assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
       fr_hit h;
       fr_intersect1(s, &ray, &h);
       /* every ISA and width runs the same triangle arithmetic: bit-identical answers */

@@ -109,7 +109,13 @@ fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width,
   out->bounds = t->nodes[0].box;
   conv c = {t, m, out, node_bytes};
   out->root = convert(&c, 0, 1);
+  out->prefetch = fr_bvhn_prefetch_auto(out);
   return FR_OK;
+}
+
+int fr_bvhn_prefetch_auto(const fr_bvhn *b) {
+  size_t node_bytes = b->width == 4 ? sizeof(fr_bvh4_node) : sizeof(fr_bvh8_node);
+  return b->nnodes * node_bytes + b->nleaves * sizeof(fr_tri4) > FR_BVHN_PREFETCH_BYTES;
 }
 
 void fr_bvhn_free(fr_bvhn *b) {

@@ -52,7 +52,14 @@ typedef struct fr_bvhn {
   uint32_t root;
   aabb bounds;
   int depth;
+  /* Single rays prefetch the children they push (trace/bvhn_single.c). That
+   * hides memory latency once the tree outgrows the caches and only costs
+   * instructions while it fits: by default (fr_bvhn_prefetch_auto) it is on
+   * above FR_BVHN_PREFETCH_BYTES. */
+  int prefetch;
 } fr_bvhn;
+
+#define FR_BVHN_PREFETCH_BYTES ((size_t)16 << 20)
 
 typedef struct fr_bvhn_stats {
   size_t inner, leaves, node_bytes, tri_bytes;
@@ -64,6 +71,7 @@ typedef struct fr_bvhn_stats {
 
 fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width, fr_bvhn *out);
 void fr_bvhn_free(fr_bvhn *b);
+int fr_bvhn_prefetch_auto(const fr_bvhn *b);
 /* SAH with a node visit (one SIMD box test) costing 1, and a triangle test or
  * a block test costing 1. */
 void fr_bvhn_stats_get(const fr_bvhn *b, fr_bvhn_stats *st);

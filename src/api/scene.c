@@ -23,6 +23,11 @@ static fr_scene *scene_new(void) {
   return s;
 }
 
+void fr_scene_apply_prefetch(fr_scene *s) {
+  fr_bvhn *b[2] = {&s->bvh4, &s->bvh8};
+  for (int i = 0; i < 2; i++) b[i]->prefetch = s->trace.prefetch < 0 ? fr_bvhn_prefetch_auto(b[i]) : s->trace.prefetch;
+}
+
 fr_error fr_scene_set_bvh_width(fr_scene *s, int width) {
   if (!s || (width != 4 && width != 8)) return fr_fail(FR_ERR_ARG, "BVH width must be 4 or 8");
   s->single_width = width;
@@ -182,6 +187,7 @@ fr_error fr_scene_commit(fr_scene *s) {
   s->bounds = aabb_merge(s->bounds, s->sphere_bvh.bounds);
   s->build_seconds = fr_seconds() - t0;
   s->committed = 1;
+  fr_scene_apply_prefetch(s);
   return FR_OK;
 }
 

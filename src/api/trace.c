@@ -13,6 +13,7 @@ void fr_trace_options_default(fr_trace_options *o) {
   o->mailbox = 0;
   o->axis_aligned = 1;
   o->ia_cull = 1;
+  o->prefetch = -1;
 }
 
 fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o) {
@@ -22,7 +23,9 @@ fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o) {
     return fr_fail(FR_ERR_ARG, "hybrid threshold %d (0..16)", o->hybrid_threshold);
   if (o->packet_bvh_width != 4 && o->packet_bvh_width != 8)
     return fr_fail(FR_ERR_ARG, "packet BVH width %d (4 or 8)", o->packet_bvh_width);
+  if (o->prefetch < -1 || o->prefetch > 1) return fr_fail(FR_ERR_ARG, "prefetch %d (-1, 0 or 1)", o->prefetch);
   s->trace = *o;
+  fr_scene_apply_prefetch(s);
   return FR_OK;
 }
 

@@ -152,6 +152,18 @@ FR_INLINE uint32_t order_children(const node_t *n, int mask, const float *dist, 
   return e[k - 1].ref;
 }
 
+/* Starts loading a pushed child while the nearer one is traversed: a node's
+ * four lines and a block's three come as two pairs (the adjacent-line
+ * prefetcher fetches 128-byte pairs). Measured on diffuse rays, interleaved
+ * A/B, 6 pairs each: hairball +9%, dragon +8%; on kitchen, whose tree fits
+ * in the caches, -6%, hence b->prefetch. */
+FR_INLINE void prefetch_ref(const fr_bvhn *b, uint32_t ref) {
+  const char *p = (ref & FR_BVHN_LEAF) ? (const char *)&b->tris[ref & ~FR_BVHN_LEAF]
+                                       : (const char *)((const node_t *)b->nodes + ref);
+  __builtin_prefetch(p);
+  __builtin_prefetch(p + 128);
+}
+
 /* Closest hit in the subtree at root before *tfar; fills *best on a hit. */
 FR_INLINE int closest(const fr_bvhn *b, const ray_pre *rp, uint32_t root, float tfar, fr_subtree_hit *best) {
   entry stack[STACK_SIZE];
@@ -166,7 +178,10 @@ FR_INLINE int closest(const fr_bvhn *b, const ray_pre *rp, uint32_t root, float 
       float dist[W] __attribute__((aligned(32)));
       int mask = visit_node(n, rp, tfar, dist);
       if (!mask) goto next;
+      int sp0 = sp;
       ref = order_children(n, mask, dist, stack, &sp);
+      if (b->prefetch)
+        for (int i = sp0; i < sp; i++) prefetch_ref(b, stack[i].ref);
     }
     {
       FR_COUNT(leaves, 1);
@@ -232,7 +247,11 @@ FR_INLINE int any_hit(const fr_bvhn *b, const ray_pre *rp, uint32_t root, const 
       {
         int last = 31 - __builtin_clz((unsigned)mask);
         ref = n->child[last];
-        for (int m = mask & ~(1 << last); m; m &= m - 1) stack[sp++] = (entry){n->child[__builtin_ctz(m)], 0.0f};
+        for (int m = mask & ~(1 << last); m; m &= m - 1) {
+          uint32_t c = n->child[__builtin_ctz(m)];
+          if (b->prefetch) prefetch_ref(b, c);
+          stack[sp++] = (entry){c, 0.0f};
+        }
       }
     }
     {

@@ -114,7 +114,7 @@ int cmd_bench(int argc, char **argv) {
     const char *a = argv[i];
     if (!strcmp(a, "--threshold") || !strcmp(a, "--mailbox") || !strcmp(a, "--axis-aligned") || !strcmp(a, "--ia") ||
         !strcmp(a, "--packet-width") || !strcmp(a, "--corner-rays") || !strcmp(a, "--shrink") || !strcmp(a, "--mft-leaf") ||
-        !strcmp(a, "--light-sets")) {
+        !strcmp(a, "--light-sets") || !strcmp(a, "--prefetch")) {
       if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
       const char *val = argv[++i];
       if (!strcmp(a, "--light-sets")) {
@@ -126,6 +126,10 @@ int cmd_bench(int argc, char **argv) {
       } else if (!strcmp(a, "--mft-leaf")) {
         if (!cli_parse_int(val, 1, FR_BVH2_MAX_LEAF, &mft_leaf))
           return cli_error(CLI_USAGE_ERROR, "--mft-leaf wants 1..%d, got '%s'", FR_BVH2_MAX_LEAF, val);
+      } else if (!strcmp(a, "--prefetch")) {
+        if (!strcmp(val, "auto")) topt.prefetch = -1;
+        else if (!strcmp(val, "on") || !strcmp(val, "off")) topt.prefetch = !strcmp(val, "on");
+        else return cli_error(CLI_USAGE_ERROR, "--prefetch is on, off or auto, not '%s'", val);
       } else if (!strcmp(a, "--threshold")) {
         if (!cli_parse_int(val, 0, 16, &topt.hybrid_threshold)) return cli_error(CLI_USAGE_ERROR, "--threshold wants 0..16, got '%s'", val);
       } else if (!strcmp(a, "--packet-width")) {
@@ -182,10 +186,11 @@ int cmd_bench(int argc, char **argv) {
   const fr_wide_stats *ws = st.single_width == 4 ? &st.bvh4 : &st.bvh8;
   /* packets traverse the packet BVH and test its Shevtsov records */
   const fr_wide_stats *wp = topt.packet_bvh_width == 4 ? &st.bvh4 : &st.bvh8;
+  int prefetch = topt.prefetch >= 0 ? topt.prefetch : fr_bvhn_prefetch_auto(st.single_width == 4 ? &s->bvh4 : &s->bvh8);
   printf("build_seconds=%.3f tracer=frusta scene=%s tris=%zu threads=%d isa=%s bvh_width=%d sah=%.2f bytes_per_tri=%.1f "
-         "packet_bvh_width=%d packet_bytes_per_tri=%.1f\n",
+         "prefetch=%s packet_bvh_width=%d packet_bytes_per_tri=%.1f\n",
          st.build_seconds, s->name, tris, threads, fr_isa_name(fr_get_isa()), st.single_width, ws->sah,
-         (double)(ws->node_bytes + ws->tri_bytes) / (double)tris, topt.packet_bvh_width,
+         (double)(ws->node_bytes + ws->tri_bytes) / (double)tris, prefetch ? "on" : "off", topt.packet_bvh_width,
          (double)(wp->node_bytes + wp->tri_bytes + wp->packet_tri_bytes) / (double)tris);
   if (use_frusta && !strcmp(mode, "mft") && fr_scene_sphere_count(s)) {
     size_t ns = fr_scene_sphere_count(s);
