@@ -59,7 +59,7 @@ typedef struct fr_bvhn {
   int prefetch;
 } fr_bvhn;
 
-#define FR_BVHN_PREFETCH_BYTES ((size_t)16 << 20)
+#define FR_BVHN_PREFETCH_BYTES ((size_t)64 << 20)
 
 typedef struct fr_bvhn_stats {
   size_t inner, leaves, node_bytes, tri_bytes;

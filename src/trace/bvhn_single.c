@@ -154,9 +154,11 @@ FR_INLINE uint32_t order_children(const node_t *n, int mask, const float *dist, 
 
 /* Starts loading a pushed child while the nearer one is traversed: a node's
  * four lines and a block's three come as two pairs (the adjacent-line
- * prefetcher fetches 128-byte pairs). Measured on diffuse rays, interleaved
- * A/B, 6 pairs each: hairball +9%, dragon +8%; on kitchen, whose tree fits
- * in the caches, -6%, hence b->prefetch. */
+ * prefetcher fetches 128-byte pairs). Prefetch on against off, same binary,
+ * interleaved, 1 thread, 512x512, mean of 5 pairs: hairball (183 MB) shadow
+ * +9%, diffuse8 +8%, ao16 +4%; dragon (55 MB) diffuse8 +3%, ao16 +4%, but
+ * shadow -9% (coherent rays find the tree in the caches); kitchen, which
+ * fits, -6% on diffuse8. Hence on only above FR_BVHN_PREFETCH_BYTES. */
 FR_INLINE void prefetch_ref(const fr_bvhn *b, uint32_t ref) {
   const char *p = (ref & FR_BVHN_LEAF) ? (const char *)&b->tris[ref & ~FR_BVHN_LEAF]
                                        : (const char *)((const node_t *)b->nodes + ref);
