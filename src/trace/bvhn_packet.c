@@ -220,9 +220,11 @@ typedef struct stack_entry {
 
 /* Pushes the children in keep for a lazy test: sorted farthest first (closest
  * hit), or in slot order so that the last slot pops first (any hit). */
-FR_INLINE int push_lazy(stack_entry *stack, int sp, const node_t *n, int keep, unsigned active, const float *lo,
-                        int sorted) {
+FR_INLINE int push_lazy(const fr_bvhn *b, stack_entry *stack, int sp, const node_t *n, int keep, unsigned active,
+                        const float *lo, int sorted) {
   const float *f = (const float *)n;
+  if (b->prefetch)
+    for (int m = keep; m; m &= m - 1) prefetch_ref(b, n->child[__builtin_ctz((unsigned)m)]);
   if (!sorted) {
     for (; keep; keep &= keep - 1) {
       int c = __builtin_ctz((unsigned)keep);
@@ -234,9 +236,9 @@ FR_INLINE int push_lazy(stack_entry *stack, int sp, const node_t *n, int keep, u
   for (; keep; keep &= keep - 1) { /* insertion sort by entry bound, farthest first */
     int c = __builtin_ctz((unsigned)keep);
     stack_entry x = {n->child[c], active, c, lo[c], f};
-    int b = sp - 1;
-    while (b >= base && stack[b].dist < x.dist) { stack[b + 1] = stack[b]; b--; }
-    stack[b + 1] = x;
+    int j = sp - 1;
+    while (j >= base && stack[j].dist < x.dist) { stack[j + 1] = stack[j]; j--; }
+    stack[j + 1] = x;
     sp++;
   }
   return sp;
@@ -383,7 +385,7 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
       float lo[W] __attribute__((aligned(32)));
       int keep = ia_test(n, &pk, tmax, lo) & cand;
       FR_COUNT(ia_culled, __builtin_popcount((unsigned)(cand & ~keep)));
-      sp = push_lazy(stack, sp, n, keep, active, lo, 1);
+      sp = push_lazy(b, stack, sp, n, keep, active, lo, 1);
       continue;
     }
     /* Mixed direction signs: each child against every ray now; hit
@@ -480,7 +482,7 @@ static unsigned occluded_packet(const fr_bvhn *b, const fr_packet_opts *o, unsig
         float lo[W] __attribute__((aligned(32)));
         int keep = ia_test(n, &pk, tfar_max, lo) & cand;
         FR_COUNT(ia_culled, __builtin_popcount((unsigned)(cand & ~keep)));
-        sp = push_lazy(stack, sp, n, keep, active, lo, 0);
+        sp = push_lazy(b, stack, sp, n, keep, active, lo, 0);
         goto next;
       }
       /* slot order, so the last slot pops first (see the single-ray any-hit) */

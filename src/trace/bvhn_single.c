@@ -152,20 +152,6 @@ FR_INLINE uint32_t order_children(const node_t *n, int mask, const float *dist, 
   return e[k - 1].ref;
 }
 
-/* Starts loading a pushed child while the nearer one is traversed: a node's
- * four lines and a block's three come as two pairs (the adjacent-line
- * prefetcher fetches 128-byte pairs). Prefetch on against off, same binary,
- * interleaved, 1 thread, 512x512, mean of 5 pairs: hairball (183 MB) shadow
- * +9%, diffuse8 +8%, ao16 +4%; dragon (55 MB) diffuse8 +3%, ao16 +4%, but
- * shadow -9% (coherent rays find the tree in the caches); kitchen, which
- * fits, -6% on diffuse8. Hence on only above FR_BVHN_PREFETCH_BYTES. */
-FR_INLINE void prefetch_ref(const fr_bvhn *b, uint32_t ref) {
-  const char *p = (ref & FR_BVHN_LEAF) ? (const char *)&b->tris[ref & ~FR_BVHN_LEAF]
-                                       : (const char *)((const node_t *)b->nodes + ref);
-  __builtin_prefetch(p);
-  __builtin_prefetch(p + 128);
-}
-
 /* Closest hit in the subtree at root before *tfar; fills *best on a hit. */
 FR_INLINE int closest(const fr_bvhn *b, const ray_pre *rp, uint32_t root, float tfar, fr_subtree_hit *best) {
   entry stack[STACK_SIZE];
