@@ -54,7 +54,8 @@ typedef vfloat4 vnode;
  * shadow -9% (coherent rays find the tree in the caches); kitchen, which
  * fits, -6% on diffuse8. Hence on only above FR_BVHN_PREFETCH_BYTES. The
  * packet kernels prefetch the children they push too: hairball primary
- * packet16 +13%, ao16 and diffuse8 hybrid16 within noise (-2%, 0%). */
+ * packet16 +13%, shadow packet16 -4%, ao16 and diffuse8 hybrid16 -2%, 0%
+ * (all but the first within this VM's noise). */
 FR_INLINE void prefetch_ref(const fr_bvhn *b, uint32_t ref) {
   const char *p = (ref & FR_BVHN_LEAF) ? (const char *)&b->tris[ref & ~FR_BVHN_LEAF]
                                        : (const char *)((const node_t *)b->nodes + ref);
