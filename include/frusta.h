@@ -216,8 +216,8 @@ typedef struct fr_trace_options {
   int mailbox;            /* inverse mailboxing in packet leaves (default off, see README) */
   int axis_aligned;       /* Shevtsov's axis-aligned fast path (default on) */
   int ia_cull;            /* interval-arithmetic culling of nodes for whole packets (default on) */
-  int prefetch;           /* single rays prefetch the children they defer: 1 on, 0 off, -1 (default)
-                             on when the BVH and triangles exceed 64 MB, where it hides memory latency */
+  int prefetch;           /* rays and packets prefetch the children they defer: 1 on, 0 off, -1
+                             (default) on when the BVH and triangles exceed 64 MB (see README) */
 } fr_trace_options;
 
 void fr_trace_options_default(fr_trace_options *o);

@@ -56,14 +56,20 @@ static void to_ray16(const fr_ray *rays, fr_ray16 *p) {
 }
 
 /* The configurations under test; each is compared with the single-ray kernels. */
-typedef struct config { const char *name; fr_trace_mode mode; int threshold, width, mailbox, axis_aligned, ia; } config;
+typedef struct config {
+  const char *name;
+  fr_trace_mode mode;
+  int threshold, width, mailbox, axis_aligned, ia, prefetch;
+} config;
 static const config configs[] = {
-    {"packet16", FR_TRACE_PACKET16, 0, 4, 0, 1, 1},  {"packet8", FR_TRACE_PACKET8, 0, 4, 0, 1, 1},
-    {"hybrid16", FR_TRACE_HYBRID16, 7, 4, 0, 1, 1},  {"hybrid16/t3", FR_TRACE_HYBRID16, 3, 4, 0, 1, 1},
-    {"hybrid16/t16", FR_TRACE_HYBRID16, 16, 4, 0, 1, 1}, {"packet16/bvh8", FR_TRACE_PACKET16, 0, 8, 0, 1, 1},
-    {"hybrid16/bvh8", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1}, {"packet16/mailbox", FR_TRACE_PACKET16, 0, 4, 1, 1, 1},
-    {"packet16/no-aa", FR_TRACE_PACKET16, 0, 4, 0, 0, 1}, {"packet16/no-ia", FR_TRACE_PACKET16, 0, 4, 0, 1, 0},
-    {"auto", FR_TRACE_AUTO, 7, 4, 0, 1, 1},
+    {"packet16", FR_TRACE_PACKET16, 0, 4, 0, 1, 1, 0},  {"packet8", FR_TRACE_PACKET8, 0, 4, 0, 1, 1, 0},
+    {"hybrid16", FR_TRACE_HYBRID16, 7, 4, 0, 1, 1, 0},  {"hybrid16/t3", FR_TRACE_HYBRID16, 3, 4, 0, 1, 1, 0},
+    {"hybrid16/t16", FR_TRACE_HYBRID16, 16, 4, 0, 1, 1, 0}, {"packet16/bvh8", FR_TRACE_PACKET16, 0, 8, 0, 1, 1, 0},
+    {"hybrid16/bvh8", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 0}, {"packet16/mailbox", FR_TRACE_PACKET16, 0, 4, 1, 1, 1, 0},
+    {"packet16/no-aa", FR_TRACE_PACKET16, 0, 4, 0, 0, 1, 0}, {"packet16/no-ia", FR_TRACE_PACKET16, 0, 4, 0, 1, 0, 0},
+    {"auto", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0},
+    /* prefetching, which these small scenes leave off by default */
+    {"hybrid16/bvh8/prefetch", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 1},
 };
 #define NCONFIGS (sizeof configs / sizeof configs[0])
 
@@ -76,6 +82,7 @@ static void set_config(fr_scene *s, const config *c) {
   o.mailbox = c->mailbox;
   o.axis_aligned = c->axis_aligned;
   o.ia_cull = c->ia;
+  o.prefetch = c->prefetch ? 1 : -1;
   assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
 }
 
@@ -211,7 +218,7 @@ static void test_leaf_against_scalar(void **st) {
       if (!fr_isa_supported((fr_isa)isa)) continue;
       fr_set_isa((fr_isa)isa);
       for (int aa = 0; aa < 2; aa++) {
-        config c = {"leaf", FR_TRACE_PACKET16, 0, 4, 0, aa, 1};
+        config c = {"leaf", FR_TRACE_PACKET16, 0, 4, 0, aa, 1, 0};
         set_config(s, &c);
         fr_tri_shevtsov use = rec;
         if (!aa) use.axis_aligned = 0;

@@ -52,7 +52,7 @@ typedef struct fr_bvhn {
   uint32_t root;
   aabb bounds;
   int depth;
-  /* Single rays prefetch the children they push (trace/bvhn_single.c). That
+  /* Traversals prefetch the children they push (trace/bvhn_node.h). That
    * hides memory latency once the tree outgrows the caches and only costs
    * instructions while it fits: by default (fr_bvhn_prefetch_auto) it is on
    * above FR_BVHN_PREFETCH_BYTES. */

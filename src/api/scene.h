@@ -22,11 +22,11 @@ struct fr_scene {
   char name[64];        /* scene name for views and reports */
 };
 
+/* Sets the BVH4's and BVH8's prefetching from the trace options. */
+void fr_scene_apply_prefetch(fr_scene *s);
 /* Another binary BVH of a committed scene with leaves of up to max_leaf
  * triangles (the shallow trees multi-frusta tracing may prefer); the caller
  * frees it with fr_bvh2_free. */
-/* Sets the single-ray kernels' prefetching from the trace options. */
-void fr_scene_apply_prefetch(fr_scene *s);
 fr_error fr_scene_build_bvh2(fr_scene *s, int max_leaf, fr_bvh2 *out);
 /* The first sphere's prim number (the triangle count). */
 static inline uint32_t fr_scene_sphere_base(const fr_scene *s) { return (uint32_t)s->mesh.ntris; }
