@@ -124,9 +124,11 @@ typedef struct fr_wide_stats {
   size_t node_bytes, tri_bytes;  /* nodes, leaf triangle blocks */
   double sah, sah_blocks;
   double node_fill;              /* mean children per inner node */
-  double leaf_fill;              /* mean triangles per leaf (of 4) */
+  double leaf_fill;              /* mean triangles per leaf */
   int depth;
   size_t packet_tri_bytes;       /* Shevtsov records the packet kernels test */
+  size_t blocks;                 /* 4-triangle blocks: a leaf holds 1-3 */
+  double block_fill;             /* mean triangles per block (of 4) */
 } fr_wide_stats;
 
 typedef struct fr_bvh_stats {

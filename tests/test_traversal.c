@@ -14,6 +14,11 @@ static void check_scene(vec3 center, float size, uint64_t seed) {
   scene_data sd = make_scene(&r, 3000, center, size);
   fr_scene *s = commit_scene(&sd);
   assert_true(fr_scene_skipped_triangles(s) > 0); /* the degenerate ones */
+  /* some leaves hold several blocks, so the kernels' loop over them runs */
+  fr_bvh_stats st;
+  assert_int_equal(fr_scene_stats(s, &st), FR_OK);
+  assert_true(st.bvh8.blocks > st.bvh8.leaves && st.bvh4.blocks > st.bvh4.leaves);
+  assert_true(st.bvh8.block_fill > 0.0 && st.bvh8.block_fill <= 4.0);
   int checked = 0, hits = 0;
   for (int i = 0; i < 4000; i++) {
     uint32_t src;

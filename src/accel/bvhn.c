@@ -1,10 +1,17 @@
 #include "bvhn.h"
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "base/alloc.h"
 #include "base/error.h"
 
-typedef struct conv { const fr_build_tree *t; const fr_mesh *m; fr_bvhn *b; size_t node_bytes; } conv;
+typedef struct conv {
+  const fr_build_tree *t;
+  const fr_mesh *m;
+  fr_bvhn *b;
+  size_t node_bytes;
+  int max_blocks; /* per leaf */
+} conv;
 
 static void fill_block(conv *c, fr_tri4 *blk, uint32_t first, uint32_t count) {
   for (int l = 0; l < 4; l++) {
@@ -40,10 +47,33 @@ static void fill_block(conv *c, fr_tri4 *blk, uint32_t first, uint32_t count) {
   }
 }
 
+/* Packs the node's triangles into consecutive blocks, in leaf order. */
 static uint32_t make_leaf(conv *c, const fr_build_node *n) {
-  uint32_t li = (uint32_t)c->b->nleaves++;
-  fill_block(c, &c->b->tris[li], n->first, n->count);
-  return FR_BVHN_LEAF | li;
+  uint32_t nb = n->count ? (n->count + 3) / 4 : 1;
+  uint32_t first = (uint32_t)c->b->nblocks;
+  c->b->nblocks += nb;
+  c->b->nleaves++;
+  for (uint32_t k = 0; k < nb; k++) {
+    uint32_t rest = n->count - 4 * k;
+    fill_block(c, &c->b->tris[first + k], n->first + 4 * k, rest < 4 ? rest : 4);
+  }
+  return FR_BVHN_LEAF_REF(first, nb);
+}
+
+static float blocks_of(uint32_t count) { return (float)((count + 3) / 4); }
+
+/* Whether a node of more than four triangles ends as a leaf of several
+ * blocks: when testing all its blocks costs no more than visiting it and
+ * testing its two halves' blocks (Embree's rule, node visit and block test
+ * both costing 1). Without it every node of 5-16 triangles became a node of
+ * two or three children, and the BVH8 had twice Embree's node count. */
+static int leaf_pays(conv *c, const fr_build_node *n) {
+  if (n->count > 4 * (uint32_t)c->max_blocks || n->left < 0) return n->left < 0;
+  const fr_build_node *l = &c->t->nodes[n->left], *r = &c->t->nodes[n->right];
+  float a = aabb_half_area(n->box);
+  float leaf = a * blocks_of(n->count);
+  float split = a + aabb_half_area(l->box) * blocks_of(l->count) + aabb_half_area(r->box) * blocks_of(r->count);
+  return leaf <= split;
 }
 
 /* Node i's float arrays (generic over the width). */
@@ -60,7 +90,7 @@ static uint32_t convert(conv *c, int32_t bi, int depth) {
   const fr_build_node *n = &c->t->nodes[bi];
   const int W = c->b->width;
   if (depth > c->b->depth) c->b->depth = depth;
-  if (n->count <= FR_BUILD_MAX_LEAF) return make_leaf(c, n);
+  if (n->count <= FR_BUILD_MAX_LEAF || leaf_pays(c, n)) return make_leaf(c, n);
   int32_t kids[8] = {n->left, n->right};
   int nk = 2;
   while (nk < W) {
@@ -107,7 +137,15 @@ fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width,
     return fr_fail(FR_ERR_NOMEM, "BVH%d: out of memory", width);
   }
   out->bounds = t->nodes[0].box;
-  conv c = {t, m, out, node_bytes};
+  /* FRUSTA_LEAF_BLOCKS=1..8 overrides the default, for measurements */
+  const char *env = getenv("FRUSTA_LEAF_BLOCKS");
+  int mb = FR_BVHN_DEFAULT_LEAF_BLOCKS;
+  if (env && env[0] >= '1' && env[0] <= '0' + FR_BVHN_MAX_LEAF_BLOCKS && !env[1]) mb = env[0] - '0';
+  if (np > FR_BVHN_MAX_BLOCKS) { /* every block holds a triangle */
+    fr_bvhn_free(out);
+    return fr_fail(FR_ERR_ARG, "BVH%d: %zu triangles are more than a leaf reference can address", width, np);
+  }
+  conv c = {t, m, out, node_bytes, mb};
   out->root = convert(&c, 0, 1);
   out->prefetch = fr_bvhn_prefetch_auto(out);
   return FR_OK;
@@ -115,7 +153,7 @@ fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width,
 
 int fr_bvhn_prefetch_auto(const fr_bvhn *b) {
   size_t node_bytes = b->width == 4 ? sizeof(fr_bvh4_node) : sizeof(fr_bvh8_node);
-  return b->nnodes * node_bytes + b->nleaves * sizeof(fr_tri4) > FR_BVHN_PREFETCH_BYTES;
+  return b->nnodes * node_bytes + b->nblocks * sizeof(fr_tri4) > FR_BVHN_PREFETCH_BYTES;
 }
 
 void fr_bvhn_free(fr_bvhn *b) {
@@ -126,9 +164,10 @@ void fr_bvhn_free(fr_bvhn *b) {
 }
 
 static int leaf_count(const fr_bvhn *b, uint32_t ref) {
-  const fr_tri4 *t = &b->tris[ref & ~FR_BVHN_LEAF];
+  const fr_tri4 *t = &b->tris[FR_BVHN_LEAF_FIRST(ref)];
   int n = 0;
-  for (int l = 0; l < 4; l++) n += t->prim[l] != FR_INVALID_ID;
+  for (uint32_t k = 0; k < FR_BVHN_LEAF_BLOCKS(ref); k++)
+    for (int l = 0; l < 4; l++) n += t[k].prim[l] != FR_INVALID_ID;
   return n;
 }
 
@@ -137,9 +176,12 @@ void fr_bvhn_stats_get(const fr_bvhn *b, fr_bvhn_stats *st) {
   size_t node_bytes = W == 4 ? sizeof(fr_bvh4_node) : sizeof(fr_bvh8_node);
   double root = aabb_half_area(b->bounds);
   size_t kids = 0, tris = 0;
-  double cost = (b->root & FR_BVHN_LEAF) ? leaf_count(b, b->root) : 1.0;
-  double cost_blocks = (b->root & FR_BVHN_LEAF) ? (double)((leaf_count(b, b->root) + 3) / 4) : 1.0;
-  if (b->root & FR_BVHN_LEAF) tris += (size_t)leaf_count(b, b->root);
+  double cost = 1.0, cost_blocks = 1.0;
+  if (b->root & FR_BVHN_LEAF) {
+    tris = (size_t)leaf_count(b, b->root);
+    cost = (double)tris;
+    cost_blocks = FR_BVHN_LEAF_BLOCKS(b->root);
+  }
   for (size_t i = 0; i < b->nnodes; i++) {
     const float *f = (const float *)((const char *)b->nodes + i * node_bytes);
     const uint32_t *child = (const uint32_t *)(f + 6 * W);
@@ -152,7 +194,7 @@ void fr_bvhn_stats_get(const fr_bvhn *b, fr_bvhn_stats *st) {
         int cnt = leaf_count(b, child[k]);
         tris += (size_t)cnt;
         cost += w * cnt;
-        cost_blocks += w * ((cnt + 3) / 4);
+        cost_blocks += w * FR_BVHN_LEAF_BLOCKS(child[k]);
       } else {
         cost += w;
         cost_blocks += w;
@@ -161,12 +203,14 @@ void fr_bvhn_stats_get(const fr_bvhn *b, fr_bvhn_stats *st) {
   }
   st->inner = b->nnodes;
   st->leaves = b->nleaves;
+  st->blocks = b->nblocks;
   st->node_bytes = b->nnodes * node_bytes;
-  st->tri_bytes = b->nleaves * sizeof(fr_tri4);
-  st->packet_tri_bytes = b->nleaves * 4 * sizeof(fr_tri_shevtsov);
+  st->tri_bytes = b->nblocks * sizeof(fr_tri4);
+  st->packet_tri_bytes = b->nblocks * 4 * sizeof(fr_tri_shevtsov);
   st->sah = cost;
   st->sah_blocks = cost_blocks;
   st->node_fill = b->nnodes ? (double)kids / (double)b->nnodes : 0.0;
   st->leaf_fill = b->nleaves ? (double)tris / (double)b->nleaves : 0.0;
+  st->block_fill = b->nblocks ? (double)tris / (double)b->nblocks : 0.0;
   st->depth = b->depth;
 }

@@ -285,7 +285,7 @@ fr_error fr_scene_stats(const fr_scene *s, fr_bvh_stats *st) {
   for (int i = 0; i < 2; i++) {
     fr_bvhn_stats b;
     fr_bvhn_stats_get(src[i], &b);
-    *dst[i] = (fr_wide_stats){b.inner, b.leaves, b.node_bytes, b.tri_bytes, b.sah, b.sah_blocks, b.node_fill, b.leaf_fill, b.depth, b.packet_tri_bytes};
+    *dst[i] = (fr_wide_stats){b.inner, b.leaves, b.node_bytes, b.tri_bytes, b.sah, b.sah_blocks, b.node_fill, b.leaf_fill, b.depth, b.packet_tri_bytes, b.blocks, b.block_fill};
   }
   st->build_seconds = s->build_seconds;
   st->single_width = s->single_width;

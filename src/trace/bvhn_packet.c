@@ -350,9 +350,10 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
       continue;
     }
     if (ref & FR_BVHN_LEAF) {
-      const uint32_t li = ref & ~FR_BVHN_LEAF;
+      const uint32_t li = FR_BVHN_LEAF_FIRST(ref);
       const fr_tri_shevtsov *rec = &b->shev[4 * (size_t)li];
-      for (int j = 0; j < 4 && rec[j].prim != FR_INVALID_ID; j++) {
+      const int nrec = 4 * (int)FR_BVHN_LEAF_BLOCKS(ref);
+      for (int j = 0; j < nrec && rec[j].prim != FR_INVALID_ID; j++) { /* only the last block has empty lanes */
         if (o->mailbox && mailbox_seen(&mb, rec[j].prim)) { FR_COUNT(mailbox_hits, 1); continue; }
         FR_COUNT(pk_tri_tests, 1);
         FR_COUNT(pk_tri_lanes, nactive);
@@ -366,9 +367,10 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
         V = vp_select(hm, v, V);
         for (unsigned m = hit; m; m &= m - 1) best[__builtin_ctz(m)] = 4 * li + (uint32_t)j;
         /* finish() reads the hit triangles' vertices: start loading them now */
-        __builtin_prefetch(&b->tris[li]);
-        __builtin_prefetch((const char *)&b->tris[li] + 64);
-        __builtin_prefetch((const char *)&b->tris[li] + 128);
+        const char *blk = (const char *)&b->tris[li + (uint32_t)j / 4];
+        __builtin_prefetch(blk);
+        __builtin_prefetch(blk + 64);
+        __builtin_prefetch(blk + 128);
       }
       continue;
     }
@@ -463,8 +465,9 @@ static unsigned occluded_packet(const fr_bvhn *b, const fr_packet_opts *o, unsig
         if (o->single->occluded_subtree(b, ref, &r)) occ |= 1u << i;
       }
     } else if (ref & FR_BVHN_LEAF) {
-      const fr_tri_shevtsov *rec = &b->shev[4 * (size_t)(ref & ~FR_BVHN_LEAF)];
-      for (int j = 0; j < 4 && rec[j].prim != FR_INVALID_ID && active; j++) {
+      const fr_tri_shevtsov *rec = &b->shev[4 * (size_t)FR_BVHN_LEAF_FIRST(ref)];
+      const int nrec = 4 * (int)FR_BVHN_LEAF_BLOCKS(ref);
+      for (int j = 0; j < nrec && rec[j].prim != FR_INVALID_ID && active; j++) {
         if (o->mailbox && mailbox_seen(&mb, rec[j].prim)) { FR_COUNT(mailbox_hits, 1); continue; }
         FR_COUNT(pk_tri_tests, 1);
         FR_COUNT(pk_tri_lanes, __builtin_popcount(active));

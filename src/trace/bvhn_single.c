@@ -12,12 +12,16 @@
 #include "trace/counters.h"
 #include "trace/kernels.h"
 
-/* What a ray precomputes once for all its node and triangle tests. */
+/* What a ray precomputes once for all its node and triangle tests. Both
+ * tests subtract node or vertex coordinates from the origin rather than the
+ * origin from them, so the load folds into the subtraction; the negated
+ * reciprocals and shear make every result bit-identical to the textbook
+ * order (IEEE subtraction and products are exactly sign-symmetric). */
 typedef struct ray_pre {
-  vnode ox, oy, oz, rx, ry, rz; /* for the node tests */
+  vnode ox, oy, oz, nrx, nry, nrz; /* origin, -1/dir: node tests */
   vfloat4 o_k[3];             /* origin in the shear frame: kx, ky, kz */
-  vfloat4 sx, sy, sz;         /* the watertight test's shear */
-  int kx, ky, kz;
+  vfloat4 sx, sy, nsz;        /* the watertight test's shear; nsz = -sz */
+  int kx4, ky4, kz4;          /* 4 * kx...: float offsets of an axis in a block */
   int near_x, near_y, near_z; /* float offsets of the near planes in a node */
   float tnear;
 } ray_pre;
@@ -32,10 +36,10 @@ static inline void ray_setup(ray_pre *r, const fr_ray *ray) {
   float rx = safe_rcp(ray->dir[0]), ry = safe_rcp(ray->dir[1]), rz = safe_rcp(ray->dir[2]);
   r->ox = VN(ray->org[0]); r->oy = VN(ray->org[1]); r->oz = VN(ray->org[2]);
   fr_wt_ray w = fr_wt_setup(v3_load(ray->dir));
-  r->kx = w.kx; r->ky = w.ky; r->kz = w.kz;
+  r->kx4 = 4 * w.kx; r->ky4 = 4 * w.ky; r->kz4 = 4 * w.kz;
   r->o_k[0] = vf4(ray->org[w.kx]); r->o_k[1] = vf4(ray->org[w.ky]); r->o_k[2] = vf4(ray->org[w.kz]);
-  r->sx = vf4(w.sx); r->sy = vf4(w.sy); r->sz = vf4(w.sz);
-  r->rx = VN(rx); r->ry = VN(ry); r->rz = VN(rz);
+  r->sx = vf4(w.sx); r->sy = vf4(w.sy); r->nsz = vf4(-w.sz);
+  r->nrx = VN(-rx); r->nry = VN(-ry); r->nrz = VN(-rz);
   /* node layout (accel/bvhn.h): lo_x 0, hi_x W, lo_y 2W, hi_y 3W, lo_z 4W, hi_z 5W */
   r->near_x = rx >= 0.0f ? 0 : W;
   r->near_y = ry >= 0.0f ? 2 * W : 3 * W;
@@ -43,15 +47,16 @@ static inline void ray_setup(ray_pre *r, const fr_ray *ray) {
   r->tnear = ray->tnear;
 }
 
-/* Returns the mask of children hit within [tnear, tfar]; dist gets their entry distances. */
+/* Returns the mask of children hit within [tnear, tfar]; dist gets their
+ * entry distances. (o - plane) * -rdir is (plane - o) * rdir exactly. */
 FR_INLINE int box_test(const node_t *n, const ray_pre *r, float tfar, float *dist) {
   const float *f = (const float *)n;
-  vnode tnx = VN_MUL(VN_SUB(VN_LOAD(f + r->near_x), r->ox), r->rx);
-  vnode tny = VN_MUL(VN_SUB(VN_LOAD(f + r->near_y), r->oy), r->ry);
-  vnode tnz = VN_MUL(VN_SUB(VN_LOAD(f + r->near_z), r->oz), r->rz);
-  vnode tfx = VN_MUL(VN_SUB(VN_LOAD(f + (r->near_x ^ W)), r->ox), r->rx);
-  vnode tfy = VN_MUL(VN_SUB(VN_LOAD(f + (r->near_y ^ W)), r->oy), r->ry);
-  vnode tfz = VN_MUL(VN_SUB(VN_LOAD(f + (r->near_z ^ W)), r->oz), r->rz);
+  vnode tnx = VN_MUL(VN_SUB(r->ox, VN_LOAD(f + r->near_x)), r->nrx);
+  vnode tny = VN_MUL(VN_SUB(r->oy, VN_LOAD(f + r->near_y)), r->nry);
+  vnode tnz = VN_MUL(VN_SUB(r->oz, VN_LOAD(f + r->near_z)), r->nrz);
+  vnode tfx = VN_MUL(VN_SUB(r->ox, VN_LOAD(f + (r->near_x ^ W))), r->nrx);
+  vnode tfy = VN_MUL(VN_SUB(r->oy, VN_LOAD(f + (r->near_y ^ W))), r->nry);
+  vnode tfz = VN_MUL(VN_SUB(r->oz, VN_LOAD(f + (r->near_z ^ W))), r->nrz);
   vnode tn = VN_MAX(VN_MAX(tnx, tny), VN_MAX(tnz, VN(r->tnear)));
   vnode tf = VN_MIN(VN_MIN(tfx, tfy), VN_MIN(tfz, VN(tfar)));
   VN_STORE(dist, tn);
@@ -84,17 +89,24 @@ static void exact_edges(vfloat4 *e0, vfloat4 *e1, vfloat4 *e2, vfloat4 ax, vfloa
 }
 
 /* Four triangles against one ray; mask of lanes hit in (tnear, tfar). The
- * same operations as fr_tri_watertight, lane by lane. */
+ * same operations as fr_tri_watertight, lane by lane, on negated vertex
+ * coordinates (o - v, so the loads fold): the edge values come out identical
+ * and t does too, with the shear's sz negated. */
 FR_INLINE void tri4_test(const fr_tri4 *tr, const ray_pre *r, float tfar, tri4_result *res) {
-  vfloat4 az = vf4_sub(vf4_load(tr->v0[r->kz]), r->o_k[2]);
-  vfloat4 bz = vf4_sub(vf4_load(tr->v1[r->kz]), r->o_k[2]);
-  vfloat4 cz = vf4_sub(vf4_load(tr->v2[r->kz]), r->o_k[2]);
-  vfloat4 ax = vf4_sub(vf4_sub(vf4_load(tr->v0[r->kx]), r->o_k[0]), vf4_mul(r->sx, az));
-  vfloat4 ay = vf4_sub(vf4_sub(vf4_load(tr->v0[r->ky]), r->o_k[1]), vf4_mul(r->sy, az));
-  vfloat4 bx = vf4_sub(vf4_sub(vf4_load(tr->v1[r->kx]), r->o_k[0]), vf4_mul(r->sx, bz));
-  vfloat4 by = vf4_sub(vf4_sub(vf4_load(tr->v1[r->ky]), r->o_k[1]), vf4_mul(r->sy, bz));
-  vfloat4 cx = vf4_sub(vf4_sub(vf4_load(tr->v2[r->kx]), r->o_k[0]), vf4_mul(r->sx, cz));
-  vfloat4 cy = vf4_sub(vf4_sub(vf4_load(tr->v2[r->ky]), r->o_k[1]), vf4_mul(r->sy, cz));
+  /* One pointer per permuted axis, the three vertices at fixed offsets from
+   * it: three address registers rather than nine (nine spilled the node
+   * loop's registers at every leaf). */
+  const float *X = tr->v0[0] + r->kx4, *Y = tr->v0[0] + r->ky4, *Z = tr->v0[0] + r->kz4;
+  enum { V1 = 12, V2 = 24 }; /* fr_tri4: v1 and v2 follow v0, 12 floats apart */
+  vfloat4 az = vf4_sub(r->o_k[2], vf4_load(Z));
+  vfloat4 bz = vf4_sub(r->o_k[2], vf4_load(Z + V1));
+  vfloat4 cz = vf4_sub(r->o_k[2], vf4_load(Z + V2));
+  vfloat4 ax = vf4_sub(vf4_sub(r->o_k[0], vf4_load(X)), vf4_mul(r->sx, az));
+  vfloat4 ay = vf4_sub(vf4_sub(r->o_k[1], vf4_load(Y)), vf4_mul(r->sy, az));
+  vfloat4 bx = vf4_sub(vf4_sub(r->o_k[0], vf4_load(X + V1)), vf4_mul(r->sx, bz));
+  vfloat4 by = vf4_sub(vf4_sub(r->o_k[1], vf4_load(Y + V1)), vf4_mul(r->sy, bz));
+  vfloat4 cx = vf4_sub(vf4_sub(r->o_k[0], vf4_load(X + V2)), vf4_mul(r->sx, cz));
+  vfloat4 cy = vf4_sub(vf4_sub(r->o_k[1], vf4_load(Y + V2)), vf4_mul(r->sy, cz));
   vfloat4 e0 = vf4_sub(vf4_mul(cx, by), vf4_mul(cy, bx));
   vfloat4 e1 = vf4_sub(vf4_mul(ax, cy), vf4_mul(ay, cx));
   vfloat4 e2 = vf4_sub(vf4_mul(bx, ay), vf4_mul(by, ax));
@@ -107,7 +119,7 @@ FR_INLINE void tri4_test(const fr_tri4 *tr, const ray_pre *r, float tfar, tri4_r
   if (!vm4_bits(inside)) return; /* most leaf tests end here, before the division */
   vfloat4 det = vf4_add(vf4_add(e0, e1), e2);
   vfloat4 inv = vf4_div(vf4(1.0f), det);
-  vfloat4 tz = vf4_add(vf4_add(vf4_mul(e0, vf4_mul(r->sz, az)), vf4_mul(e1, vf4_mul(r->sz, bz))), vf4_mul(e2, vf4_mul(r->sz, cz)));
+  vfloat4 tz = vf4_add(vf4_add(vf4_mul(e0, vf4_mul(r->nsz, az)), vf4_mul(e1, vf4_mul(r->nsz, bz))), vf4_mul(e2, vf4_mul(r->nsz, cz)));
   vfloat4 t = vf4_mul(tz, inv);
   /* NaN (unused lanes, det == 0) fails the ordered compares on t */
   vmask4 ok = vm4_and(vm4_and(inside, vf4_ne(det, zero)),
@@ -172,12 +184,13 @@ FR_INLINE int closest(const fr_bvhn *b, const ray_pre *rp, uint32_t root, float 
         for (int i = sp0; i < sp; i++) prefetch_ref(b, stack[i].ref);
     }
     {
+      const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
       FR_COUNT(leaves, 1);
-      FR_COUNT(tri_tests, 4);
-      uint32_t li = ref & ~FR_BVHN_LEAF;
-      tri4_result res;
-      tri4_test(&b->tris[li], rp, tfar, &res);
-      if (res.mask) {
+      FR_COUNT(tri_tests, 4 * nb);
+      for (uint32_t k = first; k < first + nb; k++) {
+        tri4_result res;
+        tri4_test(&b->tris[k], rp, tfar, &res);
+        if (!res.mask) continue;
         int m = res.mask, bl = __builtin_ctz(m);
         float bt = lane(res.t, bl);
         for (m &= m - 1; m; m &= m - 1) {
@@ -190,7 +203,7 @@ FR_INLINE int closest(const fr_bvhn *b, const ray_pre *rp, uint32_t root, float 
         best->t = bt;
         best->u = lane(res.e1, bl) * inv;
         best->v = lane(res.e2, bl) * inv;
-        best->id = 4 * li + (uint32_t)bl;
+        best->id = 4 * k + (uint32_t)bl;
         found = 1;
       }
     }
@@ -243,11 +256,14 @@ FR_INLINE int any_hit(const fr_bvhn *b, const ray_pre *rp, uint32_t root, const 
       }
     }
     {
+      const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
       FR_COUNT(leaves, 1);
-      FR_COUNT(tri_tests, 4);
-      tri4_result res;
-      tri4_test(&b->tris[ref & ~FR_BVHN_LEAF], rp, tfar, &res);
-      if (res.mask) return 1;
+      for (uint32_t k = first; k < first + nb; k++) {
+        FR_COUNT(tri_tests, 4);
+        tri4_result res;
+        tri4_test(&b->tris[k], rp, tfar, &res);
+        if (res.mask) return 1;
+      }
     }
   next:;
   }

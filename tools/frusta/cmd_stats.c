@@ -93,8 +93,9 @@ int cmd_stats(int argc, char **argv) {
   printf("bvh2 inner=%zu leaves=%zu sah=%.2f leaf_fill=%.2f\n", st.bvh2_inner, st.bvh2_leaves, st.bvh2_sah, st.bvh2_leaf_fill);
   const fr_wide_stats *w[2] = {&st.bvh4, &st.bvh8};
   for (int i = 0; i < 2; i++)
-    printf("bvh%d inner=%zu leaves=%zu sah=%.2f sah_blocks=%.2f node_fill=%.2f/%d leaf_fill=%.2f/4 depth=%d node_bytes=%zu tri_bytes=%zu bytes_per_tri=%.1f packet_tri_bytes=%zu packet_bytes_per_tri=%.1f\n",
-           4 << i, w[i]->inner, w[i]->leaves, w[i]->sah, w[i]->sah_blocks, w[i]->node_fill, 4 << i, w[i]->leaf_fill, w[i]->depth,
+    printf("bvh%d inner=%zu leaves=%zu blocks=%zu sah=%.2f sah_blocks=%.2f node_fill=%.2f/%d leaf_fill=%.2f block_fill=%.2f/4 depth=%d node_bytes=%zu tri_bytes=%zu bytes_per_tri=%.1f packet_tri_bytes=%zu packet_bytes_per_tri=%.1f\n",
+           4 << i, w[i]->inner, w[i]->leaves, w[i]->blocks, w[i]->sah, w[i]->sah_blocks, w[i]->node_fill, 4 << i, w[i]->leaf_fill,
+           w[i]->block_fill, w[i]->depth,
            w[i]->node_bytes, w[i]->tri_bytes, (double)(w[i]->node_bytes + w[i]->tri_bytes) / (double)nt,
            w[i]->packet_tri_bytes, (double)(w[i]->node_bytes + w[i]->tri_bytes + w[i]->packet_tri_bytes) / (double)nt);
   if (embree) {
