@@ -65,7 +65,7 @@ static float blocks_of(uint32_t count) { return (float)((count + 3) / 4); }
 /* Whether a node of more than four triangles ends as a leaf of several
  * blocks: when testing all its blocks costs no more than visiting it and
  * testing its two halves' blocks (Embree's rule, node visit and block test
- * both costing 1). Without it every node of 5-16 triangles became a node of
+ * both costing 1). Without it every node of 5-12 triangles became a node of
  * two or three children, and the BVH8 had twice Embree's node count. */
 static int leaf_pays(conv *c, const fr_build_node *n) {
   if (n->count > 4 * (uint32_t)c->max_blocks || n->left < 0) return n->left < 0;
@@ -127,6 +127,8 @@ fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width,
   memset(out, 0, sizeof *out);
   if (width != 4 && width != 8) return fr_fail(FR_ERR_ARG, "BVH width %d (4 or 8)", width);
   out->width = width;
+  if (t->nprims > FR_BVHN_MAX_BLOCKS) /* every block holds a triangle */
+    return fr_fail(FR_ERR_ARG, "BVH%d: %zu triangles are more than a leaf reference can address", width, t->nprims);
   size_t node_bytes = width == 4 ? sizeof(fr_bvh4_node) : sizeof(fr_bvh8_node);
   size_t np = t->nprims ? t->nprims : 1; /* an empty tree is one empty leaf */
   out->nodes = fr_alloc_aligned(fr_mul_size(np, node_bytes), 64);
@@ -141,10 +143,6 @@ fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width,
   const char *env = getenv("FRUSTA_LEAF_BLOCKS");
   int mb = FR_BVHN_DEFAULT_LEAF_BLOCKS;
   if (env && env[0] >= '1' && env[0] <= '0' + FR_BVHN_MAX_LEAF_BLOCKS && !env[1]) mb = env[0] - '0';
-  if (np > FR_BVHN_MAX_BLOCKS) { /* every block holds a triangle */
-    fr_bvhn_free(out);
-    return fr_fail(FR_ERR_ARG, "BVH%d: %zu triangles are more than a leaf reference can address", width, np);
-  }
   conv c = {t, m, out, node_bytes, mb};
   out->root = convert(&c, 0, 1);
   out->prefetch = fr_bvhn_prefetch_auto(out);
