@@ -127,7 +127,7 @@ typedef struct fr_wide_stats {
   double leaf_fill;              /* mean triangles per leaf */
   int depth;
   size_t packet_tri_bytes;       /* Shevtsov records the packet kernels test */
-  size_t blocks;                 /* 4-triangle blocks: a leaf holds 1-3 */
+  size_t blocks;                 /* 4-triangle blocks: 1-3 per leaf by default */
   double block_fill;             /* mean triangles per block (of 4) */
 } fr_wide_stats;
 
