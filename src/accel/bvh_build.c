@@ -43,8 +43,7 @@ static void bins_add(bins *b, const ref *r, aabb cb, const float scale[3]) {
   }
 }
 
-/* Cost in units of one 4-wide triangle test; a node visit costs 1. */
-static inline float blocks(uint32_t n) { return (float)((n + FR_BUILD_MAX_LEAF - 1) / FR_BUILD_MAX_LEAF); }
+/* Costs in fr_build_blocks units; a node visit costs 1. */
 
 static split best_split(const bins *b, const float scale[3]) {
   split best = {-1, 0, INFINITY};
@@ -66,7 +65,7 @@ static split best_split(const bins *b, const float scale[3]) {
       acc = aabb_merge(acc, b->b[a][i - 1].box);
       cnt += b->b[a][i - 1].count;
       if (cnt == 0 || rcount[i] == 0) continue;
-      float cost = aabb_half_area(acc) * blocks(cnt) + rarea[i] * blocks(rcount[i]);
+      float cost = aabb_half_area(acc) * fr_build_blocks(cnt) + rarea[i] * fr_build_blocks(rcount[i]);
       if (cost < best.cost) { best.cost = cost; best.axis = a; best.pos = i; }
     }
   }
@@ -119,7 +118,7 @@ static size_t small_split(ref *refs, size_t b, size_t e) {
     acc = aabb_empty();
     for (size_t i = n - 1; i >= 1; i--) {
       acc = aabb_merge(acc, refs[b + i].box);
-      float cost = left[i - 1] * blocks((uint32_t)i) + aabb_half_area(acc) * blocks((uint32_t)(n - i));
+      float cost = left[i - 1] * fr_build_blocks((uint32_t)i) + aabb_half_area(acc) * fr_build_blocks((uint32_t)(n - i));
       if (cost < best) { best = cost; best_axis = a; best_pos = i; }
     }
   }

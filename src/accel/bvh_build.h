@@ -16,6 +16,10 @@
 #define FR_BUILD_MAX_LEAF 4   /* triangles per leaf: one 4-wide test */
 #define FR_BUILD_MAX_DEPTH 64 /* deeper subtrees fall back to median splits */
 
+/* SAH cost of testing n primitives: one per 4-wide block, the unit both the
+ * binary build and the wide leaves' termination rule (bvhn.c) price in. */
+static inline float fr_build_blocks(uint32_t n) { return (float)((n + FR_BUILD_MAX_LEAF - 1) / FR_BUILD_MAX_LEAF); }
+
 typedef struct fr_build_node {
   aabb box;
   int32_t left, right;     /* children, or -1 for a single primitive */

@@ -60,19 +60,18 @@ static uint32_t make_leaf(conv *c, const fr_build_node *n) {
   return FR_BVHN_LEAF_REF(first, nb);
 }
 
-static float blocks_of(uint32_t count) { return (float)((count + 3) / 4); }
-
 /* Whether a node of more than four triangles ends as a leaf of several
  * blocks: when testing all its blocks costs no more than visiting it and
  * testing its two halves' blocks (Embree's rule, node visit and block test
  * both costing 1). Without it every node of 5-12 triangles became a node of
  * two or three children, and the BVH8 had twice Embree's node count. */
 static int leaf_pays(conv *c, const fr_build_node *n) {
-  if (n->count > 4 * (uint32_t)c->max_blocks || n->left < 0) return n->left < 0;
+  /* n has more than FR_BUILD_MAX_LEAF triangles, so it has two children */
+  if (n->count > FR_BUILD_MAX_LEAF * (uint32_t)c->max_blocks) return 0;
   const fr_build_node *l = &c->t->nodes[n->left], *r = &c->t->nodes[n->right];
   float a = aabb_half_area(n->box);
-  float leaf = a * blocks_of(n->count);
-  float split = a + aabb_half_area(l->box) * blocks_of(l->count) + aabb_half_area(r->box) * blocks_of(r->count);
+  float leaf = a * fr_build_blocks(n->count);
+  float split = a + aabb_half_area(l->box) * fr_build_blocks(l->count) + aabb_half_area(r->box) * fr_build_blocks(r->count);
   return leaf <= split;
 }
 
