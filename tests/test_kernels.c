@@ -99,9 +99,70 @@ static void test_degenerate_and_nan(void **st) {
   }
 }
 
+uint32_t fr_test_child_sort8_avx2(const uint32_t *child, int mask, const float *dist, void *out);
+uint32_t fr_test_child_sort8_avx512(const uint32_t *child, int mask, const float *dist, void *out);
+
+/* The scalar definition of the order: key = the distance as a monotone
+ * integer with its low three bits replaced by the slot, descending. */
+static int64_t sort_key(float d, int slot) {
+  int32_t b;
+  memcpy(&b, &d, 4);
+  if (b < 0) b ^= 0x7fffffff;
+  return (int64_t)((b & ~7) | slot);
+}
+
+/* fr_child_sort8 at AVX2 and AVX-512 against that definition: every hit child
+ * once, farthest first, with its exact distance; the nearest returned. */
+static void test_child_sort8(void **st) {
+  (void)st;
+  typedef uint32_t (*sort_fn)(const uint32_t *, int, const float *, void *);
+  const struct { fr_isa isa; sort_fn fn; } levels[] = {{FR_ISA_AVX2, fr_test_child_sort8_avx2},
+                                                        {FR_ISA_AVX512, fr_test_child_sort8_avx512}};
+  fr_rng r = fr_rng_seed(11, 5);
+  int tested = 0;
+  for (size_t l = 0; l < sizeof levels / sizeof levels[0]; l++) {
+    if (!fr_isa_supported(levels[l].isa)) continue;
+    for (int it = 0; it < 200000; it++) {
+      uint32_t child[8];
+      float dist[8];
+      int mask = (int)(fr_rng_u32(&r) & 0xff) | 1 << (it % 8);
+      for (int i = 0; i < 8; i++) {
+        child[i] = fr_rng_u32(&r);
+        /* ties, values 1 ulp apart, negatives (a negative tnear), zeros */
+        switch (it % 4) {
+        case 0: dist[i] = urand(&r, 0.0f, 100.0f); break;
+        case 1: dist[i] = (float)(fr_rng_u32(&r) % 3); break;
+        case 2: dist[i] = nextafterf(1.0f, (fr_rng_u32(&r) & 1) ? 2.0f : 0.0f); break;
+        default: dist[i] = urand(&r, -5.0f, 5.0f); break;
+        }
+      }
+      struct { uint32_t ref; float dist; } out[8], want[8];
+      /* the hit slots ordered by key, descending (at most 8: exchange sort) */
+      int slot_of[8], n = 0;
+      for (int i = 0; i < 8; i++)
+        if ((mask >> i) & 1) slot_of[n++] = i;
+      for (int a = 0; a < n; a++)
+        for (int b = a + 1; b < n; b++)
+          if (sort_key(dist[slot_of[b]], slot_of[b]) > sort_key(dist[slot_of[a]], slot_of[a])) {
+            int t = slot_of[a]; slot_of[a] = slot_of[b]; slot_of[b] = t;
+          }
+      for (int a = 0; a < n; a++) { want[a].ref = child[slot_of[a]]; want[a].dist = dist[slot_of[a]]; }
+      uint32_t nearest = levels[l].fn(child, mask, dist, out);
+      assert_int_equal(nearest, want[n - 1].ref);
+      for (int a = 0; a < n; a++) {
+        assert_int_equal(out[a].ref, want[a].ref);
+        assert_memory_equal(&out[a].dist, &want[a].dist, sizeof(float));
+      }
+      tested++;
+    }
+  }
+  print_message("child order: %d nodes\n", tested);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_agreement),
+      cmocka_unit_test(test_child_sort8),
       cmocka_unit_test(test_axis_aligned_fast_path),
       cmocka_unit_test(test_degenerate_and_nan),
   };

@@ -48,8 +48,8 @@ static inline void ray_setup(ray_pre *r, const fr_ray *ray) {
   r->tnear = ray->tnear;
 }
 
-/* Returns the mask of children hit within [tnear, tfar]; dist gets their
- * entry distances. (o - plane) * -rdir is (plane - o) * rdir exactly. */
+/* Returns the children's entry distances; *mask gets those hit within
+ * [tnear, tfar]. (o - plane) * -rdir is (plane - o) * rdir exactly. */
 FR_INLINE vnode box_test(const node_t *n, const ray_pre *r, float tfar, int *mask) {
   const float *f = (const float *)n;
   vnode tnx = VN_MUL(VN_SUB(r->ox, VN_LOAD(f + r->near_x)), r->nrx);

@@ -4,9 +4,10 @@
  * integer keys, in 256-bit AVX-512 or AVX2 operations. The insertion sort it
  * replaces mispredicted often on rays that hit several children; the network
  * measured +9% (diffuse8) and +14% (specular8) single-ray speed on hairball,
- * within noise on conference and dragon (bench/ab.sh-style interleaved pairs,
- * 1 thread, 512x512). No 512-bit operation: on this Xeon one lowers the
- * core's clock, which cost conference 5%.
+ * within noise on conference and dragon (CONCURRENT=1 bench/ab.sh, 1 thread,
+ * 512x512, 4-6 pairs). No 512-bit operation: on this Xeon one lowers the
+ * core's clock, which cost conference 5%. tests/test_kernels.c checks both
+ * levels against the scalar definition of the order below.
  *
  * A key is the entry distance as a monotone integer with its three low bits
  * replaced by the child's slot, so keys are unique (distances within 8 ulps
