@@ -62,8 +62,6 @@ typedef struct frusta {
   const fr_mft_set *set[16];
 } frusta;
 
-#define MINF(a, b) ((a) < (b) ? (a) : (b))
-#define MAXF(a, b) ((a) > (b) ? (a) : (b))
 
 /* Per lane, what a frustum's bounds are made from: the (a, b) box of its
  * active rays and the box [lo, hi] of their delta vectors. */
