@@ -62,7 +62,6 @@ typedef struct frusta {
   const fr_mft_set *set[16];
 } frusta;
 
-
 /* Per lane, what a frustum's bounds are made from: the (a, b) box of its
  * active rays and the box [lo, hi] of their delta vectors. */
 typedef struct ray_box {
