@@ -43,8 +43,8 @@ static void bins_add(bins *b, const ref *r, aabb cb, const float scale[3]) {
   }
 }
 
-/* Costs in fr_build_blocks units; a node visit costs 1. */
-
+/* The binned split of least SAH cost, in fr_build_blocks units (a node
+ * visit costs 1). */
 static split best_split(const bins *b, const float scale[3]) {
   split best = {-1, 0, INFINITY};
   for (int a = 0; a < 3; a++) {
