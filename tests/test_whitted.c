@@ -4,8 +4,9 @@
  * shadow, reflection and refraction packets) is traced again ray by ray by
  * the single-ray kernel, and the answers must agree (a disagreement must be
  * a ray within rounding of an edge or of tnear/tfar), for every packet size
- * and traversal, culls on and off. The rays really are Whitted's: there
- * are secondary rays of every kind.
+ * and traversal, culls on and off, and for the multi-frusta tracer, whose
+ * camera rays come as frusta. The rays really are Whitted's: there are
+ * secondary rays of every kind.
  */
 #include <string.h>
 #include "api/scene.h"
@@ -18,7 +19,7 @@
 typedef struct checker {
   fr_tracer inner;
   const fr_scene *s;
-  long rays, occluded_rays, disagree;
+  long rays, occluded_rays, disagree, frusta_rays;
 } checker;
 
 /* the tracer may overwrite its rays: keep a copy to re-trace */
@@ -29,23 +30,41 @@ static fr_ray *copy_rays(const fr_ray *rays, size_t n) {
   return copy;
 }
 
+/* One closest hit against fr_intersect1's on the same ray. */
+static void check_hit(checker *c, const mesh_ref *m, const fr_ray *ray, const fr_hit *got, size_t i, size_t n) {
+  fr_hit h;
+  fr_intersect1(c->s, ray, &h);
+  if (h.prim == got->prim && (h.prim == FR_INVALID_ID || fabsf(h.t - got->t) <= 1e-4f * fmaxf(1.0f, h.t))) return;
+  if (h.prim != FR_INVALID_ID && got->prim != FR_INVALID_ID && fabsf(h.t - got->t) <= 1e-4f * fmaxf(1.0f, h.t)) return;
+  c->disagree++;
+  if (!ambiguous(m, ray))
+    fail_msg("ray %zu of a packet of %zu: packet prim %u t %g, single prim %u t %g", i, n, got->prim, got->t, h.prim, h.t);
+}
+
 static void check_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
   checker *c = ctx;
   fr_ray *copy = copy_rays(rays, n);
   c->inner.intersect(c->inner.ctx, rays, hits, n, coherent);
   mesh_ref m = scene_mesh(c->s);
-  for (size_t i = 0; i < n; i++) {
-    fr_hit h;
-    fr_intersect1(c->s, &copy[i], &h);
-    c->rays++;
-    if (h.prim == hits[i].prim && (h.prim == FR_INVALID_ID || fabsf(h.t - hits[i].t) <= 1e-4f * fmaxf(1.0f, h.t))) continue;
-    if (h.prim != FR_INVALID_ID && hits[i].prim != FR_INVALID_ID && fabsf(h.t - hits[i].t) <= 1e-4f * fmaxf(1.0f, h.t)) continue;
-    c->disagree++;
-    if (!ambiguous(&m, &copy[i]))
-      fail_msg("ray %zu of a packet of %zu: packet prim %u t %g, single prim %u t %g", i, n, hits[i].prim, hits[i].t,
-               h.prim, h.t);
-  }
+  for (size_t i = 0; i < n; i++, c->rays++) check_hit(c, &m, &copy[i], &hits[i], i, n);
   free(copy);
+}
+
+/* camera frusta: each ray as fr_mft_ray makes it, in its units */
+static void check_intersect_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *hits) {
+  checker *c = ctx;
+  c->inner.intersect_frusta(c->inner.ctx, b, t, hits);
+  mesh_ref m = scene_mesh(c->s);
+  for (int f = 0; f < FR_MFT_FRUSTA; f++) {
+    if (!((b->valid >> f) & 1)) continue;
+    for (int k = 0; k < FR_MFT_RAYS; k++, c->frusta_rays++) {
+      fr_ray r = {{0, 0, 0}, b->tnear[f], {0, 0, 0}, b->tfar[f]};
+      fr_mft_ray(b, t, f, k, r.org, r.dir);
+      fr_hit got = {hits->t[f][k], hits->u[f][k], hits->v[f][k], hits->prim[f][k], {0, 0, 0}};
+      if (got.prim == FR_INVALID_ID) got.t = INFINITY;
+      check_hit(c, &m, &r, &got, (size_t)k, FR_MFT_RAYS);
+    }
+  }
 }
 
 static void check_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
@@ -64,6 +83,39 @@ static void check_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int 
 
 /* Whitted on scene s (view of name) with its materials as mirror and glass
  * say (NULL: the defaults), which must give mirrors and, if want_glass, glass. */
+static void whitted_setup(fr_workload *w, fr_scene *s, const char *name, const fr_whitted_mats *mats, int width,
+                          int height) {
+  memset(w, 0, sizeof *w);
+  w->kind = FR_WL_WHITTED;
+  w->scene = s;
+  assert_true(fr_view_lookup(name, &w->view));
+  assert_int_equal(fr_camera_setup(&w->cam, w->view.eye, w->view.at, w->view.up, w->view.fov, width, height), FR_OK);
+  float lo[3], hi[3];
+  fr_scene_bounds(s, lo, hi);
+  w->eps = 1e-4f * sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  w->threads = 1;
+  w->mats = mats;
+  w->max_depth = 4;
+}
+
+/* The multi-frusta tracer: camera rays as frusta where a 16x16 block fits
+ * (200x150 leaves partial blocks on two sides, traced as rays), the rest
+ * as streams; everything checked ray by ray. */
+static void check_whitted_mft(fr_scene *s, const char *name, const fr_whitted_mats *mats) {
+  fr_workload w;
+  whitted_setup(&w, s, name, mats, 200, 150);
+  fr_mft_tracer mctx = {s, &s->bvh2, {1, 1}};
+  checker c = {fr_tracer_mft(&mctx), s, 0, 0, 0, 0};
+  fr_tracer t = {&c, check_intersect, check_occluded, check_intersect_frusta, NULL, 0};
+  fr_workload_result r = fr_workload_run(&w, &t);
+  assert_int_equal(r.rays, (uint64_t)(c.rays + c.occluded_rays + c.frusta_rays));
+  /* 12 x 9 blocks of 16x16 as frusta; the partial ones' camera rays, and the secondaries, as rays */
+  assert_int_equal(c.frusta_rays, 12 * 9 * 256);
+  assert_true(c.rays > 200 * 150 - 12 * 9 * 256 && c.occluded_rays > 0);
+  print_message("%s mft: %ld camera rays in frusta, %ld closest-hit rays, %ld shadow rays, %ld disagreements (all at "
+                "edges or range ends)\n", name, c.frusta_rays, c.rays, c.occluded_rays, c.disagree);
+}
+
 static void check_whitted(fr_scene *s, const char *name, const char *mirror, const char *glass, int want_glass) {
   fr_whitted_mats mats;
   assert_int_equal(fr_whitted_mats_build(s, mirror, glass, &mats), FR_OK);
@@ -71,23 +123,13 @@ static void check_whitted(fr_scene *s, const char *name, const char *mirror, con
   fr_whitted_mats_census(s, &mats, &nm, &ng);
   assert_true((nm > 0 || !mirror) && (ng > 0 || !want_glass));
   fr_workload w;
-  memset(&w, 0, sizeof w);
-  w.kind = FR_WL_WHITTED;
-  w.scene = s;
-  assert_true(fr_view_lookup(name, &w.view));
-  assert_int_equal(fr_camera_setup(&w.cam, w.view.eye, w.view.at, w.view.up, w.view.fov, 192, 144), FR_OK);
-  float lo[3], hi[3];
-  fr_scene_bounds(s, lo, hi);
-  w.eps = 1e-4f * sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
-  w.threads = 1;
-  w.mats = &mats;
-  w.max_depth = 4;
+  whitted_setup(&w, s, name, &mats, 192, 144);
   static const struct { int side; fr_lp_traversal t; fr_cull c; } configs[] = {
       {2, FR_LP_MASKED, FR_CULL_CORNERS}, {4, FR_LP_PARTITION, FR_CULL_PLANES}, {8, FR_LP_RANGED, FR_CULL_IA},
       {16, FR_LP_RANGED, FR_CULL_OFF},    {16, FR_LP_PARTITION, FR_CULL_CORNERS}, {32, FR_LP_MASKED, FR_CULL_CORNERS}};
   for (size_t k = 0; k < sizeof configs / sizeof configs[0]; k++) {
     fr_lp_tracer lpc = {s, {&s->bvh2, &s->sphere_bvh, fr_scene_sphere_base(s)}, {configs[k].t, configs[k].c}, configs[k].side};
-    checker c = {fr_tracer_lp(&lpc), s, 0, 0, 0};
+    checker c = {fr_tracer_lp(&lpc), s, 0, 0, 0, 0};
     fr_tracer t = {&c, check_intersect, check_occluded, NULL, NULL, configs[k].side};
     fr_workload_result r = fr_workload_run(&w, &t);
     assert_int_equal(r.rays, (uint64_t)(c.rays + c.occluded_rays));
@@ -97,6 +139,7 @@ static void check_whitted(fr_scene *s, const char *name, const char *mirror, con
                   name, configs[k].side, configs[k].side, fr_lp_traversal_name(configs[k].t), fr_cull_name(configs[k].c),
                   c.rays, c.occluded_rays, c.disagree);
   }
+  if (!fr_scene_sphere_count(s)) check_whitted_mft(s, name, &mats);
   fr_whitted_mats_free(&mats);
 }
 

@@ -187,12 +187,32 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
   const fr_scene *sc = w->scene;
   const int max_depth = w->max_depth > 0 ? w->max_depth : 4;
   if (!reserve(S, 2 * WT_PIX)) return 0;
-  size_t n = 0;
+  size_t n = 0, traced = 0;
+  if (t->intersect_frusta && side == WT) {
+    /* a multi-frusta tracer traces the camera rays of every full 16x16
+     * quarter of the tile as 16 frusta; the tile is one packet (key 0) */
+    for (int q = 0; q < 4; q++) {
+      int qx = tx + 16 * (q % 2), qy = ty + 16 * (q / 2);
+      if (qx + 16 > W || qy + 16 > H) continue;
+      fr_camera_frusta(w, t, qx, qy, S->rays + n, S->hits + n);
+      for (int i = 0; i < 256; i++) {
+        int f = i / 16, k = i % 16;
+        int X = qx + 4 * (f % 4) + k % 4, Y = qy + 4 * (f / 4) + k / 4;
+        wray *g = &S->cur[n++];
+        g->r = S->rays[n - 1];
+        g->w = v3(1, 1, 1);
+        g->pix = (uint16_t)((Y - ty) * WT + (X - tx));
+        g->key = 0;
+      }
+    }
+    traced = n;
+  }
   for (int b = 0; b < per * per; b++)
     for (int y = 0; y < side; y++)
       for (int x = 0; x < side; x++) {
         int X = tx + (b % per) * side + x, Y = ty + (b / per) * side + y;
         if (X >= W || Y >= H) continue;
+        if (traced && X + 16 - X % 16 <= W && Y + 16 - Y % 16 <= H) continue; /* in a traced quarter */
         wray *g = &S->cur[n++];
         g->r = fr_camera_ray(&w->cam, X, Y);
         g->w = v3(1, 1, 1);
@@ -202,7 +222,8 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
   for (int i = 0; i < WT_PIX; i++) S->colour[i] = v3(0, 0, 0);
   uint64_t rays = 0;
   for (int depth = 0; n > 0; depth++) {
-    trace_runs(t, S->cur, S->rays, S->hits, NULL, n);
+    trace_runs(t, S->cur + traced, S->rays + traced, S->hits + traced, NULL, n - traced);
+    traced = 0;
     rays += n;
     size_t ns = 0, nn = 0;
     if (!reserve(S, 2 * n)) return rays;

@@ -66,13 +66,10 @@ static vec3 albedo(const fr_scene *s, uint32_t prim) {
   return mat ? v3(mat->diffuse[0], mat->diffuse[1], mat->diffuse[2]) : v3(0.8f, 0.8f, 0.8f);
 }
 
-/* Camera rays of a full tile by multi-frusta tracing: pixel 16 f + k of the
- * tile is ray k of frustum f. The hits and rays are returned in units of the
- * normalized direction, as fr_camera_ray gives them. */
-static void primary_frusta(const fr_workload *w, const fr_tracer *t, buffers *B, const fr_mft_sets *cam_set, int tx,
-                           int ty) {
+void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, fr_ray *rays, fr_hit *hits) {
   fr_mft_batch b;
   static _Thread_local fr_mft_hits h;
+  const fr_mft_sets *cam_set = w->camera_set;
   fr_mft_batch_camera(&b, &w->cam, tx, ty);
   t->intersect_frusta(t->ctx, &b, cam_set, &h);
   for (int f = 0; f < FR_MFT_FRUSTA; f++) {
@@ -90,8 +87,8 @@ static void primary_frusta(const fr_workload *w, const fr_tracer *t, buffers *B,
     }
     for (int k = 0; k < FR_MFT_RAYS; k++) {
       int i = 16 * f + k;
-      B->prim_ray[i] = (fr_ray){{b.org[0][f], b.org[1][f], b.org[2][f]}, 0.0f, {d[0][k], d[1][k], d[2][k]}, INFINITY};
-      fr_hit *o = &B->prim_hit[i];
+      rays[i] = (fr_ray){{b.org[0][f], b.org[1][f], b.org[2][f]}, 0.0f, {d[0][k], d[1][k], d[2][k]}, INFINITY};
+      fr_hit *o = &hits[i];
       o->prim = h.prim[f][k];
       o->t = o->prim == FR_INVALID_ID ? INFINITY : h.t[f][k] * len[k];
       o->u = h.u[f][k];
@@ -178,7 +175,7 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
         }
   uint64_t rays = (uint64_t)n;
   if (frusta)
-    primary_frusta(w, t, B, w->camera_set, tx, ty);
+    fr_camera_frusta(w, t, tx, ty, B->prim_ray, B->prim_hit);
   else
     t->intersect(t->ctx, B->rays, B->prim_hit, (size_t)n, 1);
   float lit[TILE_PIX];

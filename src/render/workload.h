@@ -71,6 +71,12 @@ typedef struct fr_workload_result { uint64_t rays; double seconds; } fr_workload
 
 fr_workload_result fr_workload_run(const fr_workload *w, const fr_tracer *t);
 
+/* Camera rays of the full 16x16 tile at (tx, ty) by multi-frusta tracing
+ * (t->intersect_frusta): ray and hit 16 f + k are pixel (tx + 4 (f % 4) +
+ * k % 4, ty + 4 (f / 4) + k / 4). The rays are fr_mft_ray's with unit
+ * directions, as fr_camera_ray makes them, and the hits are in their units. */
+void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, fr_ray *rays, fr_hit *hits);
+
 /* The frusta tracer: streams as the scene's trace options say. */
 fr_tracer fr_tracer_frusta(const fr_scene *s);
 
