@@ -126,7 +126,12 @@ expect 2 "$F" render --builtin --shade softshadow --reference-out "$T/r.bmp" --o
 [ ! -e "$T/s3.png" ] && ok || bad "a refused render left an output file"
 # Whitted: MTL mirrors and glass, large packets, their flags
 expect 0 "$F" render "$SHARED/scenes/museum/museum.obj.zst" --size 64x48 --shade whitted --out "$T/w.png"
-[ -s "$T/w.png" ] && grep -q 'mirror_prims=[1-9]' "$T/out" && ok || bad "whitted museum render"
+[ -s "$T/w.png" ] && grep -q 'mirror_prims=[1-9]' "$T/out" && grep -q 'tracer=mft' "$T/out" && ok || bad "whitted museum render"
+expect 0 "$F" render "$SHARED/scenes/museum/museum.obj.zst" --size 64x48 --shade whitted --mft off --out "$T/w.png"
+grep -q 'tracer=packet16x16/ranged/off' "$T/out" && ok || bad "whitted --mft off: large packets"
+expect 0 "$F" render --builtin=sphereflake --size 32x32 --shade whitted --out "$T/w.png"
+grep -q 'tracer=packet16x16' "$T/out" && ok || bad "whitted with spheres: large packets"
+expect 2 "$F" render --builtin --shade whitted --mft on --packet 8 --out "$T/w3.png"
 expect 0 "$F" render --builtin --size 40x40 --shade whitted --mirror all --depth 2 --packet 8 --traversal partition --cull corners --out "$T/w2.pfm"
 expect 2 "$F" render --builtin --shade whitted --mirror no_such --out "$T/w3.png"
 expect 2 "$F" render --builtin --shade whitted --glass all --out "$T/w3.png"

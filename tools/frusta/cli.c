@@ -192,6 +192,7 @@ int cli_whitted_flag(int argc, char **argv, int *i, cli_whitted *o) {
   if (*i + 1 >= argc) { cli_error(CLI_USAGE_ERROR, "%s needs a value", a); return -1; }
   const char *val = argv[++*i];
   int ok = 1;
+  o->large_flags |= !strcmp(a, "--traversal") || !strcmp(a, "--cull") || !strcmp(a, "--packet");
   if (!strcmp(a, "--mirror")) o->mirror = val;
   else if (!strcmp(a, "--glass")) o->glass = val;
   else if (!strcmp(a, "--depth")) {

@@ -55,6 +55,7 @@ typedef struct cli_whitted {
   int depth;                  /* 1..FR_WHITTED_MAX_DEPTH, default 4 */
   fr_lp_opts lp;              /* default ranged, corners */
   int packet;                 /* render: packet side, default 16 */
+  int large_flags;            /* --packet, --traversal or --cull given */
 } cli_whitted;
 void cli_whitted_default(cli_whitted *o);
 /* As cli_view_flag: 1 consumed, 0 not one of these flags, -1 error (reported). */

@@ -70,7 +70,7 @@ int cmd_render(int argc, char **argv) {
   cli_view v;
   memset(&v, 0, sizeof v);
   v.width = 1024; v.height = 1024;
-  int threads = omp_get_num_procs(), mft = 1;
+  int threads = omp_get_num_procs(), mft = -1; /* -1: not given */
   const char *ref_out = NULL;
   fr_softshadow_opts so = {16, 1, FR_LIGHT_SETS_CELLS};
   cli_whitted wo;
@@ -132,7 +132,7 @@ int cmd_render(int argc, char **argv) {
   w.progress = 1;
   if (w.kind == FR_WL_SOFT16) {
     /* multi-frusta tracing does not see spheres: such scenes go the packet way */
-    rc = render_soft(s, &w, &so, mft && !fr_scene_sphere_count(s), out, ref_out, threads);
+    rc = render_soft(s, &w, &so, mft != 0 && !fr_scene_sphere_count(s), out, ref_out, threads);
     fr_scene_release(s);
     return rc;
   }
@@ -140,9 +140,23 @@ int cmd_render(int argc, char **argv) {
   if (w.kind == FR_WL_WHITTED && (rc = cli_whitted_setup(s, &wo, &mats, &w))) { fr_scene_release(s); return rc; }
   w.image = calloc((size_t)v.width * (size_t)v.height * 3, sizeof(float));
   if (!w.image) { fr_whitted_mats_free(&mats); fr_scene_release(s); return cli_error(1, "out of memory for a %dx%d image", v.width, v.height); }
-  /* Whitted: large packets of --packet x --packet rays */
+  /* Whitted: camera rays by multi-frusta tracing and the rest as streams
+   * (the fastest measured, see README), or with --mft off or any of
+   * --packet, --traversal, --cull: large packets of --packet x --packet */
   fr_lp_tracer lpc = {s, cli_lp_scene(s), wo.lp, wo.packet};
-  fr_tracer t = w.kind == FR_WL_WHITTED ? fr_tracer_lp(&lpc) : fr_tracer_frusta(s);
+  fr_mft_tracer mctx = {s, &s->bvh2, {1, 1}};
+  if (w.kind == FR_WL_WHITTED && mft == 1 && wo.large_flags) {
+    fr_whitted_mats_free(&mats); fr_scene_release(s); free(w.image);
+    return cli_error(CLI_USAGE_ERROR, "--mft on and --packet/--traversal/--cull: large packets need --mft off");
+  }
+  /* multi-frusta tracing does not see spheres: such scenes go the packet way */
+  const int whitted_mft = mft != 0 && !wo.large_flags && !fr_scene_sphere_count(s);
+  fr_tracer t = w.kind != FR_WL_WHITTED ? fr_tracer_frusta(s) : whitted_mft ? fr_tracer_mft(&mctx) : fr_tracer_lp(&lpc);
+  if (w.kind == FR_WL_WHITTED) {
+    if (whitted_mft) printf("whitted tracer=mft\n");
+    else printf("whitted tracer=packet%dx%d/%s/%s\n", wo.packet, wo.packet, fr_lp_traversal_name(wo.lp.traversal),
+                fr_cull_name(wo.lp.cull));
+  }
   fr_workload_result r = fr_workload_run(&w, &t);
   if (fr_image_write(out, v.width, v.height, w.image)) rc = cli_error(1, "%s", fr_last_error());
   else
