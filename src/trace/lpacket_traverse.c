@@ -114,6 +114,53 @@ typedef struct state {
   int live;      /* chunks with rays still alive (any hit) */
 } state;
 
+/* Interval-arithmetic bounds (all the IA cull reads) straight from the
+ * rays' floats, 16 lanes at a time: min and max are exact, and the
+ * reciprocal intervals are those of the very reciprocals box16 multiplies
+ * by, so the cull stays conservative. The general build (fr_pbounds_build:
+ * three passes in double, for the planes too) cost more than the IA cull
+ * saved. */
+static void ia_bounds(fr_lpacket *p) {
+  fr_pbounds *b = &p->bounds;
+  memset(b, 0, sizeof *b);
+  const vpf inf = vp(INFINITY), ninf = vp(-INFINITY);
+  vpf olo[3], ohi[3], dlo[3], dhi[3], rlo[3], rhi[3], tlo = inf, thi = ninf;
+  for (int a = 0; a < 3; a++) olo[a] = dlo[a] = rlo[a] = inf, ohi[a] = dhi[a] = rhi[a] = ninf;
+  int any = 0;
+  for (int c = 0; c < p->nchunks; c++) {
+    if (!p->valid[c]) continue;
+    any = 1;
+    const int i = 16 * c;
+    const vpm m = vpm_bits_to(p->valid[c]);
+    for (int a = 0; a < 3; a++) {
+      vpf o = vp_load(p->o[a] + i), d = vp_load(p->d[a] + i), r = vp_load(p->rd[a] + i);
+      olo[a] = vp_min(olo[a], vp_select(m, o, inf)); ohi[a] = vp_max(ohi[a], vp_select(m, o, ninf));
+      dlo[a] = vp_min(dlo[a], vp_select(m, d, inf)); dhi[a] = vp_max(dhi[a], vp_select(m, d, ninf));
+      rlo[a] = vp_min(rlo[a], vp_select(m, r, inf)); rhi[a] = vp_max(rhi[a], vp_select(m, r, ninf));
+    }
+    tlo = vp_min(tlo, vp_select(m, vp_load(p->tnear + i), inf));
+    thi = vp_max(thi, vp_select(m, vp_load(p->tfar + i), ninf));
+  }
+  if (!any) { b->empty = 1; return; }
+  b->tmin = vp_reduce_min(tlo);
+  b->tmax = vp_reduce_max(thi);
+  float scale = 0.0f;
+  int shared = 1;
+  for (int a = 0; a < 3; a++) {
+    b->olo[a] = vp_reduce_min(olo[a]); b->ohi[a] = vp_reduce_max(ohi[a]);
+    b->dlo[a] = vp_reduce_min(dlo[a]); b->dhi[a] = vp_reduce_max(dhi[a]);
+    if (b->dlo[a] > 0.0f || b->dhi[a] < 0.0f) {
+      b->uniform |= 1u << a;
+      b->rlo[a] = vp_reduce_min(rlo[a]);
+      b->rhi[a] = vp_reduce_max(rhi[a]);
+    }
+    scale = fr_pb_max(scale, fr_pb_max(fabsf(b->olo[a]), fabsf(b->ohi[a])));
+    shared &= b->olo[a] == b->ohi[a];
+  }
+  b->scale = scale;
+  b->shared_origin = shared;
+}
+
 static void setup(state *S, fr_lpacket *p, const fr_lp_opts *opt) {
   S->p = p;
   S->opt = opt;
@@ -137,31 +184,48 @@ static void setup(state *S, fr_lpacket *p, const fr_lp_opts *opt) {
     }
   }
   for (int a = 0; a < 3; a++) S->dmean[a] = (float)sum[a];
-  if (opt->cull != FR_CULL_OFF) {
+  if (opt->cull == FR_CULL_IA) {
+    ia_bounds(p);
+  } else if (opt->cull != FR_CULL_OFF) {
     fr_ray_soa soa = {{p->o[0], p->o[1], p->o[2]}, {p->d[0], p->d[1], p->d[2]}, p->tnear, p->tfar, p->valid, p->n};
     fr_pbounds_build(&p->bounds, &soa);
   }
 }
 
+/* Whether the whole packet misses box k of node n by its bounds. */
+static int cull_box(const state *S, const fr_bvh2_node *n, int k) {
+  float lo[3] = {n->lo_x[k], n->lo_y[k], n->lo_z[k]}, hi[3] = {n->hi_x[k], n->hi_y[k], n->hi_z[k]};
+  if (!fr_pbounds_cull_box(&S->p->bounds, S->opt->cull, lo, hi)) return 0;
+  FR_COUNT(lp_culled, 1);
+  return 1;
+}
+
 /* Narrows the parent's set (entry e) to the chunks with a ray that hits e's
- * box; fills the child set in *out. 0 when no chunk is left. */
+ * box; fills the child set in *out. 0 when no chunk is left. The packet's
+ * bounds are tried only once the first chunk tested has missed (Overbeck's
+ * order): where a ray of it hits, which is most boxes a coherent packet
+ * visits, the cull could not have helped and costs nothing. */
 FR_INLINE int narrow(state *S, const entry *e, entry *out) {
   fr_lpacket *p = S->p;
   const fr_bvh2_node *n = e->parent;
-  const int k = e->slot;
+  const int k = e->slot, cull = S->opt->cull != FR_CULL_OFF;
   switch (S->opt->traversal) {
   case FR_LP_MASKED: {
     const uint16_t *in = p->frames[e->depth];
     if (e->depth + 1 >= FR_LP_FRAMES) {
       /* deeper than the frames: keep the parent's masks (a superset) */
       out->depth = e->depth;
-      return 1;
+      return !(cull && cull_box(S, n, k));
     }
     uint16_t *mo = p->frames[e->depth + 1];
     unsigned any = 0;
+    int tested = 0;
     for (int c = 0; c < p->nchunks; c++) {
       unsigned m = in[c] & p->alive[c];
-      if (m) m &= box16(p, c, n, k);
+      if (m) {
+        m &= box16(p, c, n, k);
+        if (!tested++ && !m && cull && cull_box(S, n, k)) return 0;
+      }
       mo[c] = (uint16_t)m;
       any |= m;
     }
@@ -169,9 +233,12 @@ FR_INLINE int narrow(state *S, const entry *e, entry *out) {
     return any != 0;
   }
   case FR_LP_RANGED: {
-    int first = -1, last = -1;
-    for (int c = e->a; c <= e->b; c++)
-      if (p->alive[c] && (box16(p, c, n, k) & p->alive[c])) { first = c; break; }
+    int first = -1, last = -1, tested = 0;
+    for (int c = e->a; c <= e->b; c++) {
+      if (!p->alive[c]) continue;
+      if (box16(p, c, n, k) & p->alive[c]) { first = c; break; }
+      if (!tested++ && cull && cull_box(S, n, k)) return 0;
+    }
     if (first < 0) return 0;
     for (int c = e->b; c > first; c--)
       if (p->alive[c] && (box16(p, c, n, k) & p->alive[c])) { last = c; break; }
@@ -181,13 +248,14 @@ FR_INLINE int narrow(state *S, const entry *e, entry *out) {
   }
   default: {
     uint8_t *l = p->list;
-    int hit = 0;
+    int hit = 0, tested = 0;
     for (int j = 0; j < e->a; j++) {
       int c = l[j];
-      if (p->alive[c] && (box16(p, c, n, k) & p->alive[c])) {
+      if (!p->alive[c]) continue;
+      if (box16(p, c, n, k) & p->alive[c]) {
         l[j] = l[hit];
         l[hit++] = (uint8_t)c;
-      }
+      } else if (!tested++ && !hit && cull && cull_box(S, n, k)) return 0;
     }
     out->a = hit;
     return hit > 0;
@@ -248,15 +316,7 @@ static void walk(state *S0, const fr_bvh2 *b, int closest) {
   while (sp > 0) {
     entry e = stack[--sp], in = e;
     FR_COUNT(lp_nodes, 1);
-    if (e.parent) {
-      float lo[3] = {e.parent->lo_x[e.slot], e.parent->lo_y[e.slot], e.parent->lo_z[e.slot]};
-      float hi[3] = {e.parent->hi_x[e.slot], e.parent->hi_y[e.slot], e.parent->hi_z[e.slot]};
-      if (opt->cull != FR_CULL_OFF && fr_pbounds_cull_box(&p->bounds, opt->cull, lo, hi)) {
-        FR_COUNT(lp_culled, 1);
-        continue;
-      }
-      if (!narrow(&S, &in, &e)) continue;
-    }
+    if (e.parent && !narrow(&S, &in, &e)) continue;
     if (e.ref & FR_BVH2_LEAF) {
       leaf(&S, &e, closest);
       if (!closest && S.live == 0) break;

@@ -235,6 +235,15 @@ static int lines_outside_edge(const fr_pbounds *b, const double V[3][3], const d
 int fr_pbounds_cull_tri(const fr_pbounds *b, fr_cull c, const float v0[3], const float v1[3], const float v2[3]) {
   if (b->empty) return 1;
   if (c == FR_CULL_OFF) return 0;
+  if (c == FR_CULL_IA || !b->has_planes) {
+    /* the triangle's box: min and max of floats are exact, so no double */
+    float lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+      lo[a] = fr_pb_min(v0[a], fr_pb_min(v1[a], v2[a]));
+      hi[a] = fr_pb_max(v0[a], fr_pb_max(v1[a], v2[a]));
+    }
+    return fr_pbounds_cull_box(b, FR_CULL_IA, lo, hi);
+  }
   double V[3][3], lo[3], hi[3], mag = 0.0;
   const float *src[3] = {v0, v1, v2};
   for (int i = 0; i < 3; i++)
@@ -244,7 +253,6 @@ int fr_pbounds_cull_tri(const fr_pbounds *b, fr_cull c, const float v0[3], const
     hi[a] = dmax(V[0][a], dmax(V[1][a], V[2][a]));
     mag = dmax(mag, dmax(fabs(lo[a]), fabs(hi[a])));
   }
-  if (c == FR_CULL_IA || !b->has_planes) return cull_box_d(b, FR_CULL_IA, lo, hi);
   double tol = SLACK * (b->scale + mag);
   kuv p[3] = {to_kuv(b, V[0]), to_kuv(b, V[1]), to_kuv(b, V[2])};
   if (points_outside_planes(b, p, 3, tol)) return 1;
