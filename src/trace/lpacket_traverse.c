@@ -49,16 +49,23 @@ FR_INLINE unsigned box16(const fr_lpacket *p, int c, const fr_bvh2_node *n, int 
   return vpm_bits(vp_le(tn, vp_mul(tf, vp(ROUND_UP))));
 }
 
-/* Chunk c's rays of m against triangle index ti; closest: keeps the nearer
- * hits, else returns the rays that hit anything in range. */
-FR_INLINE unsigned tri16(fr_lpacket *p, int c, const fr_bvh2_tri *r, uint32_t ti, unsigned m, int closest) {
+/* The edge vectors of triangle r seen from chunk c's origins. */
+typedef struct edges16 { vpf E[3][3], det; } edges16;
+
+FR_INLINE void chunk_edges(const fr_lpacket *p, int c, const fr_bvh2_tri *r, edges16 *e) {
   const int i = 16 * c;
   vpf o[3] = {vp_load(p->o[0] + i), vp_load(p->o[1] + i), vp_load(p->o[2] + i)};
+  fr_tri_edges16(r, o, e->E, &e->det);
+}
+
+/* Chunk c's rays of m against triangle index ti (edges e); closest: keeps
+ * the nearer hits, else returns the rays that hit anything in range. */
+FR_INLINE unsigned tri16(fr_lpacket *p, int c, const fr_bvh2_tri *r, edges16 *e, uint32_t ti, unsigned m, int closest) {
+  const int i = 16 * c;
   vpf dx = vp_load(p->d[0] + i), dy = vp_load(p->d[1] + i), dz = vp_load(p->d[2] + i);
-  vpf E[3][3], det, w[3];
+  vpf w[3], det = e->det;
   FR_COUNT(lp_tri_chunks, 1);
-  fr_tri_edges16(r, o, E, &det);
-  m = fr_tri_edges16_inside(dx, dy, dz, E, det, m, w);
+  m = fr_tri_edges16_inside(dx, dy, dz, e->E, det, m, w);
   if (!m) return 0;
   vpf tf = vp_load(p->tfar + i);
   vpf t = vp_div(det, fr_dot3v(dx, dy, dz, vp(r->n[0]), vp(r->n[1]), vp(r->n[2])));
@@ -112,6 +119,8 @@ typedef struct state {
   const fr_lp_opts *opt;
   float dmean[3];
   int live;      /* chunks with rays still alive (any hit) */
+  int shared;    /* every valid ray starts at o0 (camera rays) */
+  float o0[3];
 } state;
 
 /* Interval-arithmetic bounds (all the IA cull reads) straight from the
@@ -165,6 +174,15 @@ static void setup(state *S, fr_lpacket *p, const fr_lp_opts *opt) {
   S->p = p;
   S->opt = opt;
   S->live = 0;
+  S->shared = 1;
+  float *o0 = S->o0;
+  o0[0] = o0[1] = o0[2] = 0.0f;
+  for (int c = 0; c < p->nchunks; c++)
+    if (p->valid[c]) {
+      int k = __builtin_ctz(p->valid[c]);
+      for (int a = 0; a < 3; a++) o0[a] = p->o[a][16 * c + k];
+      break;
+    }
   double sum[3] = {0, 0, 0};
   vpf tiny = vp(TINY);
   for (int c = 0; c < p->nchunks; c++) {
@@ -175,6 +193,10 @@ static void setup(state *S, fr_lpacket *p, const fr_lp_opts *opt) {
       vp_store(p->rd[a] + i, vp_div(vp(1.0f), d));
     }
     p->alive[c] = p->valid[c];
+    /* bit for bit (-0 is not 0 to the edge products' signs) */
+    for (int k = 0; k < 16 && S->shared; k++)
+      if ((p->valid[c] >> k) & 1) S->shared = !memcmp(&p->o[0][i + k], &o0[0], 4) && !memcmp(&p->o[1][i + k], &o0[1], 4) &&
+                                            !memcmp(&p->o[2][i + k], &o0[2], 4);
     p->occ[c] = 0;
     S->live += p->valid[c] != 0;
     for (int k = 0; k < 16; k++) {
@@ -282,12 +304,26 @@ static void leaf(state *S, const entry *e, int closest) {
       continue;
     }
     int nc = S->opt->traversal == FR_LP_RANGED ? e->b - e->a + 1 : S->opt->traversal == FR_LP_PARTITION ? e->a : p->nchunks;
+    edges16 ed;
+    int have_edges = 0;
     for (int jc = 0; jc < nc; jc++) {
       int c = S->opt->traversal == FR_LP_RANGED ? e->a + jc : S->opt->traversal == FR_LP_PARTITION ? p->list[jc] : jc;
       unsigned m = p->alive[c];
       if (S->opt->traversal == FR_LP_MASKED) m &= p->frames[e->depth][c];
       if (!m) continue;
-      unsigned hit = sp ? sphere16(p, c, sp, first + j, m, closest) : tri16(p, c, r, first + j, m, closest);
+      unsigned hit;
+      if (sp) hit = sphere16(p, c, sp, first + j, m, closest);
+      else {
+        /* one origin: the edges are the same in every chunk (and lane),
+         * made once per triangle, bit for bit what each chunk would make */
+        if (!S->shared) chunk_edges(p, c, r, &ed);
+        else if (!have_edges) {
+          const vpf o[3] = {vp(S->o0[0]), vp(S->o0[1]), vp(S->o0[2])};
+          fr_tri_edges16(r, o, ed.E, &ed.det);
+          have_edges = 1;
+        }
+        hit = tri16(p, c, r, &ed, first + j, m, closest);
+      }
       if (!closest && hit) {
         p->occ[c] |= (uint16_t)hit;
         p->alive[c] &= (uint16_t)~hit;
