@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The Whitted benchmark (issue 5): large packets of 2x2 .. 32x32 rays with
 # each traversal (masked, ranged, partition), the culls (off, ia, planes,
-# corners) at 2x2 and 16x16, frusta's hybrid16 and auto, and Embree's modes,
+# corners) at 2x2 and 16x16, frusta's hybrid16, auto and mft, and Embree's modes,
 # all on the same Whitted rays, 2 threads, 1024x1024. kitchen and museum
 # with their MTL mirrors and glass, spd_rings with every surface a mirror,
 # and the analytic sphereflake (--builtin=sphereflake: 820 mirror spheres).
@@ -36,6 +36,8 @@ for s in $SCENES; do
   bench ./build/frusta "$s" --mode hybrid16 --tracer both >>"$RAW"
   bench ./build/frusta "$s" --mode all --tracer embree >>"$RAW"
   bench ./build/frusta "$s" --mode auto >>"$RAW"
+  # camera rays as multi-frusta, the rest as auto (no spheres in frusta)
+  if [ "$s" != sphereflake ]; then bench ./build/frusta "$s" --mode mft >>"$RAW"; fi
   for n in 2 4 8 16 32; do
     for t in masked ranged partition; do
       bench ./build/frusta "$s" --mode "packet${n}x${n}" --traversal "$t" --cull off >>"$RAW"
