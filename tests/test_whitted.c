@@ -81,8 +81,7 @@ static void check_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int 
   free(copy);
 }
 
-/* Whitted on scene s (view of name) with its materials as mirror and glass
- * say (NULL: the defaults), which must give mirrors and, if want_glass, glass. */
+/* The Whitted workload on scene s with the view of name, at width x height. */
 static void whitted_setup(fr_workload *w, fr_scene *s, const char *name, const fr_whitted_mats *mats, int width,
                           int height) {
   memset(w, 0, sizeof *w);
@@ -116,6 +115,8 @@ static void check_whitted_mft(fr_scene *s, const char *name, const fr_whitted_ma
                 "edges or range ends)\n", name, c.frusta_rays, c.rays, c.occluded_rays, c.disagree);
 }
 
+/* Whitted on scene s (view of name) with its materials as mirror and glass
+ * say (NULL: the defaults), which must give mirrors and, if want_glass, glass. */
 static void check_whitted(fr_scene *s, const char *name, const char *mirror, const char *glass, int want_glass) {
   fr_whitted_mats mats;
   assert_int_equal(fr_whitted_mats_build(s, mirror, glass, &mats), FR_OK);

@@ -188,18 +188,18 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
   const int max_depth = w->max_depth > 0 ? w->max_depth : 4;
   if (!reserve(S, 2 * WT_PIX)) return 0;
   size_t n = 0, traced = 0;
-  if (t->intersect_frusta && side == WT) {
+  if (t->intersect_frusta && w->camera_set && side == WT) {
     /* a multi-frusta tracer traces the camera rays of every full 16x16
      * quarter of the tile as 16 frusta; the tile is one packet (key 0) */
     for (int q = 0; q < 4; q++) {
       int qx = tx + 16 * (q % 2), qy = ty + 16 * (q / 2);
       if (qx + 16 > W || qy + 16 > H) continue;
       fr_camera_frusta(w, t, qx, qy, S->rays + n, S->hits + n);
-      for (int i = 0; i < 256; i++) {
+      for (int i = 0; i < 256; i++, n++) {
         int f = i / 16, k = i % 16;
         int X = qx + 4 * (f % 4) + k % 4, Y = qy + 4 * (f / 4) + k / 4;
-        wray *g = &S->cur[n++];
-        g->r = S->rays[n - 1];
+        wray *g = &S->cur[n];
+        g->r = S->rays[n];
         g->w = v3(1, 1, 1);
         g->pix = (uint16_t)((Y - ty) * WT + (X - tx));
         g->key = 0;
