@@ -22,9 +22,11 @@
  *
  * The tests are conservative: a cull never rejects what one of the rays
  * hits, with slack for the rays' own float rounding (tests/test_cull.c
- * checks this on millions of random packets). Everything is in double; a
- * packet's bounds are made once and each test is a few dozen flops, small
- * against the 16-ray SIMD tests they save.
+ * checks this on millions of random packets). The bounds are made in
+ * double, once per packet, and each test is a few dozen flops; the large
+ * packets make their interval-arithmetic bounds themselves, in float from
+ * the rays' own values (trace/lpacket_traverse.c), and the IA triangle cull
+ * needs no double either.
  */
 #ifndef FR_TRACE_PACKET_BOUNDS_H
 #define FR_TRACE_PACKET_BOUNDS_H
