@@ -161,6 +161,17 @@ static void check_scene(vec3 center, float size, uint64_t seed) {
                 fail_msg("%s isa %d packet %d ray %d: occluded %d vs single %d", cn, isa, p, i, (occ16 >> i) & 1, occ1[i]);
             }
           }
+          if (((valid >> i) & 1) && hs[i].prim == h16.prim[i]) {
+            /* the stream's gathered rays and scattered answers: every field
+             * as the packet call's (u, v only where both ran the packet
+             * kernel: a hybrid's single-ray phase, which depends on the
+             * packet's other rays, gives the watertight test's u, v) */
+            int same_kernel = configs[c].threshold == 0 && configs[c].mode != FR_TRACE_AUTO;
+            float a[6] = {h16.t[i], h16.ng_x[i], h16.ng_y[i], h16.ng_z[i], h16.u[i], h16.v[i]};
+            float b[6] = {hs[i].t, hs[i].ng[0], hs[i].ng[1], hs[i].ng[2], hs[i].u, hs[i].v};
+            if (memcmp(a, b, (same_kernel ? 6 : 4) * sizeof(float)))
+              fail_msg("%s stream isa %d packet %d ray %d: answer differs from the packet's", configs[c].name, isa, p, i);
+          }
           if (clear[i]) {
             if (!fr_hits_agree(hs[i].t, single[i].t))
               fail_msg("%s stream isa %d packet %d ray %d: t %g vs single %g", cn, isa, p, i, hs[i].t, single[i].t);

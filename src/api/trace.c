@@ -135,16 +135,6 @@ unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays) 
  * and culls by interval arithmetic. */
 #define STREAM_CHUNK 1024
 
-/* The rays of a packet: rays[idx[0..n)]. Returns the valid mask. */
-static unsigned gather(const fr_ray *rays, const uint32_t *idx, size_t n, fr_ray16 *r16) {
-  for (size_t i = 0; i < n; i++) {
-    const fr_ray *r = &rays[idx[i]];
-    r16->org_x[i] = r->org[0]; r16->org_y[i] = r->org[1]; r16->org_z[i] = r->org[2]; r16->tnear[i] = r->tnear;
-    r16->dir_x[i] = r->dir[0]; r16->dir_y[i] = r->dir[1]; r16->dir_z[i] = r->dir[2]; r16->tfar[i] = r->tfar;
-  }
-  return (unsigned)((1u << n) - 1u);
-}
-
 /* How a group is traced: 0 single rays, else the packet size. */
 static int group_plan(const fr_scene *s, size_t n, int *threshold) {
   switch (s->trace.mode) {
@@ -210,18 +200,11 @@ static void triangles_intersect_stream(const fr_scene *s, const fr_ray *rays, fr
   const fr_bvhn *sb;
   const fr_trace_fns *single = single_fns(s, &sb);
   if (s->trace.mode == FR_TRACE_SINGLE) { single->intersect_stream(sb, rays, hits, n); return; }
-  fr_ray16 r16 __attribute__((aligned(64)));
-  fr_hit16 h16 __attribute__((aligned(64)));
   FOR_EACH_GROUP(s, rays, n, {
     fr_packet_opts po;
     const fr_bvhn *pb;
     const fr_packet_fns *pf = packet_fns(s, size, threshold, &po, &pb);
-    pf->intersect(pb, &po, gather(rays + c0, idx, m, &r16), &r16, &h16);
-    for (size_t i = 0; i < m; i++) {
-      fr_hit *h = &hits[c0 + idx[i]];
-      h->t = h16.t[i]; h->u = h16.u[i]; h->v = h16.v[i]; h->prim = h16.prim[i];
-      h->ng[0] = h16.ng_x[i]; h->ng[1] = h16.ng_y[i]; h->ng[2] = h16.ng_z[i];
-    }
+    pf->intersect_idx(pb, &po, rays + c0, idx, (int)m, hits + c0);
   }, {
     for (size_t i = 0; i < m; i++) single->intersect1(sb, &rays[c0 + idx[i]], &hits[c0 + idx[i]]);
   });
@@ -231,12 +214,11 @@ static void triangles_occluded_stream(const fr_scene *s, const fr_ray *rays, uin
   const fr_bvhn *sb;
   const fr_trace_fns *single = single_fns(s, &sb);
   if (s->trace.mode == FR_TRACE_SINGLE) { single->occluded_stream(sb, rays, occ, n); return; }
-  fr_ray16 r16 __attribute__((aligned(64)));
   FOR_EACH_GROUP(s, rays, n, {
     fr_packet_opts po;
     const fr_bvhn *pb;
     const fr_packet_fns *pf = packet_fns(s, size, threshold, &po, &pb);
-    unsigned o = pf->occluded(pb, &po, gather(rays + c0, idx, m, &r16), &r16);
+    unsigned o = pf->occluded_idx(pb, &po, rays + c0, idx, (int)m);
     for (size_t i = 0; i < m; i++) occ[c0 + idx[i]] = (uint8_t)((o >> i) & 1);
   }, {
     for (size_t i = 0; i < m; i++) occ[c0 + idx[i]] = (uint8_t)single->occluded1(sb, &rays[c0 + idx[i]]);

@@ -14,6 +14,8 @@
 #define FR_BASE_SIMD_PACKET_H
 #include "base/simd.h"
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 
 #ifndef FR_PACKET
 #error "define FR_PACKET (8 or 16)"
@@ -139,6 +141,55 @@ FR_INLINE vpf vp_abs(vpf a) {
   return vp_and(a, vp(m.f));
 }
 FR_INLINE vpf vp_copysign(vpf mag, vpf sgn) { return vp_or(vp_abs(mag), vp_and(sgn, vp(-0.0f))); }
+
+/* Memory by lane: vp_gather reads base[idx[i]] (idx: P aligned int32, each a
+ * valid index), vp_store_mask writes lane i of a to p[i] where bit i of mask is
+ * set, vp_scatter writes it to base[idx[i]] (distinct indices). Plain moves,
+ * so every level gives the same bits; uint32 fields pass through as float
+ * bit patterns. */
+#if defined(FR_BUILD_ISA_AVX512)
+#if P == 16
+FR_INLINE vpf vp_gather(const float *base, const int32_t *idx) {
+  vpf r = {_mm512_i32gather_ps(_mm512_load_si512((const void *)idx), base, 4)};
+  return r;
+}
+FR_INLINE void vp_scatter(float *base, const int32_t *idx, unsigned mask, vpf a) {
+  _mm512_mask_i32scatter_ps(base, (__mmask16)mask, _mm512_load_si512((const void *)idx), a.v, 4);
+}
+#else
+FR_INLINE vpf vp_gather(const float *base, const int32_t *idx) {
+  vpf r = {_mm256_i32gather_ps(base, _mm256_load_si256((const __m256i *)idx), 4)};
+  return r;
+}
+FR_INLINE void vp_scatter(float *base, const int32_t *idx, unsigned mask, vpf a) {
+  _mm256_mask_i32scatter_ps(base, (__mmask8)mask, _mm256_load_si256((const __m256i *)idx), a.v, 4);
+}
+#endif
+FR_INLINE void vp_store_mask(float *p, unsigned mask, vpf a) { FR_VP_OP(mask_storeu_ps)(p, (fr_vp_kmask)mask, a.v); }
+#elif defined(FR_BUILD_ISA_AVX2)
+FR_INLINE vpf vp_gather(const float *base, const int32_t *idx) {
+  vpf r;
+  for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_i32gather_ps(base, _mm256_load_si256((const __m256i *)(idx + 8 * h)), 4);
+  return r;
+}
+FR_INLINE void vp_store_mask(float *p, unsigned mask, vpf a) {
+  vpm m = vpm_bits_to(mask);
+  for (int h = 0; h < FR_VP_HALVES; h++) _mm256_maskstore_ps(p + 8 * h, _mm256_castps_si256(m.m[h]), a.v[h]);
+}
+FR_INLINE void vp_scatter(float *base, const int32_t *idx, unsigned mask, vpf a) {
+  float t[P] __attribute__((aligned(32)));
+  vp_store(t, a);
+  for (; mask; mask &= mask - 1) { int i = __builtin_ctz(mask); base[idx[i]] = t[i]; }
+}
+#else
+FR_INLINE vpf vp_gather(const float *base, const int32_t *idx) { vpf r; for (int i = 0; i < P; i++) memcpy(&r.f[i], base + idx[i], 4); return r; }
+FR_INLINE void vp_store_mask(float *p, unsigned mask, vpf a) {
+  for (; mask; mask &= mask - 1) { int i = __builtin_ctz(mask); p[i] = a.f[i]; }
+}
+FR_INLINE void vp_scatter(float *base, const int32_t *idx, unsigned mask, vpf a) {
+  for (; mask; mask &= mask - 1) { int i = __builtin_ctz(mask); memcpy(base + idx[i], &a.f[i], 4); }
+}
+#endif
 
 #if !(defined(FR_BUILD_ISA_AVX512) && P == 16) && !defined(FR_BUILD_ISA_SCALAR)
 /* horizontal min/max of 8 lanes: halves, quarters, pairs */

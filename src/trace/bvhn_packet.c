@@ -22,6 +22,7 @@
  * Compiled once per ISA, packet size (FR_PACKET) and BVH width (FR_WIDTH).
  */
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 #include "base/simd.h"
 #include "base/simd_packet.h"
@@ -45,18 +46,44 @@ typedef struct packet {
   float ia_near_o[3], ia_far_o[3]; /* see ia_test */
 } packet;
 
-/* Loads lanes 0..P-1; returns the valid mask without rays that cannot hit
- * (the conditions of fr_ray_invalid, lane by lane). */
-static unsigned packet_setup(packet *pk, unsigned valid, const fr_ray16 *in) {
-  const float *org[3] = {in->org_x, in->org_y, in->org_z}, *dir[3] = {in->dir_x, in->dir_y, in->dir_z};
+/* A packet's rays as loaded, in fr_ray's field order. */
+typedef struct rays_in { vpf o[3], tnear, d[3], tfar; } rays_in;
+
+static void load_soa(const fr_ray16 *in, rays_in *r) {
+  r->o[0] = vp_loadu(in->org_x); r->o[1] = vp_loadu(in->org_y); r->o[2] = vp_loadu(in->org_z);
+  r->d[0] = vp_loadu(in->dir_x); r->d[1] = vp_loadu(in->dir_y); r->d[2] = vp_loadu(in->dir_z);
+  r->tnear = vp_loadu(in->tnear); r->tfar = vp_loadu(in->tfar);
+}
+
+/* rays[idx[0..n)], 1 <= n <= P, gathered straight into registers: copying
+ * them lane by lane into an fr_ray16 first cost a store-forwarding stall on
+ * every vector load after it. Lanes past n repeat ray idx[0]; returns the
+ * mask of the first n. */
+_Static_assert(sizeof(fr_ray) == 8 * sizeof(float), "fr_ray is gathered as 8 floats");
+static unsigned load_aos(const fr_ray *rays, const uint32_t *idx, int n, rays_in *r) {
+  int32_t gi[P] __attribute__((aligned(64)));
+  for (int i = 0; i < P; i++) gi[i] = 8 * (int32_t)idx[i < n ? i : 0];
+  const float *f = (const float *)rays;
+  for (int a = 0; a < 3; a++) {
+    r->o[a] = vp_gather(f + a, gi);
+    r->d[a] = vp_gather(f + 4 + a, gi);
+  }
+  r->tnear = vp_gather(f + 3, gi);
+  r->tfar = vp_gather(f + 7, gi);
+  return n >= P ? FR_PACKET_ALL : (1u << n) - 1u;
+}
+
+/* Returns the valid mask without rays that cannot hit (the conditions of
+ * fr_ray_invalid, lane by lane). */
+static unsigned packet_setup(packet *pk, unsigned valid, const rays_in *in) {
   const vpf inf = vp(INFINITY), zero = vp(0.0f), tiny = vp(1e-18f);
-  vpf tnear = vp_loadu(in->tnear), tfar = vp_loadu(in->tfar);
+  vpf tnear = in->tnear, tfar = in->tfar;
   valid &= FR_PACKET_ALL & vpm_bits(vp_le(tnear, tfar));
   unsigned nonzero = 0;
   vpf o[3], d[3];
   for (int a = 0; a < 3; a++) {
-    o[a] = vp_loadu(org[a]);
-    d[a] = vp_loadu(dir[a]);
+    o[a] = in->o[a];
+    d[a] = in->d[a];
     valid &= vpm_bits(vpm_and(vp_lt(vp_abs(o[a]), inf), vp_lt(vp_abs(d[a]), inf)));
     nonzero |= ~vpm_bits(vp_eq(d[a], zero));
   }
@@ -249,52 +276,69 @@ static inline fr_ray lane_ray(const packet *pk, int i, float tfar) {
   return r;
 }
 
-/* The fr_hit16 of a closest-hit packet: as fr_hit_finish lane by lane, with
- * the double-precision t of fr_tri_refine_lane computed for all lanes in one
- * loop, which the compiler vectorizes (a lane at a time it cost ~20% of a
- * primary-ray packet). */
-static void finish(const fr_bvhn *b, const packet *pk, unsigned asked, const uint32_t *best, vpf tfar, vpf U, vpf V,
-                   fr_hit16 *out) {
-  float TF[P] __attribute__((aligned(64))), UU[P] __attribute__((aligned(64))), VV[P] __attribute__((aligned(64)));
-  float T[P] __attribute__((aligned(64)));
-  float A[9][P] __attribute__((aligned(64)));
-  vp_store(TF, tfar); vp_store(UU, U); vp_store(VV, V);
+/* A closest-hit packet's answers in registers (prim as float bit patterns). */
+typedef struct hit_regs { vpf t, u, v, prim, ng[3]; } hit_regs;
+
+/* The answers of fr_hit_finish, for all lanes at once: the hit triangles'
+ * vertices gathered lane by lane, the double-precision t of
+ * fr_tri_refine_lane in one loop the compiler vectorizes, the normal as
+ * v3_cross(p1 - p0, p2 - p0) with the same operations. Misses get
+ * fr_hit_miss's values. */
+static void finish(const fr_bvhn *b, const packet *pk, const uint32_t *best, vpf tfar, vpf U, vpf V, hit_regs *h) {
+  enum { REC = sizeof(fr_tri4) / sizeof(float) };
+  _Static_assert(offsetof(fr_tri4, prim) == 36 * sizeof(float), "prim follows the vertices");
+  int32_t ix[P] __attribute__((aligned(64)));
+  unsigned hit = 0;
   for (int i = 0; i < P; i++) {
-    if (best[i] == FR_INVALID_ID) {
-      for (int k = 0; k < 9; k++) A[k][i] = 0.0f; /* den = 0: keeps TF */
-      continue;
-    }
-    const fr_tri4 *blk = &b->tris[best[i] >> 2];
-    int l = (int)(best[i] & 3);
-    for (int k = 0; k < 3; k++) {
-      A[k][i] = blk->v0[k][l];
-      A[3 + k][i] = blk->v1[k][l];
-      A[6 + k][i] = blk->v2[k][l];
-    }
+    int ok = best[i] != FR_INVALID_ID;
+    hit |= (unsigned)ok << i;
+    ix[i] = ok ? (int32_t)((best[i] >> 2) * REC + (best[i] & 3)) : 0;
   }
+  const vpf zero = vp(0.0f);
+  union { uint32_t u; float f; } invalid = {FR_INVALID_ID};
+  h->t = vp(INFINITY); h->u = h->v = zero; h->prim = vp(invalid.f);
+  h->ng[0] = h->ng[1] = h->ng[2] = zero;
+  if (!hit) return;
+  /* A[3 * vertex + axis]; indices are int32 floats into b->tris */
+  float A[9][P] __attribute__((aligned(64)));
+  vpf prim;
+  const float *base = (const float *)b->tris;
+  if (b->nblocks <= (size_t)INT32_MAX / REC) {
+    for (int k = 0; k < 9; k++) vp_store(A[k], vp_gather(base + 4 * k, ix));
+    prim = vp_gather(base + 36, ix);
+  } else { /* too many blocks for 32-bit indices */
+    float pr[P] __attribute__((aligned(64)));
+    for (int i = 0; i < P; i++) {
+      const float *rec = base + (hit >> i & 1 ? (size_t)(best[i] >> 2) * REC + (best[i] & 3) : 0);
+      for (int k = 0; k < 9; k++) A[k][i] = rec[4 * k];
+      memcpy(&pr[i], rec + 36, sizeof(float));
+    }
+    prim = vp_load(pr);
+  }
+  float TF[P] __attribute__((aligned(64))), T[P] __attribute__((aligned(64)));
+  vp_store(TF, tfar);
   for (int i = 0; i < P; i++)
     T[i] = fr_tri_refine_lane(pk->o[0][i], pk->o[1][i], pk->o[2][i], pk->d[0][i], pk->d[1][i], pk->d[2][i], pk->tnear[i],
                               pk->tfar[i], A[0][i], A[1][i], A[2][i], A[3][i], A[4][i], A[5][i], A[6][i], A[7][i],
                               A[8][i], TF[i]);
-  for (unsigned m = asked; m; m &= m - 1) {
-    int i = __builtin_ctz(m);
-    if (best[i] == FR_INVALID_ID) {
-      out->t[i] = INFINITY; out->u[i] = out->v[i] = 0.0f; out->prim[i] = FR_INVALID_ID;
-      out->ng_x[i] = out->ng_y[i] = out->ng_z[i] = 0.0f;
-      continue;
-    }
-    vec3 p0 = v3(A[0][i], A[1][i], A[2][i]), p1 = v3(A[3][i], A[4][i], A[5][i]), p2 = v3(A[6][i], A[7][i], A[8][i]);
-    vec3 ng = v3_cross(v3_sub(p1, p0), v3_sub(p2, p0));
-    out->t[i] = T[i]; out->u[i] = UU[i]; out->v[i] = VV[i];
-    out->prim[i] = b->tris[best[i] >> 2].prim[best[i] & 3];
-    out->ng_x[i] = ng.x; out->ng_y[i] = ng.y; out->ng_z[i] = ng.z;
+  vpf e1[3], e2[3];
+  for (int k = 0; k < 3; k++) {
+    vpf p0 = vp_load(A[k]);
+    e1[k] = vp_sub(vp_load(A[3 + k]), p0);
+    e2[k] = vp_sub(vp_load(A[6 + k]), p0);
   }
+  vpm m = vpm_bits_to(hit);
+  h->t = vp_select(m, vp_load(T), h->t);
+  h->u = vp_select(m, U, zero);
+  h->v = vp_select(m, V, zero);
+  h->prim = vp_select(m, prim, h->prim);
+  h->ng[0] = vp_select(m, vp_sub(vp_mul(e1[1], e2[2]), vp_mul(e1[2], e2[1])), zero);
+  h->ng[1] = vp_select(m, vp_sub(vp_mul(e1[2], e2[0]), vp_mul(e1[0], e2[2])), zero);
+  h->ng[2] = vp_select(m, vp_sub(vp_mul(e1[0], e2[1]), vp_mul(e1[1], e2[0])), zero);
 }
 
-static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const fr_ray16 *in,
-                             fr_hit16 *out) {
+static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in, hit_regs *out) {
   packet pk;
-  const unsigned asked = valid & FR_PACKET_ALL;
   valid = packet_setup(&pk, valid, in);
   FR_COUNT(packets, 1);
   FR_COUNT(rays, __builtin_popcount(valid));
@@ -422,10 +466,40 @@ static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned
     }
   }
 
-  finish(b, &pk, asked, best, tfar, U, V, out);
+  finish(b, &pk, best, tfar, U, V, out);
 }
 
-static unsigned occluded_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const fr_ray16 *in) {
+static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const fr_ray16 *in,
+                             fr_hit16 *out) {
+  rays_in r;
+  load_soa(in, &r);
+  hit_regs h;
+  intersect_rays(b, o, valid, &r, &h);
+  const unsigned asked = valid & FR_PACKET_ALL;
+  vp_store_mask(out->t, asked, h.t); vp_store_mask(out->u, asked, h.u); vp_store_mask(out->v, asked, h.v);
+  vp_store_mask((float *)out->prim, asked, h.prim);
+  vp_store_mask(out->ng_x, asked, h.ng[0]); vp_store_mask(out->ng_y, asked, h.ng[1]); vp_store_mask(out->ng_z, asked, h.ng[2]);
+}
+
+/* rays[idx[0..n)] to hits[idx[0..n)], answers scattered straight from
+ * registers (fr_hit as 7 floats). */
+_Static_assert(sizeof(fr_hit) == 7 * sizeof(float) && offsetof(fr_hit, prim) == 3 * sizeof(float) &&
+                   offsetof(fr_hit, ng) == 4 * sizeof(float), "fr_hit is scattered as 7 floats");
+static void intersect_rays_idx(const fr_bvhn *b, const fr_packet_opts *o, const fr_ray *rays, const uint32_t *idx, int n,
+                               fr_hit *hits) {
+  rays_in r;
+  const unsigned asked = load_aos(rays, idx, n, &r);
+  hit_regs h;
+  intersect_rays(b, o, asked, &r, &h);
+  int32_t si[P] __attribute__((aligned(64)));
+  for (int i = 0; i < P; i++) si[i] = 7 * (int32_t)idx[i < n ? i : 0];
+  float *f = (float *)hits;
+  vp_scatter(f, si, asked, h.t); vp_scatter(f + 1, si, asked, h.u); vp_scatter(f + 2, si, asked, h.v);
+  vp_scatter(f + 3, si, asked, h.prim);
+  for (int a = 0; a < 3; a++) vp_scatter(f + 4 + a, si, asked, h.ng[a]);
+}
+
+static unsigned occluded_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in) {
   packet pk;
   valid = packet_setup(&pk, valid, in);
   FR_COUNT(packets, 1);
@@ -502,6 +576,20 @@ static unsigned occluded_packet(const fr_bvhn *b, const fr_packet_opts *o, unsig
   return occ;
 }
 
+static unsigned occluded_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const fr_ray16 *in) {
+  rays_in r;
+  load_soa(in, &r);
+  return occluded_rays(b, o, valid, &r);
+}
+
+static unsigned occluded_rays_idx(const fr_bvhn *b, const fr_packet_opts *o, const fr_ray *rays, const uint32_t *idx,
+                                  int n) {
+  rays_in r;
+  unsigned valid = load_aos(rays, idx, n, &r);
+  return occluded_rays(b, o, valid, &r);
+}
+
 #define PK_NAME3(p, w, isa) fr_packet_p##p##_w##w##_##isa
 #define PK_NAME(p, w, isa) PK_NAME3(p, w, isa)
-const fr_packet_fns PK_NAME(FR_PACKET, FR_WIDTH, FR_ISA_SUFFIX) = {intersect_packet, occluded_packet};
+const fr_packet_fns PK_NAME(FR_PACKET, FR_WIDTH, FR_ISA_SUFFIX) = {intersect_packet, occluded_packet, intersect_rays_idx,
+                                                       occluded_rays_idx};

@@ -37,6 +37,12 @@ typedef struct fr_packet_opts {
 typedef struct fr_packet_fns {
   void (*intersect)(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const fr_ray16 *rays, fr_hit16 *hits);
   unsigned (*occluded)(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const fr_ray16 *rays);
+  /* The same on rays[idx[0..n)] of a stream (1 <= n <= packet size, each
+   * idx[i] < 2^27), answers to hits[idx[i]] / bit i: gathered and scattered
+   * in registers, with no fr_ray16 in between. */
+  void (*intersect_idx)(const fr_bvhn *b, const fr_packet_opts *o, const fr_ray *rays, const uint32_t *idx, int n,
+                        fr_hit *hits);
+  unsigned (*occluded_idx)(const fr_bvhn *b, const fr_packet_opts *o, const fr_ray *rays, const uint32_t *idx, int n);
 } fr_packet_fns;
 
 typedef struct fr_kernels {
