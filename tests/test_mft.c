@@ -2,8 +2,9 @@
  * Multi-frusta kernels against the single-ray kernels, ray by ray, on random
  * scenes and on the built-in scene: soft-shadow frusta (16 hit points, 16
  * interleaved light samples each) with any-hit, camera frusta (16 blocks of
- * 4x4 pixels) with closest hit. Every ISA, corner-ray culling and shrinking on
- * and off; the ISAs must agree bit for bit.
+ * 4x4 pixels) with closest hit, and those turned back into rays of unit
+ * direction. Every ISA, corner-ray culling and shrinking on and off; the ISAs
+ * must agree bit for bit.
  *
  * The MFT test and the single-ray test are both watertight but round
  * differently, so a ray that passes within rounding of an edge may get either
@@ -122,6 +123,28 @@ static void check_shadows(const fr_scene *s, const fr_mft_batch *b, const fr_mft
   check_shadows_vs(s, b, T, tl, NULL);
 }
 
+/* A kernel's expand against the scalar formulas, bit for bit: ray k of
+ * frustum f as fr_mft_ray makes it with its direction divided by its
+ * length, and its t times that length. */
+static void check_expand(const fr_mft_fns *fns, const fr_mft_batch *b, const fr_mft_sets *T, const fr_mft_hits *h) {
+  static fr_ray rays[256];
+  static fr_hit hits[256];
+  memset(rays, 0xAB, sizeof rays);
+  memset(hits, 0xAB, sizeof hits);
+  fns->expand(b, T, h, rays, hits);
+  for (int f = 0; f < 16; f++)
+    for (int k = 0; k < 16; k++) {
+      fr_ray r = {{0}, 0.0f, {0}, INFINITY};
+      fr_mft_ray(b, T, f, k, r.org, r.dir);
+      float len = sqrtf(r.dir[0] * r.dir[0] + r.dir[1] * r.dir[1] + r.dir[2] * r.dir[2]);
+      for (int a = 0; a < 3; a++) r.dir[a] /= len;
+      uint32_t prim = h->prim[f][k];
+      fr_hit e = {prim == FR_INVALID_ID ? INFINITY : h->t[f][k] * len, h->u[f][k], h->v[f][k], prim, {0, 0, 0}};
+      assert_memory_equal(&rays[16 * f + k], &r, sizeof r);
+      assert_memory_equal(&hits[16 * f + k], &e, sizeof e);
+    }
+}
+
 static void check_camera(const fr_scene *s, const fr_camera *cam, int x0, int y0, tally *tl) {
   mesh_ref m = scene_mesh(s);
   fr_mft_sets T;
@@ -136,6 +159,7 @@ static void check_camera(const fr_scene *s, const fr_camera *cam, int x0, int y0
       fr_mft_opts o = {corner, 0};
       memset(&h, 0xAB, sizeof h);
       isa_fns[i]->intersect(&s->bvh2, &o, &b, &T, &h);
+      check_expand(isa_fns[i], &b, &T, &h);
       if (!first) {
         assert_memory_equal(&h, &ref, sizeof h);
         continue;

@@ -191,6 +191,59 @@ FR_INLINE void vp_scatter(float *base, const int32_t *idx, unsigned mask, vpf a)
 }
 #endif
 
+/* Structure-of-arrays to records: record i (nf = 7 or 8 floats, at dst +
+ * nf * i) gets lane i of f[0..nf), for the P lanes. Whole 8-float rows are
+ * transposed in registers and stored at once; storing lane by lane cost a
+ * store per float. */
+#if defined(FR_BUILD_ISA_SCALAR)
+FR_INLINE void vp_store_records(float *dst, const vpf *f, int nf) {
+  for (int i = 0; i < P; i++)
+    for (int k = 0; k < nf; k++) memcpy(dst + nf * i + k, &f[k].f[i], sizeof(float));
+}
+#else
+/* rows r[0..8) of 8 lanes to records 0..7 (8 floats each), in place */
+FR_INLINE void fr_transpose8(__m256 r[8]) {
+  __m256 t[8], s[8];
+  for (int i = 0; i < 4; i++) {
+    t[2 * i] = _mm256_unpacklo_ps(r[2 * i], r[2 * i + 1]);
+    t[2 * i + 1] = _mm256_unpackhi_ps(r[2 * i], r[2 * i + 1]);
+  }
+  for (int h = 0; h < 2; h++) { /* fields 0-3 from t[0..3], fields 4-7 from t[4..7] */
+    s[4 * h] = _mm256_shuffle_ps(t[4 * h], t[4 * h + 2], 0x44);
+    s[4 * h + 1] = _mm256_shuffle_ps(t[4 * h], t[4 * h + 2], 0xEE);
+    s[4 * h + 2] = _mm256_shuffle_ps(t[4 * h + 1], t[4 * h + 3], 0x44);
+    s[4 * h + 3] = _mm256_shuffle_ps(t[4 * h + 1], t[4 * h + 3], 0xEE);
+  }
+  for (int i = 0; i < 4; i++) { /* s[i] holds records i | i + 4, fields 0-3; s[4 + i] fields 4-7 */
+    r[i] = _mm256_permute2f128_ps(s[i], s[4 + i], 0x20);
+    r[4 + i] = _mm256_permute2f128_ps(s[i], s[4 + i], 0x31);
+  }
+}
+FR_INLINE __m256 fr_vp_half(vpf a, int h) {
+#if defined(FR_BUILD_ISA_AVX512) && P == 16
+  return h ? _mm512_extractf32x8_ps(a.v, 1) : _mm512_castps512_ps256(a.v);
+#elif defined(FR_BUILD_ISA_AVX512)
+  (void)h;
+  return a.v;
+#else
+  return a.v[h];
+#endif
+}
+FR_INLINE void vp_store_records(float *dst, const vpf *f, int nf) {
+  const __m256i seven = _mm256_setr_epi32(-1, -1, -1, -1, -1, -1, -1, 0);
+  for (int h = 0; h < P / 8; h++) {
+    __m256 r[8];
+    for (int k = 0; k < 8; k++) r[k] = k < nf ? fr_vp_half(f[k], h) : _mm256_setzero_ps();
+    fr_transpose8(r);
+    for (int i = 0; i < 8; i++) {
+      float *rec = dst + nf * (8 * h + i);
+      if (nf == 8) _mm256_storeu_ps(rec, r[i]);
+      else _mm256_maskstore_ps(rec, seven, r[i]);
+    }
+  }
+}
+#endif
+
 #if !(defined(FR_BUILD_ISA_AVX512) && P == 16) && !defined(FR_BUILD_ISA_SCALAR)
 /* horizontal min/max of 8 lanes: halves, quarters, pairs */
 #define FR_VP_HREDUCE(name, op128, opss)                                                \

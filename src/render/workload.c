@@ -72,30 +72,7 @@ void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, 
   const fr_mft_sets *cam_set = w->camera_set;
   fr_mft_batch_camera(&b, &w->cam, tx, ty);
   t->intersect_frusta(t->ctx, &b, cam_set, &h);
-  for (int f = 0; f < FR_MFT_FRUSTA; f++) {
-    /* fr_mft_ray's directions, normalized a frustum at a time in loops the
-     * compiler vectorizes (ray by ray this loop cost a third as much as
-     * tracing the frusta) */
-    const fr_mft_set *set = &cam_set->set[b.set[f]];
-    float d[3][FR_MFT_RAYS], len[FR_MFT_RAYS];
-    for (int k = 0; k < FR_MFT_RAYS; k++) {
-      d[0][k] = b.start[0][f] + set->dx[k];
-      d[1][k] = b.start[1][f] + set->dy[k];
-      d[2][k] = b.start[2][f] + set->dz[k];
-      len[k] = sqrtf(d[0][k] * d[0][k] + d[1][k] * d[1][k] + d[2][k] * d[2][k]);
-      for (int a = 0; a < 3; a++) d[a][k] /= len[k];
-    }
-    for (int k = 0; k < FR_MFT_RAYS; k++) {
-      int i = 16 * f + k;
-      rays[i] = (fr_ray){{b.org[0][f], b.org[1][f], b.org[2][f]}, 0.0f, {d[0][k], d[1][k], d[2][k]}, INFINITY};
-      fr_hit *o = &hits[i];
-      o->prim = h.prim[f][k];
-      o->t = o->prim == FR_INVALID_ID ? INFINITY : h.t[f][k] * len[k];
-      o->u = h.u[f][k];
-      o->v = h.v[f][k];
-      o->ng[0] = o->ng[1] = o->ng[2] = 0.0f;
-    }
-  }
+  fr_mft_active()->expand(&b, cam_set, &h, rays, hits);
 }
 
 /* Soft shadows: pixels 16 j .. 16 j + 15 with a primary hit are the frusta of

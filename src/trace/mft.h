@@ -22,6 +22,7 @@
 #define FR_TRACE_MFT_H
 #include <stdint.h>
 #include "accel/bvh2.h"
+#include "frusta.h"
 
 #define FR_MFT_RAYS 16    /* rays per frustum */
 #define FR_MFT_FRUSTA 16  /* frusta traced together */
@@ -84,9 +85,20 @@ typedef struct fr_mft_fns {
                    uint16_t occ[FR_MFT_FRUSTA]);
   void (*intersect)(const fr_bvh2 *b, const fr_mft_opts *o, const fr_mft_batch *batch, const fr_mft_sets *sets,
                     fr_mft_hits *hits);
+  /* rays[16 f + k] = ray k of frustum f with its direction normalized,
+   * hits[16 f + k] its hit with t in units of that direction (ng zero), for
+   * all 16 frusta (src/trace/mft_expand.c) */
+  void (*expand)(const fr_mft_batch *batch, const fr_mft_sets *sets, const fr_mft_hits *hits, fr_ray *rays_out,
+                 fr_hit *hits_out);
 } fr_mft_fns;
 
 extern const fr_mft_fns fr_mft_avx512, fr_mft_avx2, fr_mft_scalar;
+#define FR_MFT_EXPAND_DECL(isa)                                                                            \
+  void fr_mft_expand_##isa(const fr_mft_batch *batch, const fr_mft_sets *sets, const fr_mft_hits *hits, fr_ray *rays_out, \
+                           fr_hit *hits_out);
+FR_MFT_EXPAND_DECL(avx512)
+FR_MFT_EXPAND_DECL(avx2)
+FR_MFT_EXPAND_DECL(scalar)
 
 /* The kernels of the active ISA. */
 const fr_mft_fns *fr_mft_active(void);

@@ -454,4 +454,4 @@ static void intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft
       if (H->prim[f][k] == FR_INVALID_ID) H->t[f][k] = INFINITY;
 }
 
-const fr_mft_fns FR_ISA_FN(fr_mft) = {occluded_mft, intersect_mft};
+const fr_mft_fns FR_ISA_FN(fr_mft) = {occluded_mft, intersect_mft, FR_ISA_FN(fr_mft_expand)};
