@@ -146,7 +146,7 @@ FR_INLINE vpf vp_copysign(vpf mag, vpf sgn) { return vp_or(vp_abs(mag), vp_and(s
  * valid index), vp_store_mask writes lane i of a to p[i] where bit i of mask is
  * set, vp_scatter writes it to base[idx[i]] (distinct indices). Plain moves,
  * so every level gives the same bits; uint32 fields pass through as float
- * bit patterns. */
+ * bit patterns (memcpy in plain C, so no access breaks type aliasing). */
 #if defined(FR_BUILD_ISA_AVX512)
 #if P == 16
 FR_INLINE vpf vp_gather(const float *base, const int32_t *idx) {
@@ -179,12 +179,12 @@ FR_INLINE void vp_store_mask(float *p, unsigned mask, vpf a) {
 FR_INLINE void vp_scatter(float *base, const int32_t *idx, unsigned mask, vpf a) {
   float t[P] __attribute__((aligned(32)));
   vp_store(t, a);
-  for (; mask; mask &= mask - 1) { int i = __builtin_ctz(mask); base[idx[i]] = t[i]; }
+  for (; mask; mask &= mask - 1) { int i = __builtin_ctz(mask); memcpy(base + idx[i], &t[i], sizeof(float)); }
 }
 #else
 FR_INLINE vpf vp_gather(const float *base, const int32_t *idx) { vpf r; for (int i = 0; i < P; i++) memcpy(&r.f[i], base + idx[i], 4); return r; }
 FR_INLINE void vp_store_mask(float *p, unsigned mask, vpf a) {
-  for (; mask; mask &= mask - 1) { int i = __builtin_ctz(mask); p[i] = a.f[i]; }
+  for (; mask; mask &= mask - 1) { int i = __builtin_ctz(mask); memcpy(p + i, &a.f[i], sizeof(float)); }
 }
 FR_INLINE void vp_scatter(float *base, const int32_t *idx, unsigned mask, vpf a) {
   for (; mask; mask &= mask - 1) { int i = __builtin_ctz(mask); memcpy(base + idx[i], &a.f[i], 4); }
