@@ -33,8 +33,10 @@ void FR_ISA_FN(fr_mft_expand)(const fr_mft_batch *b, const fr_mft_sets *sets, co
     for (int k = 0; k < FR_MFT_RAYS; k++) miss |= (unsigned)(h->prim[f][k] == FR_INVALID_ID) << k;
     vpf ray[8] = {vp(b->org[0][f]), vp(b->org[1][f]), vp(b->org[2][f]), zero,
                   vp_div(d[0], len), vp_div(d[1], len), vp_div(d[2], len), inf};
+    float prim[FR_MFT_RAYS] __attribute__((aligned(64))); /* ids as float bit patterns: copied, never cast */
+    memcpy(prim, h->prim[f], sizeof prim);
     vpf hit[7] = {vp_select(vpm_bits_to(miss), inf, vp_mul(vp_load(h->t[f]), len)), vp_load(h->u[f]), vp_load(h->v[f]),
-                  vp_load((const float *)h->prim[f]), zero, zero, zero};
+                  vp_load(prim), zero, zero, zero};
     vp_store_records((float *)(rays + FR_MFT_RAYS * f), ray, 8);
     vp_store_records((float *)(hits + FR_MFT_RAYS * f), hit, 7);
   }
