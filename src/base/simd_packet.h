@@ -182,12 +182,12 @@ FR_INLINE void vp_scatter(float *base, const int32_t *idx, unsigned mask, vpf a)
   for (; mask; mask &= mask - 1) { int i = __builtin_ctz(mask); memcpy(base + idx[i], &t[i], sizeof(float)); }
 }
 #else
-FR_INLINE vpf vp_gather(const float *base, const int32_t *idx) { vpf r; for (int i = 0; i < P; i++) memcpy(&r.f[i], base + idx[i], 4); return r; }
+FR_INLINE vpf vp_gather(const float *base, const int32_t *idx) { vpf r; for (int i = 0; i < P; i++) memcpy(&r.f[i], base + idx[i], sizeof(float)); return r; }
 FR_INLINE void vp_store_mask(float *p, unsigned mask, vpf a) {
   for (; mask; mask &= mask - 1) { int i = __builtin_ctz(mask); memcpy(p + i, &a.f[i], sizeof(float)); }
 }
 FR_INLINE void vp_scatter(float *base, const int32_t *idx, unsigned mask, vpf a) {
-  for (; mask; mask &= mask - 1) { int i = __builtin_ctz(mask); memcpy(base + idx[i], &a.f[i], 4); }
+  for (; mask; mask &= mask - 1) { int i = __builtin_ctz(mask); memcpy(base + idx[i], &a.f[i], sizeof(float)); }
 }
 #endif
 

@@ -299,7 +299,7 @@ static void finish(const fr_bvhn *b, const packet *pk, const uint32_t *best, vpf
   h->t = vp(INFINITY); h->u = h->v = zero; h->prim = vp(invalid.f);
   h->ng[0] = h->ng[1] = h->ng[2] = zero;
   if (!hit) return;
-  /* A[3 * vertex + axis]; indices are int32 floats into b->tris */
+  /* A[3 * vertex + axis]; ix counts floats from b->tris, so it must fit an int32 */
   float A[9][P] __attribute__((aligned(64)));
   vpf prim;
   const float *base = (const float *)b->tris;
