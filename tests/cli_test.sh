@@ -60,6 +60,11 @@ expect 2 "$F" bench --builtin --workload primary --mode single --threads 0
 expect 0 "$F" bench --builtin --workload shadow --mode single --tracer both --size 64x64 --repeat 1
 grep -q '^scene=builtin tris=[0-9]* workload=shadow tracer=frusta mode=single threads=[0-9]* rays=[0-9]* seconds=' "$T/out" && ok || bad "bench line format"
 grep -q 'tracer=embree mode=single' "$T/out" && ok || bad "no embree line"
+# a list of modes: each tracer runs the ones it has, interleaved
+expect 0 "$F" bench --builtin --workload shadow --mode packet16,hybrid16,stream --tracer both --size 32x32 --repeat 2
+[ "$(grep -c '^scene=' "$T/out")" = 4 ] && grep -q 'tracer=frusta mode=hybrid16 ' "$T/out" &&
+  grep -q 'tracer=embree mode=stream ' "$T/out" && ok || bad "bench mode list"
+expect 2 "$F" bench --builtin --workload shadow --mode packet16,stream --tracer frusta
 
 # ray files: a small one written with perl (part of every Debian system)
 perl -e 'my @r; for my $i (0..99) { push @r, pack("f<8", -0.5+$i*0.01, 5, 0.1, 0, -1, 0.001*$i, 0, 9**9**9) } print "RAYS0001", pack("Q<", 100), @r;' >"$T/r.rays"
@@ -142,8 +147,8 @@ expect 2 "$F" render --builtin --shade whitted --cull maybe --out "$T/w3.png"
 [ ! -e "$T/w3.png" ] && ok || bad "a failed whitted render left an output file"
 expect 0 "$F" bench --builtin --size 64x64 --workload whitted --mode packet4x4 --traversal masked --cull planes --repeat 1 --mirror all
 grep -q 'mode=packet4x4/masked/planes' "$T/out" && ok || bad "bench packet4x4 line"
-expect 0 "$F" bench "$SHARED/scenes/museum/museum.obj.zst" --size 64x64 --workload whitted --mode packet32x32 --tracer both --repeat 1
-grep -q 'tracer=embree' "$T/out" && grep -q 'workload=whitted tracer=frusta' "$T/out" && ok || bad "bench whitted both tracers"
+expect 0 "$F" bench "$SHARED/scenes/museum/museum.obj.zst" --size 64x64 --workload whitted --mode packet32x32,stream --tracer both --repeat 1
+grep -q 'workload=whitted tracer=embree mode=stream ' "$T/out" && grep -q 'workload=whitted tracer=frusta mode=packet32x32' "$T/out" && ok || bad "bench whitted both tracers"
 # analytic spheres: the sphereflake; multi-frusta tracing refuses them
 expect 0 "$F" render --builtin=sphereflake --size 48x48 --shade whitted --glass flake --out "$T/sf.png"
 [ -s "$T/sf.png" ] && grep -q 'glass_prims=820' "$T/out" && ok || bad "sphereflake whitted render"

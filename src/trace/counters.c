@@ -1,6 +1,12 @@
 #include "counters.h"
 #include <string.h>
 
+void fr_counters_add(fr_counters *acc, const fr_counters *c) {
+#define FR_COUNTER_SUM(f) acc->f += c->f;
+  FR_COUNTER_FIELDS(FR_COUNTER_SUM)
+#undef FR_COUNTER_SUM
+}
+
 #ifdef FRUSTA_COUNTERS
 _Thread_local fr_counters fr_tls_counters;
 static fr_counters total;

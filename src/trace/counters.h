@@ -47,4 +47,6 @@ void fr_counters_flush(void);   /* adds this thread's counts to the total */
 int fr_counters_enabled(void);
 void fr_counters_reset(void);
 fr_counters fr_counters_read(void);
+/* acc += c, field by field */
+void fr_counters_add(fr_counters *acc, const fr_counters *c);
 #endif

@@ -1,7 +1,11 @@
 /*
  * frusta bench: the workloads of ../shared/spec/workloads.md, frusta and Embree
- * side by side in one process, on the same scene, rays and threads. Each run
- * is repeated K times; the line reports the best and the median.
+ * side by side in one process, on the same scene, rays and threads. Each
+ * (tracer, mode) run is repeated K times; the line reports the best and the
+ * median. The repetitions are interleaved, round-robin over every run
+ * selected for a workload: this VM's speed drifts by up to 2x within one
+ * process, and runs done one after the other each saw a different stretch
+ * of it, so their ratios measured the host as much as the tracers.
  */
 #include <omp.h>
 #include <stdio.h>
@@ -46,22 +50,30 @@ static int cmp_double(const void *a, const void *b) {
   return x < y ? -1 : x > y;
 }
 
-static void run(const fr_workload *w0, const fr_tracer *t, const char *scene, size_t tris, const char *tracer,
-                const char *mode, int repeat) {
+/* One (tracer, mode) run of a workload: how to trace, and what its
+ * repetitions measured. */
+typedef struct bench_run {
+  const char *tracer; /* "frusta" or "embree" */
+  int mode;           /* index into frusta_modes, or an ebr_mode */
+  char name[96];
+  fr_lp_tracer lpc;   /* large packets: the tracer's context */
+  fr_tracer t;
   double secs[64];
-  uint64_t rays = 0;
-  fr_counters_reset();
-  for (int k = 0; k < repeat; k++) {
-    fr_workload_result r = fr_workload_run(w0, t);
-    secs[k] = r.seconds;
-    rays = r.rays;
-  }
+  uint64_t rays;
+  fr_counters c;      /* summed over the repetitions */
+} bench_run;
+
+static void report(const fr_workload *w0, const bench_run *r, const char *scene, size_t tris, int repeat) {
+  double secs[64];
+  memcpy(secs, r->secs, sizeof(double) * (size_t)repeat);
   qsort(secs, (size_t)repeat, sizeof(double), cmp_double);
   double best = secs[0], med = secs[repeat / 2];
+  const char *tracer = r->tracer, *mode = r->name;
+  uint64_t rays = r->rays;
   printf("scene=%s tris=%zu workload=%s tracer=%s mode=%s threads=%d rays=%llu seconds=%.4f mrays=%.2f median_seconds=%.4f median_mrays=%.2f\n",
          scene, tris, fr_workload_name(w0->kind), tracer, mode, w0->threads, (unsigned long long)rays, best,
          (double)rays / best * 1e-6, med, (double)rays / med * 1e-6);
-  fr_counters c = fr_counters_read();
+  fr_counters c = r->c;
   if (fr_counters_enabled() && c.rays)
     printf("counters tracer=%s mode=%s workload=%s per_ray nodes=%.2f box_tests=%.2f leaves=%.2f tri_tests=%.2f\n", tracer, mode,
            fr_workload_name(w0->kind), (double)c.nodes / c.rays, (double)c.box_tests / c.rays, (double)c.leaves / c.rays,
@@ -91,6 +103,34 @@ static void run(const fr_workload *w0, const fr_tracer *t, const char *scene, si
            (double)c.lp_tri_chunks / c.lp_packets, (double)c.lp_sph_culled / c.lp_packets,
            (double)c.lp_sph_chunks / c.lp_packets);
   fflush(stdout);
+}
+
+/* --mode: all, or a comma-separated list of mode names; *fsel and *esel get
+ * the frusta and Embree modes picked (bit m: frusta_modes[m], ebr_mode m).
+ * A name must belong to a tracer in use. */
+static int parse_modes(const char *list, int use_frusta, int use_embree, unsigned *fsel, unsigned *esel) {
+  *fsel = *esel = 0;
+  if (!strcmp(list, "all")) {
+    if (use_frusta) *fsel = (1u << N_FRUSTA_MODES) - 1;
+    if (use_embree) *esel = (1u << EBR_MODE_COUNT) - 1;
+    return 0;
+  }
+  char buf[256];
+  if (strlen(list) >= sizeof buf) return cli_error(CLI_USAGE_ERROR, "--mode: list too long");
+  memcpy(buf, list, strlen(list) + 1);
+  for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+    int known = 0;
+    ebr_mode em;
+    for (int m = 0; m < N_FRUSTA_MODES; m++)
+      if (use_frusta && !strcmp(tok, frusta_modes[m])) { *fsel |= 1u << m; known = 1; }
+    if (use_embree && ebr_mode_parse(tok, &em)) { *esel |= 1u << em; known = 1; }
+    if (!known)
+      return cli_error(CLI_USAGE_ERROR, "no tracer in use has mode '%s' (frusta: single, single4, packet8, packet16, "
+                       "hybrid16, auto, mft, packet2x2 .. packet32x32; embree: single, packet4, packet8, packet16, "
+                       "stream; or all)", tok);
+  }
+  if (!*fsel && !*esel) return cli_error(CLI_USAGE_ERROR, "--mode: no mode given");
+  return 0;
 }
 
 int cmd_bench(int argc, char **argv) {
@@ -163,14 +203,9 @@ int cmd_bench(int argc, char **argv) {
   if (!all_wl && !fr_workload_parse(workload, &wk))
     return cli_error(CLI_USAGE_ERROR, "unknown workload '%s' (primary, shadow, soft16, ao16, diffuse8, specular8, whitted, all)", workload);
   int all_modes = !strcmp(mode, "all");
-  ebr_mode em = EBR_SINGLE;
-  int frusta_has_mode = all_modes;
-  for (int m = 0; m < N_FRUSTA_MODES; m++) frusta_has_mode |= !strcmp(mode, frusta_modes[m]);
-  int embree_has_mode = all_modes || ebr_mode_parse(mode, &em);
-  if (use_frusta && !frusta_has_mode && !(use_embree && embree_has_mode))
-    return cli_error(CLI_USAGE_ERROR, "frusta has no mode '%s' (single, single4, packet8, packet16, hybrid16, auto, mft, packet2x2 .. packet32x32, all)", mode);
-  if (use_embree && !embree_has_mode && !(use_frusta && frusta_has_mode))
-    return cli_error(CLI_USAGE_ERROR, "embree has no mode '%s' (single, packet4, packet8, packet16, stream, all)", mode);
+  unsigned fsel, esel;
+  if (parse_modes(mode, use_frusta, use_embree, &fsel, &esel)) return CLI_USAGE_ERROR;
+  const int want_mft = (fsel >> MODE_MFT) & 1;
 
   omp_set_num_threads(threads);
   fr_scene *s;
@@ -192,7 +227,7 @@ int cmd_bench(int argc, char **argv) {
          st.build_seconds, s->name, tris, threads, fr_isa_name(fr_get_isa()), st.single_width, ws->sah,
          (double)(ws->node_bytes + ws->tri_bytes) / (double)tris, prefetch ? "on" : "off", topt.packet_bvh_width,
          (double)(wp->node_bytes + wp->tri_bytes + wp->packet_tri_bytes) / (double)tris);
-  if (use_frusta && !strcmp(mode, "mft") && fr_scene_sphere_count(s)) {
+  if (want_mft && !all_modes && fr_scene_sphere_count(s)) {
     size_t ns = fr_scene_sphere_count(s);
     fr_scene_release(s);
     return cli_error(CLI_USAGE_ERROR, "--mode mft: multi-frusta tracing does not trace spheres (this scene has %zu)", ns);
@@ -201,11 +236,11 @@ int cmd_bench(int argc, char **argv) {
   fr_bvh2 shallow;
   memset(&shallow, 0, sizeof shallow);
   fr_mft_tracer mctx = {s, &s->bvh2, mopt};
-  if (use_frusta && (all_modes || !strcmp(mode, "mft")) && mft_leaf != FR_BUILD_MAX_LEAF) {
+  if (want_mft && mft_leaf != FR_BUILD_MAX_LEAF) {
     if (fr_scene_build_bvh2(s, mft_leaf, &shallow)) { fr_scene_release(s); return cli_error(1, "%s", fr_last_error()); }
     mctx.bvh = &shallow;
   }
-  if (use_frusta && (all_modes || !strcmp(mode, "mft")))
+  if (want_mft)
     printf("mft_bvh leaf=%d inner=%zu leaves=%zu sah=%.2f corner_rays=%s shrink=%s\n", mctx.bvh->max_leaf,
            mctx.bvh->nnodes, mctx.bvh->nleaves, fr_bvh2_sah(mctx.bvh), mopt.corner_rays ? "on" : "off",
            mopt.shrink ? "on" : "off");
@@ -216,7 +251,7 @@ int cmd_bench(int argc, char **argv) {
     return rc;
   }
   ebr_scene *e = NULL;
-  if (use_embree) {
+  if (esel) {
     ebr_options o = {threads, 2, 0}; /* high quality, not robust: Embree's fastest tracing */
     if (ebr_create(s, o, &e)) {
       fr_bvh2_free(&shallow);
@@ -227,33 +262,48 @@ int cmd_bench(int argc, char **argv) {
     printf("build_seconds=%.3f tracer=embree scene=%s tris=%zu threads=%d quality=high bytes_per_tri=%.1f\n",
            ebr_build_seconds(e), s->name, tris, threads, (double)ebr_bytes(e) / (double)tris);
   }
+  bench_run runs[N_FRUSTA_MODES + EBR_MODE_COUNT];
+  const int width = st.single_width;
   for (int k = all_wl ? 0 : (int)wk; k < (all_wl ? FR_WL_COUNT : (int)wk + 1); k++) {
     w.kind = (fr_workload_kind)k;
-    if (use_frusta && frusta_has_mode) {
-      fr_tracer t = fr_tracer_frusta(s), tm = fr_tracer_mft(&mctx);
-      int width = st.single_width;
-      for (int m = 0; m < N_FRUSTA_MODES; m++)
-        if ((all_modes || !strcmp(mode, frusta_modes[m])) && !(m == MODE_MFT && fr_scene_sphere_count(s))) {
-          set_frusta_mode(s, m, &topt, width);
-          fr_lp_tracer lpc = {s, cli_lp_scene(s), wo.lp, m >= MODE_LARGE ? 2 << (m - MODE_LARGE) : 0};
-          fr_tracer tl = m >= MODE_LARGE ? fr_tracer_lp(&lpc) : t;
-          char name[96];
-          if (m >= MODE_LARGE)
-            snprintf(name, sizeof name, "%s/%s/%s", frusta_modes[m], fr_lp_traversal_name(wo.lp.traversal),
-                     fr_cull_name(wo.lp.cull));
-          else
-            snprintf(name, sizeof name, "%s", frusta_modes[m]);
-          run(&w, m == MODE_MFT ? &tm : &tl, s->name, tris, "frusta", name, repeat);
-        }
-      fr_scene_set_bvh_width(s, width);
-      fr_scene_set_trace_options(s, &topt);
+    int nruns = 0;
+    for (int m = 0; m < N_FRUSTA_MODES; m++) {
+      if (!((fsel >> m) & 1) || (m == MODE_MFT && fr_scene_sphere_count(s))) continue;
+      bench_run *r = &runs[nruns++];
+      memset(r, 0, sizeof *r);
+      r->tracer = "frusta";
+      r->mode = m;
+      if (m >= MODE_LARGE)
+        snprintf(r->name, sizeof r->name, "%s/%s/%s", frusta_modes[m], fr_lp_traversal_name(wo.lp.traversal),
+                 fr_cull_name(wo.lp.cull));
+      else
+        snprintf(r->name, sizeof r->name, "%s", frusta_modes[m]);
+      r->lpc = (fr_lp_tracer){s, cli_lp_scene(s), wo.lp, m >= MODE_LARGE ? 2 << (m - MODE_LARGE) : 0};
+      r->t = m == MODE_MFT ? fr_tracer_mft(&mctx) : m >= MODE_LARGE ? fr_tracer_lp(&r->lpc) : fr_tracer_frusta(s);
     }
-    if (e && embree_has_mode)
-      for (int m = 0; m < EBR_MODE_COUNT; m++)
-        if (all_modes || m == (int)em) {
-          fr_tracer t = ebr_tracer(e, (ebr_mode)m);
-          run(&w, &t, s->name, tris, "embree", ebr_mode_name((ebr_mode)m), repeat);
-        }
+    for (int m = 0; e && m < EBR_MODE_COUNT; m++) {
+      if (!((esel >> m) & 1)) continue;
+      bench_run *r = &runs[nruns++];
+      memset(r, 0, sizeof *r);
+      r->tracer = "embree";
+      r->mode = m;
+      snprintf(r->name, sizeof r->name, "%s", ebr_mode_name((ebr_mode)m));
+      r->t = ebr_tracer(e, (ebr_mode)m);
+    }
+    for (int rep = 0; rep < repeat; rep++)
+      for (int i = 0; i < nruns; i++) {
+        bench_run *r = &runs[i];
+        if (r->tracer[0] == 'f') set_frusta_mode(s, r->mode, &topt, width);
+        fr_counters_reset();
+        fr_workload_result res = fr_workload_run(&w, &r->t);
+        fr_counters c = fr_counters_read();
+        fr_counters_add(&r->c, &c);
+        r->secs[rep] = res.seconds;
+        r->rays = res.rays;
+      }
+    fr_scene_set_bvh_width(s, width);
+    fr_scene_set_trace_options(s, &topt);
+    for (int i = 0; i < nruns; i++) report(&w, &runs[i], s->name, tris, repeat);
   }
   ebr_release(e);
   fr_bvh2_free(&shallow);
