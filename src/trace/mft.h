@@ -77,7 +77,12 @@ typedef struct fr_mft_hits {
 typedef struct fr_mft_opts {
   int corner_rays;  /* cull frusta against a triangle's edges and plane with corner rays */
   int shrink;       /* shadows: shrink corner rays and intervals to the active rays */
+  float corner_cost; /* ... only where it is expected to spare more 16-ray tests than this (see
+                        mft_traverse.c); 0: for every triangle */
 } fr_mft_opts;
+
+/* corner rays and shrinking on, corner_cost FR_MFT_CORNER_COST */
+fr_mft_opts fr_mft_opts_default(void);
 
 typedef struct fr_mft_fns {
   /* occ[f]: bit k set when ray k of frustum f is occluded */

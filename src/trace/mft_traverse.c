@@ -58,6 +58,7 @@ typedef struct frusta {
    * reaches a leaf (rd_ready): leaf boxes are tested ray by ray */
   float rd[16][3][16] __attribute__((aligned(64)));
   unsigned rd_ready;
+  unsigned cull_seen, cull_gone; /* frustum-triangle pairs the corner-ray cull saw and removed */
   int bounded;
   const fr_mft_set *set[16];
 } frusta;
@@ -143,6 +144,8 @@ static void frusta_bounds(frusta *F, const fr_mft_sets *T, unsigned lanes, const
 
 static void frusta_setup(frusta *F, const fr_mft_batch *B, const fr_mft_sets *T, unsigned valid, int bounded) {
   F->rd_ready = 0;
+  F->cull_seen = 2; /* a prior: half culled */
+  F->cull_gone = 1;
   memset(F->pos, 0, sizeof F->pos);
   memset(F->straddle, 0, sizeof F->straddle);
   F->bounded = bounded;
@@ -235,10 +238,19 @@ FR_INLINE unsigned tri_cull(const frusta *F, const fr_bvh2_tri *r, unsigned m, i
 }
 
 /* tri_cull for a leaf's triangle, counted (the paper's Table 1) */
-FR_INLINE unsigned leaf_tri_cull(const frusta *F, const fr_bvh2_tri *r, unsigned m, int corner_rays, tri_frusta *X) {
+FR_INLINE unsigned leaf_tri_cull(frusta *F, const fr_bvh2_tri *r, unsigned m, const fr_mft_opts *opt,
+                                  tri_frusta *X) {
+  const int n = __builtin_popcount(m);
   FR_COUNT(mft_tris, 1);
-  FR_COUNT(mft_tri_frusta, __builtin_popcount(m));
-  unsigned left = tri_cull(F, r, m, corner_rays, X);
+  FR_COUNT(mft_tri_frusta, n);
+  /* cull where the share of frusta it removed so far in this batch, times
+   * the n frusta here, exceeds its cost in 16-ray tests */
+  int cull = opt->corner_rays && (float)F->cull_gone * (float)n >= opt->corner_cost * (float)F->cull_seen;
+  unsigned left = tri_cull(F, r, m, cull, X);
+  if (cull) {
+    F->cull_seen += (unsigned)n;
+    F->cull_gone += (unsigned)(n - __builtin_popcount(left));
+  }
   FR_COUNT(mft_tri_left, __builtin_popcount(left));
   return left;
 }
@@ -365,7 +377,7 @@ static void occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_
       unsigned rays[16], m = leaf_rays(&F, &e, e.mask & alive, active, NULL, rays);
       for (uint32_t i = first; i < first + count && m; i++) {
         const fr_bvh2_tri *r = &b->tris[i];
-        unsigned left = leaf_tri_cull(&F, r, m, opt->corner_rays, &X), shrink = 0;
+        unsigned left = leaf_tri_cull(&F, r, m, opt, &X), shrink = 0;
         for (; left; left &= left - 1) {
           int f = __builtin_ctz(left);
           unsigned hit = ray_test(&F, &X, r, f, vp(F.tfar[f]), rays[f] & active[f], NULL, NULL, NULL);
@@ -427,7 +439,7 @@ static void intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft
       unsigned changed = 0, rays[16], m = leaf_rays(&F, &e, e.mask, all, (const float(*)[16])H->t, rays);
       for (uint32_t i = first; i < first + count && m; i++) {
         const fr_bvh2_tri *r = &b->tris[i];
-        unsigned left = leaf_tri_cull(&F, r, m, opt->corner_rays, &X);
+        unsigned left = leaf_tri_cull(&F, r, m, opt, &X);
         for (; left; left &= left - 1) {
           int f = __builtin_ctz(left);
           vpf tb = vp_load(H->t[f]), t, u, v;

@@ -141,7 +141,7 @@ int cmd_bench(int argc, char **argv) {
   int threads = omp_get_num_procs(), repeat = 3;
   fr_trace_options topt;
   fr_trace_options_default(&topt);
-  fr_mft_opts mopt = {1, 1};
+  fr_mft_opts mopt = fr_mft_opts_default();
   int mft_leaf = FR_BUILD_MAX_LEAF;
   fr_light_sets light_sets = FR_LIGHT_SETS_SPREAD;
   cli_whitted wo;
@@ -154,6 +154,7 @@ int cmd_bench(int argc, char **argv) {
     const char *a = argv[i];
     if (!strcmp(a, "--threshold") || !strcmp(a, "--mailbox") || !strcmp(a, "--axis-aligned") || !strcmp(a, "--ia") ||
         !strcmp(a, "--packet-width") || !strcmp(a, "--corner-rays") || !strcmp(a, "--shrink") || !strcmp(a, "--mft-leaf") ||
+        !strcmp(a, "--corner-cost") ||
         !strcmp(a, "--light-sets") || !strcmp(a, "--prefetch")) {
       if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
       const char *val = argv[++i];
@@ -163,6 +164,9 @@ int cmd_bench(int argc, char **argv) {
         else return cli_error(CLI_USAGE_ERROR, "--light-sets is spread or cells, not '%s'", val);
       } else if (!strcmp(a, "--corner-rays") || !strcmp(a, "--shrink")) {
         if (parse_onoff(a, val, !strcmp(a, "--shrink") ? &mopt.shrink : &mopt.corner_rays)) return CLI_USAGE_ERROR;
+      } else if (!strcmp(a, "--corner-cost")) {
+        if (!cli_parse_float(val, &mopt.corner_cost) || !(mopt.corner_cost >= 0.0f && mopt.corner_cost <= 16.0f))
+          return cli_error(CLI_USAGE_ERROR, "--corner-cost wants 0..16, got '%s'", val);
       } else if (!strcmp(a, "--mft-leaf")) {
         if (!cli_parse_int(val, 1, FR_BVH2_MAX_LEAF, &mft_leaf))
           return cli_error(CLI_USAGE_ERROR, "--mft-leaf wants 1..%d, got '%s'", FR_BVH2_MAX_LEAF, val);
@@ -241,9 +245,9 @@ int cmd_bench(int argc, char **argv) {
     mctx.bvh = &shallow;
   }
   if (want_mft)
-    printf("mft_bvh leaf=%d inner=%zu leaves=%zu sah=%.2f corner_rays=%s shrink=%s\n", mctx.bvh->max_leaf,
+    printf("mft_bvh leaf=%d inner=%zu leaves=%zu sah=%.2f corner_rays=%s corner_cost=%g shrink=%s\n", mctx.bvh->max_leaf,
            mctx.bvh->nnodes, mctx.bvh->nleaves, fr_bvh2_sah(mctx.bvh), mopt.corner_rays ? "on" : "off",
-           mopt.shrink ? "on" : "off");
+           (double)mopt.corner_cost, mopt.shrink ? "on" : "off");
   fr_whitted_mats mats = {NULL, 0};
   if ((all_wl || wk == FR_WL_WHITTED) && (rc = cli_whitted_setup(s, &wo, &mats, &w))) {
     fr_bvh2_free(&shallow);
