@@ -17,6 +17,7 @@
 #include "render/views.h"
 #include "random_scene.h"
 #include "render/mft_rays.h"
+#include "render/softshadow.h"
 #include "test_util.h"
 #include "trace/mft.h"
 
@@ -430,6 +431,73 @@ static void light_sets_are_nets(void **state) {
   }
 }
 
+/* Soft shadows of a tile go as rays where its first batch's frusta fetch
+ * many triangles each (render/workload.c). On the dragon at 64x64 both paths
+ * run: the visibility must match the stream tracer's, pixel by pixel, up to
+ * rays grazing an edge. */
+typedef struct ray_counter { fr_tracer inner; size_t rays, batches; } ray_counter;
+
+static void counted_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
+  ray_counter *c = ctx;
+  c->rays += n;
+  c->inner.occluded(c->inner.ctx, rays, occ, n, coherent);
+}
+
+static void counted_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
+  ray_counter *c = ctx;
+  c->inner.intersect(c->inner.ctx, rays, hits, n, coherent);
+}
+
+static void counted_intersect_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *h) {
+  ray_counter *c = ctx;
+  c->inner.intersect_frusta(c->inner.ctx, b, t, h);
+}
+
+static unsigned counted_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[16]) {
+  ray_counter *c = ctx;
+  c->batches++;
+  return c->inner.occluded_frusta(c->inner.ctx, b, t, occ);
+}
+
+static void soft_fallback(void **state) {
+  (void)state;
+  const char *root = getenv("FRUSTA_SHARED");
+  char path[4096];
+  snprintf(path, sizeof path, "%s/scenes/dragon/dragon.ply.zst", root ? root : "../../shared");
+  fr_scene *s;
+  if (fr_scene_load(path, &s) != FR_OK) fail_msg("%s: %s", path, fr_last_error());
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  enum { SZ = 64 };
+  fr_workload w;
+  memset(&w, 0, sizeof w);
+  w.scene = s;
+  assert_true(fr_view_lookup(s->name, &w.view));
+  assert_int_equal(fr_camera_setup(&w.cam, w.view.eye, w.view.at, w.view.up, w.view.fov, SZ, SZ), FR_OK);
+  float lo[3], hi[3];
+  fr_scene_bounds(s, lo, hi);
+  w.eps = 1e-4f * v3_len(v3_sub(v3_load(hi), v3_load(lo)));
+  w.threads = 1;
+  fr_softshadow_opts so = {16, 0, FR_LIGHT_SETS_SPREAD};
+  static float img[SZ * SZ * 3], vis_mft[SZ * SZ], vis_rays[SZ * SZ];
+  fr_mft_tracer mctx = {s, &s->bvh2, fr_mft_opts_default()};
+  ray_counter c = {fr_tracer_mft(&mctx), 0, 0};
+  fr_tracer counted = {&c, counted_intersect, counted_occluded, counted_intersect_frusta, counted_occluded_frusta, 0};
+  fr_workload_result r;
+  assert_int_equal(fr_render_softshadow(&w, &counted, &so, img, vis_mft, &r), FR_OK);
+  fr_tracer rays = fr_tracer_frusta(s);
+  assert_int_equal(fr_render_softshadow(&w, &rays, &so, img, vis_rays, &r), FR_OK);
+  print_message("dragon soft shadows: %zu frusta batches, %zu rays as rays\n", c.batches, c.rays);
+  assert_true(c.batches > 0 && c.rays > 0); /* both paths ran */
+  double sum = 0.0;
+  for (int i = 0; i < SZ * SZ; i++) {
+    float d = fabsf(vis_mft[i] - vis_rays[i]);
+    assert_true(d <= 2.0f / 16.0f + 1e-6f);
+    sum += d;
+  }
+  assert_true(sum / (SZ * SZ) < 0.002);
+  fr_scene_release(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(light_sets_are_nets),
@@ -437,6 +505,7 @@ int main(void) {
       cmocka_unit_test(builtin_scene),
       cmocka_unit_test(fine_far_sphere),
       cmocka_unit_test(shared_scenes),
+      cmocka_unit_test(soft_fallback),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

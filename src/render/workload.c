@@ -79,11 +79,20 @@ void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, 
  * batch j: origin p, rays p + t (c + s e1 + q e2 - p) for the samples of the
  * pixel's interleaved set, t in (eps / |light centre - p|, 1 - 1e-4). Returns
  * the shadow rays traced; lit[i] gets pixel i's unoccluded fraction. */
+/* Frusta that fetch more triangles than this each (the tile's first batch
+ * tells) would be outrun by their rays traced one packet at a time: the rest
+ * of the tile goes as rays. Triangles per frustum, 1024x1024: conference and
+ * sibenik ~1, kitchen ~5 (frusta 1.1-1.3x the rays), dragon ~20 (frusta
+ * 0.4x: fine triangles in wide frusta). The tile decides, not the thread,
+ * so that a tile's image does not depend on which thread traced what. */
+#define SOFT_FRUSTA_MAX_TRIS 8
+
 static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *B, int n, float *lit) {
   const fr_mft_sets *T = w->light_sets;
   vec3 centre = v3_add(w->view.area_c, v3_scale(v3_add(w->view.area_e1, w->view.area_e2), 0.5f));
   uint64_t rays = 0;
-  int m = 0;
+  int m = 0, as_rays = !t->occluded_frusta;
+  uint8_t by_rays[TILE_PIX] = {0};
   for (int j = 0; j < (n + 15) / 16; j++) {
     fr_mft_batch b;
     memset(&b, 0, sizeof b);
@@ -100,17 +109,20 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
       b.valid |= 1u << f;
     }
     rays += 16u * (uint64_t)__builtin_popcount(b.valid);
-    if (t->occluded_frusta) {
+    if (!as_rays) {
       uint16_t occ[FR_MFT_FRUSTA];
-      t->occluded_frusta(t->ctx, &b, T, occ);
+      unsigned fetched = t->occluded_frusta(t->ctx, &b, T, occ);
       for (unsigned v = b.valid; v; v &= v - 1) {
         int f = __builtin_ctz(v);
         lit[16 * j + f] = (float)(16 - __builtin_popcount(occ[f])) / 16.0f;
       }
+      as_rays = !w->mft_no_fallback && fetched > SOFT_FRUSTA_MAX_TRIS * (unsigned)__builtin_popcount(b.valid);
       continue;
     }
+    if (t->occluded_frusta && b.valid) FR_COUNT(mft_ray_batches, 1);
     for (unsigned v = b.valid; v; v &= v - 1) {
       int f = __builtin_ctz(v);
+      by_rays[16 * j + f] = 1;
       for (int k = 0; k < FR_MFT_RAYS; k++) {
         fr_ray *r = &B->rays[m];
         fr_mft_ray(&b, T, f, k, r->org, r->dir);
@@ -120,12 +132,12 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
       }
     }
   }
-  if (!t->occluded_frusta) {
+  if (m) {
     t->occluded(t->ctx, B->rays, B->occ, (size_t)m, 0);
     int cnt[TILE_PIX] = {0};
     for (int k = 0; k < m; k++) cnt[B->owner[k]] += !B->occ[k];
     for (int i = 0; i < n; i++)
-      if (B->prim_hit[i].prim != FR_INVALID_ID) lit[i] = (float)cnt[i] / 16.0f;
+      if (by_rays[i]) lit[i] = (float)cnt[i] / 16.0f;
   }
   return rays;
 }
@@ -354,9 +366,10 @@ static void mft_intersect_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_
   fr_mft_active()->intersect(m->bvh, &m->opts, b, t, hits);
 }
 
-static void mft_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[FR_MFT_FRUSTA]) {
+static unsigned mft_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t,
+                                    uint16_t occ[FR_MFT_FRUSTA]) {
   const fr_mft_tracer *m = ctx;
-  fr_mft_active()->occluded(m->bvh, &m->opts, b, t, occ);
+  return fr_mft_active()->occluded(m->bvh, &m->opts, b, t, occ);
 }
 
 fr_tracer fr_tracer_mft(const fr_mft_tracer *ctx) {

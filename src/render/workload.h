@@ -38,7 +38,8 @@ typedef struct fr_tracer {
   void (*intersect)(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent);
   void (*occluded)(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent);
   void (*intersect_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *hits);
-  void (*occluded_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[FR_MFT_FRUSTA]);
+  /* returns the triangles the batch fetched (see soft_shadows in workload.c) */
+  unsigned (*occluded_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[FR_MFT_FRUSTA]);
   int packet_side;
 } fr_tracer;
 
@@ -62,6 +63,10 @@ typedef struct fr_workload {
   /* whitted: which surfaces mirror and refract, recursion depth (0: 4) */
   const struct fr_whitted_mats *mats;
   int max_depth;
+  /* soft shadows with a frusta tracer: 0 (default) traces a tile's shadows as
+   * rays where its first batch's frusta fetched more than 8 triangles each;
+   * 1 keeps every batch as frusta (the paper's pure multi-frusta, to measure) */
+  int mft_no_fallback;
   /* set by fr_workload_run for its tiles */
   const fr_mft_sets *light_sets;  /* this frame's interleaved samples on the quad light */
   const fr_mft_sets *camera_set;  /* the 4x4 pixels of a block */

@@ -13,7 +13,8 @@
  * active rays in them (pk_*_lanes). Multi-frusta work (mft_*): batches of 16
  * frusta, SIMD box tests (one box, 16 frusta) and the active frusta in them,
  * triangles fetched by leaves, frustum-triangle pairs before and after the
- * corner-ray cull (each pair left is one 16-ray test). Large packets
+ * corner-ray cull (each pair left is one 16-ray test), soft-shadow batches
+ * traced as rays instead (render/workload.c). Large packets
  * (lp_*): packets, stack entries popped, boxes culled for the whole packet,
  * 16-ray box tests, leaves, prims (triangles and spheres) reached, triangles culled for the
  * whole packet, 16-ray triangle tests. Spheres: single-ray box and sphere
@@ -24,7 +25,7 @@
   X(packets) X(pk_nodes) X(pk_box_tests) X(pk_box_lanes) X(pk_tri_tests)       \
   X(pk_tri_lanes) X(ia_culled) X(mailbox_hits) X(switches) X(switch_rays)    \
   X(mft_batches) X(mft_nodes) X(mft_box_tests) X(mft_box_lanes) X(mft_tris)   \
-  X(mft_tri_frusta) X(mft_tri_left)                                         \
+  X(mft_tri_frusta) X(mft_tri_left) X(mft_ray_batches)                      \
   X(lp_packets) X(lp_nodes) X(lp_culled) X(lp_box_chunks) X(lp_leaves) X(lp_tris) \
   X(lp_tri_culled) X(lp_tri_chunks)                                          \
   X(sp_box_tests) X(sp_tests) X(lp_sph_culled) X(lp_sph_chunks)

@@ -85,8 +85,9 @@ typedef struct fr_mft_opts {
 fr_mft_opts fr_mft_opts_default(void);
 
 typedef struct fr_mft_fns {
-  /* occ[f]: bit k set when ray k of frustum f is occluded */
-  void (*occluded)(const fr_bvh2 *b, const fr_mft_opts *o, const fr_mft_batch *batch, const fr_mft_sets *sets,
+  /* occ[f]: bit k set when ray k of frustum f is occluded; returns the
+   * triangles the batch's leaves fetched (what it cost) */
+  unsigned (*occluded)(const fr_bvh2 *b, const fr_mft_opts *o, const fr_mft_batch *batch, const fr_mft_sets *sets,
                    uint16_t occ[FR_MFT_FRUSTA]);
   void (*intersect)(const fr_bvh2 *b, const fr_mft_opts *o, const fr_mft_batch *batch, const fr_mft_sets *sets,
                     fr_mft_hits *hits);

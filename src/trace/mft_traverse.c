@@ -349,7 +349,7 @@ FR_INLINE int visit_node(const frusta *F, const fr_bvh2 *b, uint32_t ref, unsign
   return 0;
 }
 
-static void occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B, const fr_mft_sets *T,
+static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B, const fr_mft_sets *T,
                          uint16_t occ[16]) {
   frusta F;
   tri_frusta X;
@@ -357,8 +357,9 @@ static void occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_
   for (int f = 0; f < 16; f++) occ[f] = 0;
   FR_COUNT(mft_batches, 1);
   FR_COUNT(rays, 16 * __builtin_popcount(valid));
-  if (!valid || !b->nodes) return;
+  if (!valid || !b->nodes) return 0;
   frusta_setup(&F, B, T, valid, 1);
+  unsigned fetched = 0;
   unsigned active[16];
   for (int f = 0; f < 16; f++) active[f] = (valid >> f) & 1 ? 0xFFFFu : 0;
   unsigned alive = valid;
@@ -375,6 +376,7 @@ static void occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_
       }
       uint32_t first = e.ref & FR_BVH2_FIRST_MASK, count = (e.ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
       unsigned rays[16], m = leaf_rays(&F, &e, e.mask & alive, active, NULL, rays);
+      if (m) fetched += count;
       for (uint32_t i = first; i < first + count && m; i++) {
         const fr_bvh2_tri *r = &b->tris[i];
         unsigned left = leaf_tri_cull(&F, r, m, opt, &X), shrink = 0;
@@ -405,6 +407,7 @@ static void occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_
       break;
     }
   }
+  return fetched;
 }
 
 static void intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B, const fr_mft_sets *T,

@@ -80,11 +80,12 @@ static void report(const fr_workload *w0, const bench_run *r, const char *scene,
            (double)c.tri_tests / c.rays);
   if (fr_counters_enabled() && c.mft_batches)
     printf("counters tracer=%s mode=%s workload=%s batches=%llu per_batch nodes=%.2f box_tests=%.2f "
-           "avg_active_frusta=%.2f tris=%.2f tri_frusta=%.2f tri_frusta_left=%.2f\n",
+           "avg_active_frusta=%.2f tris=%.2f tri_frusta=%.2f tri_frusta_left=%.2f ray_batches=%llu\n",
            tracer, mode, fr_workload_name(w0->kind), (unsigned long long)c.mft_batches,
            (double)c.mft_nodes / c.mft_batches, (double)c.mft_box_tests / c.mft_batches,
            c.mft_box_tests ? (double)c.mft_box_lanes / c.mft_box_tests : 0.0, (double)c.mft_tris / c.mft_batches,
-           (double)c.mft_tri_frusta / c.mft_batches, (double)c.mft_tri_left / c.mft_batches);
+           (double)c.mft_tri_frusta / c.mft_batches, (double)c.mft_tri_left / c.mft_batches,
+           (unsigned long long)c.mft_ray_batches);
   if (fr_counters_enabled() && c.packets)
     printf("counters tracer=%s mode=%s workload=%s packets=%llu per_packet pk_nodes=%.2f pk_box_tests=%.2f "
            "pk_tri_tests=%.2f ia_culled=%.2f mailbox_hits=%.2f switches=%.2f avg_active_box=%.2f avg_active_tri=%.2f\n",
@@ -142,7 +143,7 @@ int cmd_bench(int argc, char **argv) {
   fr_trace_options topt;
   fr_trace_options_default(&topt);
   fr_mft_opts mopt = fr_mft_opts_default();
-  int mft_leaf = FR_BUILD_MAX_LEAF;
+  int mft_leaf = FR_BUILD_MAX_LEAF, mft_no_fallback = 0;
   fr_light_sets light_sets = FR_LIGHT_SETS_SPREAD;
   cli_whitted wo;
   cli_whitted_default(&wo);
@@ -154,7 +155,7 @@ int cmd_bench(int argc, char **argv) {
     const char *a = argv[i];
     if (!strcmp(a, "--threshold") || !strcmp(a, "--mailbox") || !strcmp(a, "--axis-aligned") || !strcmp(a, "--ia") ||
         !strcmp(a, "--packet-width") || !strcmp(a, "--corner-rays") || !strcmp(a, "--shrink") || !strcmp(a, "--mft-leaf") ||
-        !strcmp(a, "--corner-cost") ||
+        !strcmp(a, "--corner-cost") || !strcmp(a, "--mft-fallback") ||
         !strcmp(a, "--light-sets") || !strcmp(a, "--prefetch")) {
       if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
       const char *val = argv[++i];
@@ -164,6 +165,10 @@ int cmd_bench(int argc, char **argv) {
         else return cli_error(CLI_USAGE_ERROR, "--light-sets is spread or cells, not '%s'", val);
       } else if (!strcmp(a, "--corner-rays") || !strcmp(a, "--shrink")) {
         if (parse_onoff(a, val, !strcmp(a, "--shrink") ? &mopt.shrink : &mopt.corner_rays)) return CLI_USAGE_ERROR;
+      } else if (!strcmp(a, "--mft-fallback")) {
+        int on = 1;
+        if (parse_onoff(a, val, &on)) return CLI_USAGE_ERROR;
+        mft_no_fallback = !on;
       } else if (!strcmp(a, "--corner-cost")) {
         if (!cli_parse_float(val, &mopt.corner_cost) || !(mopt.corner_cost >= 0.0f && mopt.corner_cost <= 16.0f))
           return cli_error(CLI_USAGE_ERROR, "--corner-cost wants 0..16, got '%s'", val);
@@ -219,6 +224,7 @@ int cmd_bench(int argc, char **argv) {
   if (rc) return rc;
   w.seed = 7;
   w.light_sets_kind = light_sets;
+  w.mft_no_fallback = mft_no_fallback;
   size_t tris = fr_scene_triangle_count(s);
   fr_bvh_stats st;
   fr_scene_stats(s, &st);
@@ -245,9 +251,9 @@ int cmd_bench(int argc, char **argv) {
     mctx.bvh = &shallow;
   }
   if (want_mft)
-    printf("mft_bvh leaf=%d inner=%zu leaves=%zu sah=%.2f corner_rays=%s corner_cost=%g shrink=%s\n", mctx.bvh->max_leaf,
+    printf("mft_bvh leaf=%d inner=%zu leaves=%zu sah=%.2f corner_rays=%s corner_cost=%g shrink=%s fallback=%s\n", mctx.bvh->max_leaf,
            mctx.bvh->nnodes, mctx.bvh->nleaves, fr_bvh2_sah(mctx.bvh), mopt.corner_rays ? "on" : "off",
-           (double)mopt.corner_cost, mopt.shrink ? "on" : "off");
+           (double)mopt.corner_cost, mopt.shrink ? "on" : "off", mft_no_fallback ? "off" : "on");
   fr_whitted_mats mats = {NULL, 0};
   if ((all_wl || wk == FR_WL_WHITTED) && (rc = cli_whitted_setup(s, &wo, &mats, &w))) {
     fr_bvh2_free(&shallow);
