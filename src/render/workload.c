@@ -75,18 +75,19 @@ void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, 
   fr_mft_active()->expand(&b, cam_set, &h, rays, hits);
 }
 
+/* Frusta that fetch more triangles than this each (the tile's first batch
+ * tells) would be outrun by their rays traced one packet at a time: the rest
+ * of the tile goes as rays. Triangles per frustum, 1024x1024, on average:
+ * conference and sibenik ~1, kitchen ~5, dragon ~20 (pure frusta 0.4x the
+ * rays there: fine triangles in wide frusta). The tile decides, not the
+ * thread, so that a tile's image does not depend on which thread traced
+ * what. */
+#define SOFT_FRUSTA_MAX_TRIS 8
+
 /* Soft shadows: pixels 16 j .. 16 j + 15 with a primary hit are the frusta of
  * batch j: origin p, rays p + t (c + s e1 + q e2 - p) for the samples of the
  * pixel's interleaved set, t in (eps / |light centre - p|, 1 - 1e-4). Returns
  * the shadow rays traced; lit[i] gets pixel i's unoccluded fraction. */
-/* Frusta that fetch more triangles than this each (the tile's first batch
- * tells) would be outrun by their rays traced one packet at a time: the rest
- * of the tile goes as rays. Triangles per frustum, 1024x1024: conference and
- * sibenik ~1, kitchen ~5 (frusta 1.1-1.3x the rays), dragon ~20 (frusta
- * 0.4x: fine triangles in wide frusta). The tile decides, not the thread,
- * so that a tile's image does not depend on which thread traced what. */
-#define SOFT_FRUSTA_MAX_TRIS 8
-
 static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *B, int n, float *lit) {
   const fr_mft_sets *T = w->light_sets;
   vec3 centre = v3_add(w->view.area_c, v3_scale(v3_add(w->view.area_e1, w->view.area_e2), 0.5f));
