@@ -461,9 +461,8 @@ static unsigned counted_occluded_frusta(void *ctx, const fr_mft_batch *b, const 
 
 static void soft_fallback(void **state) {
   (void)state;
-  const char *root = getenv("FRUSTA_SHARED");
-  char path[4096];
-  snprintf(path, sizeof path, "%s/scenes/dragon/dragon.ply.zst", root ? root : "../../shared");
+  char path[1024];
+  shared_scene_path(path, sizeof path, "dragon/dragon.ply.zst");
   fr_scene *s;
   if (fr_scene_load(path, &s) != FR_OK) fail_msg("%s: %s", path, fr_last_error());
   assert_int_equal(fr_scene_commit(s), FR_OK);

@@ -80,12 +80,17 @@ static inline int ambiguous(const mesh_ref *m, const fr_ray *r) {
   return 0;
 }
 
+/* out = $FRUSTA_SHARED/scenes/rel (../shared without it). */
+static inline void shared_scene_path(char *out, size_t cap, const char *rel) {
+  const char *root = getenv("FRUSTA_SHARED");
+  snprintf(out, cap, "%s/scenes%s%s", root ? root : "../shared", *rel ? "/" : "", rel);
+}
+
 /* Calls fn with the path of every .ply.zst of ../shared/scenes (or
  * $FRUSTA_SHARED/scenes); returns how many. A missing folder fails the test. */
 static inline int for_each_shared_scene(void (*fn)(const char *path, void *ctx), void *ctx) {
-  const char *root = getenv("FRUSTA_SHARED");
   char dir[1024];
-  snprintf(dir, sizeof dir, "%s/scenes", root ? root : "../shared");
+  shared_scene_path(dir, sizeof dir, "");
   DIR *d = opendir(dir);
   if (!d) fail_msg("cannot open %s: the shared scenes must sit beside the repository", dir);
   int count = 0;

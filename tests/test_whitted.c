@@ -145,9 +145,9 @@ static void check_whitted(fr_scene *s, const char *name, const char *mirror, con
 }
 
 static void check_scene(const char *name) {
-  const char *root = getenv("FRUSTA_SHARED");
-  char path[1024];
-  snprintf(path, sizeof path, "%s/scenes/%s/%s.obj.zst", root ? root : "../shared", name, name);
+  char rel[256], path[1024];
+  snprintf(rel, sizeof rel, "%s/%s.obj.zst", name, name);
+  shared_scene_path(path, sizeof path, rel);
   fr_scene *s;
   if (fr_scene_load(path, &s) != FR_OK) fail_msg("%s", fr_last_error());
   assert_int_equal(fr_scene_commit(s), FR_OK);
