@@ -64,8 +64,9 @@ typedef struct fr_workload {
   const struct fr_whitted_mats *mats;
   int max_depth;
   /* soft shadows with a frusta tracer: 0 (default) traces a tile's shadows as
-   * rays where its first batch's frusta fetched more than 8 triangles each;
-   * 1 keeps every batch as frusta (the paper's pure multi-frusta, to measure) */
+   * rays where its first batch's frusta fetched too many triangles each
+   * (SOFT_FRUSTA_MAX_TRIS in workload.c); 1 keeps every batch as frusta (the
+   * paper's pure multi-frusta, to measure) */
   int mft_no_fallback;
   /* set by fr_workload_run for its tiles */
   const fr_mft_sets *light_sets;  /* this frame's interleaved samples on the quad light */
