@@ -6,13 +6,18 @@
  * a ray within rounding of an edge or of tnear/tfar), for every packet size
  * and traversal, culls on and off, and for the multi-frusta tracer, whose
  * camera rays come as frusta. The rays really are Whitted's: there are
- * secondary rays of every kind.
+ * secondary rays of every kind. The shading kernel, at every ISA level,
+ * against per-ray scalar formulas, bit for bit.
  */
 #include <string.h>
 #include "api/scene.h"
 #include "render/camera.h"
 #include "render/views.h"
 #include "render/whitted.h"
+#include "render/whitted_shade.h"
+#include "base/rng.h"
+#include "base/vec3.h"
+#include "trace/kernels.h"
 #include "render/workload.h"
 #include "test_util.h"
 
@@ -187,9 +192,156 @@ static void test_materials(void **state) {
   fr_scene_release(s);
 }
 
+
+/* ---- the shading kernel against the formulas, ray by ray ---------------------- */
+
+static float ref_fresnel(float cosi, float eta, float *cost_out) {
+  float k = 1.0f - eta * eta * (1.0f - cosi * cosi);
+  if (k <= 0.0f) { *cost_out = 0.0f; return 1.0f; } /* total internal reflection */
+  float cost = sqrtf(k);
+  float rs = (eta * cosi - cost) / (eta * cosi + cost), rp = (eta * cost - cosi) / (eta * cost + cosi);
+  *cost_out = cost;
+  return 0.5f * (rs * rs + rp * rp);
+}
+static float ref_max3(vec3 a) { return fr_maxf(a.x, fr_maxf(a.y, a.z)); }
+
+typedef struct ref_lane {
+  vec3 add, p, l, lw, rd, rw, td, tw;
+  float ltfar;
+  int shadow, refl, refr;
+} ref_lane;
+
+/* One hit, as the renderer shaded it before the kernel (one branch per case). */
+static ref_lane ref_shade(const fr_wshade_in *in, const fr_whitted_mats *mats, int lane) {
+  ref_lane o;
+  memset(&o, 0, sizeof o);
+  const fr_wray *g = &in->ray[lane];
+  vec3 w = v3_load(g->w);
+  if (!((in->hits >> lane) & 1)) { o.add = v3_scale(w, FR_WHITTED_BACKGROUND); return o; }
+  const fr_whitted_mat *m = &mats->mat[in->mat[lane]];
+  vec3 d = v3_load(g->r.dir), p = v3_add(v3_load(g->r.org), v3_scale(d, in->hit[lane].t));
+  vec3 ng = v3_norm(v3_load(in->ng + 3 * lane));
+  int entering = v3_dot(ng, d) < 0.0f;
+  vec3 nf = entering ? ng : v3_scale(ng, -1.0f);
+  vec3 kd = v3_load(m->kd), ks = v3_load(m->ks);
+  o.add = v3_mul(w, v3_scale(kd, FR_WHITTED_AMBIENT));
+  o.p = p;
+  vec3 to = v3_sub(v3_load(in->light), p);
+  float dist = v3_len(to);
+  vec3 l = v3_scale(to, 1.0f / dist);
+  float ndl = v3_dot(nf, l);
+  if (ndl > 0.0f && dist > 0.0f && (ref_max3(kd) > 0.0f || (m->kind == FR_SURF_DIFFUSE && ref_max3(ks) > 0.0f))) {
+    vec3 lit = v3_scale(kd, ndl);
+    if (m->kind == FR_SURF_DIFFUSE && m->ns > 0.0f && ref_max3(ks) > 0.0f) {
+      vec3 r = v3_sub(v3_scale(nf, 2.0f * ndl), l);
+      float rv = -v3_dot(r, d);
+      if (rv > 0.0f) lit = v3_add(lit, v3_scale(ks, powf(rv, m->ns)));
+    }
+    o.shadow = 1; o.l = l; o.ltfar = dist * (1.0f - 1e-4f); o.lw = v3_mul(w, lit);
+  }
+  if (!in->bounce || m->kind == FR_SURF_DIFFUSE) return o;
+  float cosi = -v3_dot(d, nf);
+  vec3 refl = v3_add(d, v3_scale(nf, 2.0f * cosi));
+  vec3 wr = v3_mul(w, ks), wt = v3(0, 0, 0), tdir = v3(0, 0, 0);
+  if (m->kind == FR_SURF_GLASS) {
+    float eta = entering ? 1.0f / m->ior : m->ior, cost;
+    float F = ref_fresnel(cosi, eta, &cost);
+    wr = v3_scale(w, F);
+    wt = v3_scale(v3_mul(w, v3_load(m->kt)), 1.0f - F);
+    tdir = v3_add(v3_scale(d, eta), v3_scale(nf, eta * cosi - cost));
+  }
+  if (ref_max3(wr) > FR_WHITTED_MIN_WEIGHT) { o.refl = 1; o.rd = refl; o.rw = wr; }
+  if (ref_max3(wt) > FR_WHITTED_MIN_WEIGHT) { o.refr = 1; o.td = v3_norm(tdir); o.tw = wt; }
+  return o;
+}
+
+static int same3(vec3 a, const float (*v)[FR_WS_LANES], int l) {
+  float b[3] = {v[0][l], v[1][l], v[2][l]};
+  return !memcmp(&a, b, sizeof b);
+}
+
+/* Random hits (misses, zero normals, grazing and back-facing ones, total
+ * internal reflection) on materials of every kind, in partial groups too. */
+static void test_shade_kernel(void **state) {
+  (void)state;
+  fr_scene *s;
+  assert_int_equal(fr_scene_builtin(&s), FR_OK);
+  fr_whitted_mats mats;
+  assert_int_equal(fr_whitted_mats_build(s, NULL, NULL, &mats), FR_OK);
+  /* a material table of our own: diffuse, Phong, mirror, two glasses, black */
+  static const fr_whitted_mat table[] = {
+      {FR_SURF_DIFFUSE, {0.7f, 0.6f, 0.5f}, {0, 0, 0}, 0, {0, 0, 0}, 1.5f},
+      {FR_SURF_DIFFUSE, {0.2f, 0.3f, 0.4f}, {0.5f, 0.5f, 0.5f}, 20.0f, {0, 0, 0}, 1.5f},
+      {FR_SURF_MIRROR, {0, 0, 0}, {0.9f, 0.8f, 0.9f}, 0, {0, 0, 0}, 1.5f},
+      {FR_SURF_GLASS, {0, 0, 0}, {0, 0, 0}, 0, {0.9f, 0.9f, 0.9f}, 1.5f},
+      {FR_SURF_GLASS, {0.1f, 0, 0}, {0, 0, 0}, 0, {0.5f, 0.9f, 0.7f}, 2.4f},
+      {FR_SURF_DIFFUSE, {0, 0, 0}, {0, 0, 0}, 0, {0, 0, 0}, 1.5f},
+  };
+  fr_whitted_mats_free(&mats);
+  mats.count = sizeof table / sizeof table[0];
+  mats.mat = malloc(sizeof table);
+  memcpy(mats.mat, table, sizeof table);
+  /* the table the renderer builds, from these */
+  mats.soa = malloc(FR_WM_FIELDS * mats.count * sizeof(float));
+  fr_whitted_mats_soa(&mats);
+  fr_rng rng = fr_rng_seed(7, 11);
+  long lanes_checked = 0, counts[3] = {0, 0, 0};
+  for (int trial = 0; trial < 4000; trial++) {
+    fr_wray rays[FR_WS_LANES];
+    fr_hit hits[FR_WS_LANES];
+    float ng[3 * FR_WS_LANES];
+    int32_t mi[FR_WS_LANES];
+    int n = 1 + (int)(fr_rng_u32(&rng) % FR_WS_LANES);
+    fr_wshade_in in = {rays, hits, ng, mi, (1u << n) - 1u, 0, mats.soa, mats.count, {0, 0, 0}, 1e-3f, trial % 4 != 0};
+    for (int a = 0; a < 3; a++) in.light[a] = 4.0f * fr_rng_float(&rng) - 2.0f;
+    for (int l = 0; l < n; l++) {
+      vec3 d = v3_norm(v3(2 * fr_rng_float(&rng) - 1, 2 * fr_rng_float(&rng) - 1, 2 * fr_rng_float(&rng) - 1));
+      rays[l] = (fr_wray){{{fr_rng_float(&rng), fr_rng_float(&rng), fr_rng_float(&rng)}, 0, {d.x, d.y, d.z}, INFINITY},
+                          {fr_rng_float(&rng), fr_rng_float(&rng), fr_rng_float(&rng)}, (uint16_t)l, 0};
+      hits[l].t = 3.0f * fr_rng_float(&rng);
+      hits[l].prim = fr_rng_u32(&rng) % 5 ? (uint32_t)l : FR_INVALID_ID;
+      in.hits |= (unsigned)(hits[l].prim != FR_INVALID_ID) << l;
+      mi[l] = (int32_t)(fr_rng_u32(&rng) % mats.count);
+      for (int a = 0; a < 3; a++) ng[3 * l + a] = 2 * fr_rng_float(&rng) - 1;
+      if (fr_rng_u32(&rng) % 50 == 0) ng[3 * l] = ng[3 * l + 1] = ng[3 * l + 2] = 0.0f;
+    }
+    for (int isa = 0; isa < 3; isa++) {
+      if (!fr_isa_supported((fr_isa)isa)) continue;
+      fr_wshade_out out;
+      memset(&out, 0, sizeof out);
+      if (isa == FR_ISA_AVX512) fr_whitted_shade16_avx512(&in, &out);
+      else if (isa == FR_ISA_AVX2) fr_whitted_shade16_avx2(&in, &out);
+      else fr_whitted_shade16_scalar(&in, &out);
+      for (int l = 0; l < n; l++) {
+        ref_lane r = ref_shade(&in, &mats, l);
+        assert_true(same3(r.add, out.add, l));
+        assert_int_equal(r.shadow, (out.shadow >> l) & 1);
+        assert_int_equal(r.refl, (out.refl >> l) & 1);
+        assert_int_equal(r.refr, (out.refr >> l) & 1);
+        if (r.shadow || r.refl || r.refr) assert_true(same3(r.p, out.p, l));
+        if (r.shadow) {
+          assert_true(same3(r.l, out.l, l) && same3(r.lw, out.lw, l));
+          assert_memory_equal(&r.ltfar, &out.ltfar[l], sizeof(float));
+        }
+        if (r.refl) assert_true(same3(r.rd, out.rd, l) && same3(r.rw, out.rw, l));
+        if (r.refr) assert_true(same3(r.td, out.td, l) && same3(r.tw, out.tw, l));
+        counts[0] += r.shadow; counts[1] += r.refl; counts[2] += r.refr;
+        lanes_checked++;
+      }
+    }
+  }
+  /* every kind of output really came up */
+  assert_true(counts[0] > 1000 && counts[1] > 1000 && counts[2] > 1000);
+  print_message("shading kernel: %ld lanes bit-identical to the formulas (%ld shadow, %ld reflection, %ld refraction rays)\n",
+                lanes_checked, counts[0], counts[1], counts[2]);
+  fr_whitted_mats_free(&mats);
+  fr_scene_release(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_materials),
+      cmocka_unit_test(test_shade_kernel),
       cmocka_unit_test(test_kitchen),
       cmocka_unit_test(test_museum),
       cmocka_unit_test(test_sphereflake),

@@ -160,10 +160,18 @@ static int chunk_order(const fr_scene *s, const fr_ray *rays, size_t n, uint32_t
   }
   size_t start[9] = {0};
   uint8_t oct[STREAM_CHUNK];
+  unsigned some = 0, every = 7;
   for (size_t i = 0; i < n; i++) {
     const float *d = rays[i].dir;
     oct[i] = (uint8_t)((__builtin_signbit(d[0]) != 0) | (__builtin_signbit(d[1]) != 0) << 1 | (__builtin_signbit(d[2]) != 0) << 2);
+    some |= oct[i];
+    every &= oct[i];
     start[oct[i] + 1]++;
+  }
+  if (some == every) { /* one octant, as most packets of a renderer's calls: no sort */
+    for (size_t i = 0; i < n; i++) order[i] = (uint32_t)i;
+    run_end[0] = n;
+    return 1;
   }
   int runs = 0;
   for (int o = 0; o < 8; o++) {

@@ -6,12 +6,12 @@
 #include "api/scene.h"
 #include "base/error.h"
 #include "base/vec3.h"
+#include "render/whitted_shade.h"
 #include "render/workload.h"
+#include "trace/kernels.h"
 
 #define WT FR_WHITTED_TILE /* tile side: the largest packet */
 #define WT_PIX (WT * WT)
-#define MIN_WEIGHT 0.01f   /* secondary rays carrying less are not traced */
-#define AMBIENT 0.1f
 
 /* ---- materials --------------------------------------------------------------- */
 
@@ -85,17 +85,46 @@ fr_error fr_whitted_mats_build(const fr_scene *s, const char *mirror, const char
       }
     }
   }
+  out->soa = malloc(FR_WM_FIELDS * out->count * sizeof *out->soa);
+  if (!out->soa) { fr_whitted_mats_free(out); return fr_fail(FR_ERR_NOMEM, "out of memory for %zu materials", nm + 1); }
+  fr_whitted_mats_soa(out);
   return FR_OK;
+}
+
+void fr_whitted_mats_soa(fr_whitted_mats *m) {
+  for (size_t i = 0; i < m->count; i++) {
+    const fr_whitted_mat *w = &m->mat[i];
+    float *f = m->soa + i;
+    const size_t c = m->count;
+    float kd = fr_maxf(w->kd[0], fr_maxf(w->kd[1], w->kd[2])), ks = fr_maxf(w->ks[0], fr_maxf(w->ks[1], w->ks[2]));
+    for (int a = 0; a < 3; a++) {
+      f[(FR_WM_KD + a) * c] = w->kd[a];
+      f[(FR_WM_KS + a) * c] = w->ks[a];
+      f[(FR_WM_KT + a) * c] = w->kt[a];
+    }
+    f[FR_WM_NS * c] = w->ns;
+    f[FR_WM_IOR * c] = w->ior;
+    f[FR_WM_GLASS * c] = w->kind == FR_SURF_GLASS;
+    f[FR_WM_BOUNCES * c] = w->kind != FR_SURF_DIFFUSE;
+    /* the point light adds where the surface has a colour or a highlight */
+    f[FR_WM_LIGHTS * c] = kd > 0.0f || (w->kind == FR_SURF_DIFFUSE && ks > 0.0f);
+    f[FR_WM_PHONG * c] = w->kind == FR_SURF_DIFFUSE && w->ns > 0.0f && ks > 0.0f;
+  }
 }
 
 void fr_whitted_mats_free(fr_whitted_mats *m) {
   free(m->mat);
+  free(m->soa);
   memset(m, 0, sizeof *m);
 }
 
-static const fr_whitted_mat *mat_of(const fr_scene *s, const fr_whitted_mats *m, uint32_t prim) {
+static uint32_t mat_index(const fr_scene *s, const fr_whitted_mats *m, uint32_t prim) {
   uint32_t i = fr_scene_prim_material(s, prim);
-  return &m->mat[i == FR_INVALID_ID || i + 1 >= m->count ? m->count - 1 : i];
+  return i == FR_INVALID_ID || i + 1 >= m->count ? (uint32_t)m->count - 1 : i;
+}
+
+static const fr_whitted_mat *mat_of(const fr_scene *s, const fr_whitted_mats *m, uint32_t prim) {
+  return &m->mat[mat_index(s, m, prim)];
 }
 
 void fr_whitted_mats_census(const fr_scene *s, const fr_whitted_mats *m, size_t *mirror_prims, size_t *glass_prims) {
@@ -108,16 +137,17 @@ void fr_whitted_mats_census(const fr_scene *s, const fr_whitted_mats *m, size_t 
   }
 }
 
+void fr_whitted_shade16(const fr_wshade_in *in, fr_wshade_out *out) {
+  switch (fr_kernels_active()->isa) {
+  case FR_ISA_AVX512: fr_whitted_shade16_avx512(in, out); break;
+  case FR_ISA_AVX2: fr_whitted_shade16_avx2(in, out); break;
+  default: fr_whitted_shade16_scalar(in, out); break;
+  }
+}
+
 /* ---- the tile engine ------------------------------------------------------------ */
 
-/* a ray of a generation: its pixel, the weight it carries, its packet key
- * (block * 2 + kind: 0 camera or reflection, 1 refraction) */
-typedef struct wray {
-  fr_ray r;
-  vec3 w;
-  uint16_t pix;
-  uint16_t key;
-} wray;
+typedef fr_wray wray;
 
 typedef struct fr_whitted_scratch {
   size_t cap;
@@ -125,6 +155,8 @@ typedef struct fr_whitted_scratch {
   fr_ray *rays;
   fr_hit *hits;
   uint8_t *occ;
+  float *ng;                  /* a generation's geometric normals (3 per ray), not unit */
+  int32_t *mat;               /* ... and material indices */
   vec3 colour[WT_PIX];
 } fr_whitted_scratch;
 
@@ -142,7 +174,8 @@ static int reserve(fr_whitted_scratch *S, size_t n) {
   while (cap < n) cap *= 2;
   if (!grow((void **)&S->cur, cap * sizeof *S->cur) || !grow((void **)&S->next, cap * sizeof *S->next) ||
       !grow((void **)&S->shadow, cap * sizeof *S->shadow) || !grow((void **)&S->rays, cap * sizeof *S->rays) ||
-      !grow((void **)&S->hits, cap * sizeof *S->hits) || !grow((void **)&S->occ, cap))
+      !grow((void **)&S->hits, cap * sizeof *S->hits) || !grow((void **)&S->occ, cap) ||
+      !grow((void **)&S->ng, 3 * cap * sizeof *S->ng) || !grow((void **)&S->mat, (cap + FR_WS_LANES) * sizeof *S->mat))
     return 0;
   S->cap = cap;
   return 1;
@@ -153,6 +186,7 @@ fr_whitted_scratch *fr_whitted_scratch_new(void) { return calloc(1, sizeof(fr_wh
 void fr_whitted_scratch_free(fr_whitted_scratch *S) {
   if (!S) return;
   free(S->cur); free(S->next); free(S->shadow); free(S->rays); free(S->hits); free(S->occ);
+  free(S->ng); free(S->mat);
   free(S);
 }
 
@@ -168,18 +202,6 @@ static void trace_runs(const fr_tracer *t, const wray *g, fr_ray *rays, fr_hit *
     a = b;
   }
 }
-
-static float fresnel(float cosi, float eta, float *cost_out) {
-  float k = 1.0f - eta * eta * (1.0f - cosi * cosi);
-  if (k <= 0.0f) { *cost_out = 0.0f; return 1.0f; } /* total internal reflection */
-  float cost = sqrtf(k);
-  float rs = (eta * cosi - cost) / (eta * cosi + cost), rp = (eta * cost - cosi) / (eta * cost + cosi);
-  *cost_out = cost;
-  return 0.5f * (rs * rs + rp * rp);
-}
-
-static float vmax3(vec3 a) { return fmaxf(a.x, fmaxf(a.y, a.z)); }
-static vec3 vmul(vec3 a, vec3 b) { return v3(a.x * b.x, a.y * b.y, a.z * b.z); }
 
 uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_scratch *S, int tx, int ty) {
   const int W = w->cam.width, H = w->cam.height;
@@ -200,7 +222,7 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
         int X = qx + 4 * (f % 4) + k % 4, Y = qy + 4 * (f / 4) + k / 4;
         wray *g = &S->cur[n];
         g->r = S->rays[n];
-        g->w = v3(1, 1, 1);
+        g->w[0] = g->w[1] = g->w[2] = 1.0f;
         g->pix = (uint16_t)((Y - ty) * WT + (X - tx));
         g->key = 0;
       }
@@ -215,7 +237,7 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
         if (traced && X + 16 - X % 16 <= W && Y + 16 - Y % 16 <= H) continue; /* in a traced quarter */
         wray *g = &S->cur[n++];
         g->r = fr_camera_ray(&w->cam, X, Y);
-        g->w = v3(1, 1, 1);
+        g->w[0] = g->w[1] = g->w[2] = 1.0f;
         g->pix = (uint16_t)((Y - ty) * WT + (X - tx));
         g->key = (uint16_t)(2 * b);
       }
@@ -227,75 +249,65 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
     rays += n;
     size_t ns = 0, nn = 0;
     if (!reserve(S, 2 * n)) return rays;
+    /* First what each hit needs from memory, its material and normal, in a
+     * loop short enough that the cache misses of many hits overlap; then the
+     * arithmetic 16 hits at a time; then the new rays, in ray order. */
     for (size_t i = 0; i < n; i++) {
-      const wray *g = &S->cur[i];
       const fr_hit *h = &S->hits[i];
-      if (h->prim == FR_INVALID_ID) {
-        S->colour[g->pix] = v3_add(S->colour[g->pix], v3_scale(g->w, 0.05f));
-        continue;
-      }
-      const fr_whitted_mat *m = mat_of(sc, w->mats, h->prim);
-      vec3 d = v3_load(g->r.dir), p = v3_add(v3_load(g->r.org), v3_scale(d, h->t));
-      float gn[3], pp[3] = {p.x, p.y, p.z};
-      fr_scene_geometric_normal(sc, h->prim, pp, gn);
-      vec3 ng = v3_norm(v3_load(gn));
-      int entering = v3_dot(ng, d) < 0.0f;
-      vec3 nf = entering ? ng : v3_scale(ng, -1.0f);
-      vec3 kd = v3(m->kd[0], m->kd[1], m->kd[2]), ks = v3(m->ks[0], m->ks[1], m->ks[2]);
-      S->colour[g->pix] = v3_add(S->colour[g->pix], vmul(g->w, v3_scale(kd, AMBIENT)));
-      /* direct light: a shadow ray wherever the surface has a colour of its own */
-      vec3 to = v3_sub(w->view.light, p);
-      float dist = v3_len(to);
-      vec3 l = v3_scale(to, 1.0f / dist);
-      float ndl = v3_dot(nf, l);
-      if (ndl > 0.0f && dist > 0.0f && (vmax3(kd) > 0.0f || (m->kind == FR_SURF_DIFFUSE && vmax3(ks) > 0.0f))) {
-        vec3 lit = v3_scale(kd, ndl);
-        if (m->kind == FR_SURF_DIFFUSE && m->ns > 0.0f && vmax3(ks) > 0.0f) {
-          vec3 r = v3_sub(v3_scale(nf, 2.0f * ndl), l);
-          float rv = -v3_dot(r, d);
-          if (rv > 0.0f) lit = v3_add(lit, v3_scale(ks, powf(rv, m->ns)));
+      float *ng = S->ng + 3 * i;
+      S->mat[i] = 0;
+      ng[0] = ng[1] = ng[2] = 0.0f;
+      if (h->prim == FR_INVALID_ID) continue;
+      const float *o = S->cur[i].r.org, *d = S->cur[i].r.dir;
+      float pp[3] = {o[0] + d[0] * h->t, o[1] + d[1] * h->t, o[2] + d[2] * h->t};
+      fr_scene_geometric_normal(sc, h->prim, pp, ng);
+      S->mat[i] = (int32_t)mat_index(sc, w->mats, h->prim);
+    }
+    fr_wshade_in in = {.mats = w->mats->soa, .mat_count = w->mats->count, .eps = w->eps,
+                       .bounce = depth < max_depth};
+    memcpy(in.light, &w->view.light, sizeof in.light);
+    for (size_t i0 = 0; i0 < n; i0 += FR_WS_LANES) {
+      const size_t lanes = n - i0 < FR_WS_LANES ? n - i0 : FR_WS_LANES;
+      in.ray = S->cur + i0;
+      in.hit = S->hits + i0;
+      in.ng = S->ng + 3 * i0;
+      in.mat = S->mat + i0;
+      in.valid = (unsigned)((1u << lanes) - 1u);
+      in.hits = 0;
+      for (size_t l = 0; l < lanes; l++) in.hits |= (unsigned)(S->hits[i0 + l].prim != FR_INVALID_ID) << l;
+      fr_wshade_out out;
+      fr_whitted_shade16(&in, &out);
+      for (size_t l = 0; l < lanes; l++) {
+        const wray *g = &S->cur[i0 + l];
+        vec3 *c = &S->colour[g->pix];
+        *c = v3_add(*c, v3(out.add[0][l], out.add[1][l], out.add[2][l]));
+        const fr_ray base = {{out.p[0][l], out.p[1][l], out.p[2][l]}, w->eps, {0, 0, 0}, INFINITY};
+        if ((out.shadow >> l) & 1) {
+          wray *r = &S->shadow[ns++];
+          *r = (wray){base, {out.lw[0][l], out.lw[1][l], out.lw[2][l]}, g->pix, (uint16_t)(g->key / 2)};
+          r->r.dir[0] = out.l[0][l]; r->r.dir[1] = out.l[1][l]; r->r.dir[2] = out.l[2][l];
+          r->r.tfar = out.ltfar[l];
         }
-        wray *sh = &S->shadow[ns++];
-        sh->r = (fr_ray){{p.x, p.y, p.z}, w->eps, {l.x, l.y, l.z}, dist * (1.0f - 1e-4f)};
-        sh->w = vmul(g->w, lit);
-        sh->pix = g->pix;
-        sh->key = (uint16_t)(g->key / 2);
-      }
-      if (depth >= max_depth || m->kind == FR_SURF_DIFFUSE) continue;
-      float cosi = -v3_dot(d, nf);
-      vec3 refl = v3_add(d, v3_scale(nf, 2.0f * cosi));
-      vec3 wr = vmul(g->w, ks), wt = v3(0, 0, 0), tdir = v3(0, 0, 0);
-      if (m->kind == FR_SURF_GLASS) {
-        float eta = entering ? 1.0f / m->ior : m->ior, cost;
-        float F = fresnel(cosi, eta, &cost);
-        wr = v3_scale(g->w, F);
-        wt = v3_scale(vmul(g->w, v3(m->kt[0], m->kt[1], m->kt[2])), 1.0f - F);
-        tdir = v3_add(v3_scale(d, eta), v3_scale(nf, eta * cosi - cost));
-      }
-      if (vmax3(wr) > MIN_WEIGHT) {
-        wray *r = &S->next[nn++];
-        r->r = (fr_ray){{p.x, p.y, p.z}, w->eps, {refl.x, refl.y, refl.z}, INFINITY};
-        r->w = wr;
-        r->pix = g->pix;
-        r->key = (uint16_t)(g->key & ~1u);
-      }
-      if (vmax3(wt) > MIN_WEIGHT) {
-        tdir = v3_norm(tdir);
-        wray *r = &S->next[nn++];
-        r->r = (fr_ray){{p.x, p.y, p.z}, w->eps, {tdir.x, tdir.y, tdir.z}, INFINITY};
-        r->w = wt;
-        r->pix = g->pix;
-        r->key = (uint16_t)(g->key | 1u);
+        if ((out.refl >> l) & 1) {
+          wray *r = &S->next[nn++];
+          *r = (wray){base, {out.rw[0][l], out.rw[1][l], out.rw[2][l]}, g->pix, (uint16_t)(g->key & ~1u)};
+          r->r.dir[0] = out.rd[0][l]; r->r.dir[1] = out.rd[1][l]; r->r.dir[2] = out.rd[2][l];
+        }
+        if ((out.refr >> l) & 1) {
+          wray *r = &S->next[nn++];
+          *r = (wray){base, {out.tw[0][l], out.tw[1][l], out.tw[2][l]}, g->pix, (uint16_t)(g->key | 1u)};
+          r->r.dir[0] = out.td[0][l]; r->r.dir[1] = out.td[1][l]; r->r.dir[2] = out.td[2][l];
+        }
       }
     }
     /* shadow rays, packet by packet (they follow their block's order) */
     trace_runs(t, S->shadow, S->rays, NULL, S->occ, ns);
     rays += ns;
     for (size_t i = 0; i < ns; i++)
-      if (!S->occ[i]) S->colour[S->shadow[i].pix] = v3_add(S->colour[S->shadow[i].pix], S->shadow[i].w);
+      if (!S->occ[i]) S->colour[S->shadow[i].pix] = v3_add(S->colour[S->shadow[i].pix], v3_load(S->shadow[i].w));
     /* the next generation grouped by key: reflection and refraction packets of each block */
     size_t count[2 * WT_PIX + 1];
-    memset(count, 0, sizeof count);
+    memset(count, 0, (2 * (size_t)(per * per) + 1) * sizeof count[0]);
     for (size_t i = 0; i < nn; i++) count[S->next[i].key + 1]++;
     for (int k = 1; k <= 2 * per * per; k++) count[k] += count[k - 1];
     for (size_t i = 0; i < nn; i++) S->cur[count[S->next[i].key]++] = S->next[i];

@@ -34,6 +34,7 @@ typedef struct fr_whitted_mat {
 typedef struct fr_whitted_mats {
   fr_whitted_mat *mat;
   size_t count;
+  float *soa; /* the same as the shading kernel reads it (render/whitted_shade.h) */
 } fr_whitted_mats;
 
 /* Which materials mirror and which refract. mirror and glass are
@@ -44,6 +45,8 @@ typedef struct fr_whitted_mats {
  * unknown material. */
 fr_error fr_whitted_mats_build(const fr_scene *s, const char *mirror, const char *glass, fr_whitted_mats *out);
 void fr_whitted_mats_free(fr_whitted_mats *m);
+/* Fills m->soa (allocated, FR_WM_FIELDS x count) from m->mat. */
+void fr_whitted_mats_soa(fr_whitted_mats *m);
 /* How many prims (triangles and spheres) are mirrors and glass. */
 void fr_whitted_mats_census(const fr_scene *s, const fr_whitted_mats *m, size_t *mirror_prims, size_t *glass_prims);
 #endif

@@ -254,7 +254,7 @@ int cmd_bench(int argc, char **argv) {
     printf("mft_bvh leaf=%d inner=%zu leaves=%zu sah=%.2f corner_rays=%s corner_cost=%g shrink=%s fallback=%s\n", mctx.bvh->max_leaf,
            mctx.bvh->nnodes, mctx.bvh->nleaves, fr_bvh2_sah(mctx.bvh), mopt.corner_rays ? "on" : "off",
            (double)mopt.corner_cost, mopt.shrink ? "on" : "off", mft_no_fallback ? "off" : "on");
-  fr_whitted_mats mats = {NULL, 0};
+  fr_whitted_mats mats = {0};
   if ((all_wl || wk == FR_WL_WHITTED) && (rc = cli_whitted_setup(s, &wo, &mats, &w))) {
     fr_bvh2_free(&shallow);
     fr_scene_release(s);

@@ -136,7 +136,7 @@ int cmd_render(int argc, char **argv) {
     fr_scene_release(s);
     return rc;
   }
-  fr_whitted_mats mats = {NULL, 0};
+  fr_whitted_mats mats = {0};
   if (w.kind == FR_WL_WHITTED && (rc = cli_whitted_setup(s, &wo, &mats, &w))) { fr_scene_release(s); return rc; }
   w.image = calloc((size_t)v.width * (size_t)v.height * 3, sizeof(float));
   if (!w.image) { fr_whitted_mats_free(&mats); fr_scene_release(s); return cli_error(1, "out of memory for a %dx%d image", v.width, v.height); }

@@ -1,0 +1,137 @@
+/*
+ * Whitted shading of 16 hits (see whitted_shade.h), compiled once per ISA.
+ * The operations and their order are those of the scalar formulas written
+ * next to them, so every level, lane by lane, gives the same bits; only the
+ * Phong highlight's powf runs lane by lane.
+ */
+#include <math.h>
+#include <stddef.h>
+#include "base/simd_packet.h"
+#include "render/whitted_shade.h"
+
+typedef struct v3p { vpf x, y, z; } v3p;
+
+FR_INLINE v3p v3p_gather(const float *base, const int32_t *idx) {
+  v3p r = {vp_gather(base, idx), vp_gather(base + 1, idx), vp_gather(base + 2, idx)};
+  return r;
+}
+FR_INLINE v3p v3p_splat(const float *a) { v3p r = {vp(a[0]), vp(a[1]), vp(a[2])}; return r; }
+FR_INLINE vpf vp_neg(vpf a) { return vp_xor(a, vp(-0.0f)); }
+FR_INLINE v3p v3p_add(v3p a, v3p b) { v3p r = {vp_add(a.x, b.x), vp_add(a.y, b.y), vp_add(a.z, b.z)}; return r; }
+FR_INLINE v3p v3p_sub(v3p a, v3p b) { v3p r = {vp_sub(a.x, b.x), vp_sub(a.y, b.y), vp_sub(a.z, b.z)}; return r; }
+FR_INLINE v3p v3p_mul(v3p a, v3p b) { v3p r = {vp_mul(a.x, b.x), vp_mul(a.y, b.y), vp_mul(a.z, b.z)}; return r; }
+FR_INLINE v3p v3p_scale(v3p a, vpf s) { v3p r = {vp_mul(a.x, s), vp_mul(a.y, s), vp_mul(a.z, s)}; return r; }
+FR_INLINE vpf v3p_dot(v3p a, v3p b) { return vp_add(vp_add(vp_mul(a.x, b.x), vp_mul(a.y, b.y)), vp_mul(a.z, b.z)); }
+FR_INLINE vpf v3p_max3(v3p a) { return vp_max(a.x, vp_max(a.y, a.z)); }
+FR_INLINE v3p v3p_select(vpm m, v3p a, v3p b) {
+  v3p r = {vp_select(m, a.x, b.x), vp_select(m, a.y, b.y), vp_select(m, a.z, b.z)};
+  return r;
+}
+FR_INLINE void v3p_store(float (*dst)[FR_WS_LANES], v3p a) { vp_store(dst[0], a.x); vp_store(dst[1], a.y); vp_store(dst[2], a.z); }
+/* v3_norm: a / |a|, a itself when |a| is 0 */
+FR_INLINE v3p v3p_norm(v3p a) {
+  vpf l = vp_sqrt(v3p_dot(a, a));
+  return v3p_select(vp_gt(l, vp(0.0f)), v3p_scale(a, vp_div(vp(1.0f), l)), a);
+}
+/* field f of each lane's material */
+typedef struct mat_lanes { const float *soa; size_t count; const int32_t *idx; } mat_lanes;
+FR_INLINE vpf mat_field(const mat_lanes *m, int f) { return vp_gather(m->soa + (size_t)f * m->count, m->idx); }
+FR_INLINE v3p mat_field3(const mat_lanes *m, int f) {
+  v3p r = {mat_field(m, f), mat_field(m, f + 1), mat_field(m, f + 2)};
+  return r;
+}
+
+void FR_ISA_FN(fr_whitted_shade16)(const fr_wshade_in *in, fr_wshade_out *out) {
+  enum { RAY = sizeof(fr_wray) / sizeof(float), HIT = sizeof(fr_hit) / sizeof(float) };
+  _Static_assert(sizeof(fr_wray) % sizeof(float) == 0 && sizeof(fr_hit) % sizeof(float) == 0, "whole floats");
+  int32_t ri[FR_WS_LANES] __attribute__((aligned(64))), hi[FR_WS_LANES] __attribute__((aligned(64)));
+  int32_t ni[FR_WS_LANES] __attribute__((aligned(64)));
+  int32_t mi[FR_WS_LANES] __attribute__((aligned(64))); /* the gathers want aligned indices */
+  int first = __builtin_ctz(in->valid);
+  for (int l = 0; l < FR_WS_LANES; l++) { /* absent lanes read a present one */
+    int s = (in->valid >> l) & 1 ? l : first;
+    ri[l] = s * RAY; hi[l] = s * HIT; ni[l] = 3 * s; mi[l] = in->mat[s];
+  }
+  const mat_lanes M = {in->mats, in->mat_count, mi};
+  const float *rf = (const float *)in->ray, *hf = (const float *)in->hit;
+  v3p o = v3p_gather(rf + offsetof(fr_wray, r.org) / sizeof(float), ri);
+  v3p d = v3p_gather(rf + offsetof(fr_wray, r.dir) / sizeof(float), ri);
+  v3p w = v3p_gather(rf + offsetof(fr_wray, w) / sizeof(float), ri);
+  vpf t = vp_gather(hf + offsetof(fr_hit, t) / sizeof(float), hi);
+  vpm hit = vpm_bits_to(in->hits);
+
+  /* a miss sees the background, a hit the ambient term: w * (kd * AMBIENT) */
+  v3p kd = mat_field3(&M, FR_WM_KD), ks = mat_field3(&M, FR_WM_KS);
+  v3p amb = v3p_mul(w, v3p_scale(kd, vp(FR_WHITTED_AMBIENT)));
+  v3p_store(out->add, v3p_select(hit, amb, v3p_scale(w, vp(FR_WHITTED_BACKGROUND))));
+  out->shadow = out->refl = out->refr = 0;
+  if (!in->hits) return;
+
+  v3p p = v3p_add(o, v3p_scale(d, t));
+  v3p_store(out->p, p);
+  v3p ng = v3p_norm(v3p_gather(in->ng, ni));
+  vpm entering = vp_lt(v3p_dot(ng, d), vp(0.0f));
+  v3p nf = v3p_select(entering, ng, v3p_scale(ng, vp(-1.0f)));
+
+  /* direct light: a shadow ray wherever the surface has a colour of its own */
+  v3p to = v3p_sub(v3p_splat(in->light), p);
+  vpf dist = vp_sqrt(v3p_dot(to, to));
+  v3p l = v3p_scale(to, vp_div(vp(1.0f), dist));
+  vpf ndl = v3p_dot(nf, l);
+  vpm lights = vpm_and(vpm_and(hit, vp_gt(mat_field(&M, FR_WM_LIGHTS), vp(0.0f))),
+                       vpm_and(vp_gt(ndl, vp(0.0f)), vp_gt(dist, vp(0.0f))));
+  out->shadow = vpm_bits(lights);
+  if (out->shadow) {
+    v3p lit = v3p_scale(kd, ndl);
+    /* Phong: r = nf * (2 ndl) - l, highlight ks * (-r.d)^ns where positive */
+    v3p r = v3p_sub(v3p_scale(nf, vp_mul(vp(2.0f), ndl)), l);
+    vpf rv = vp_neg(v3p_dot(r, d));
+    unsigned phong = vpm_bits(vpm_and(lights, vpm_and(vp_gt(mat_field(&M, FR_WM_PHONG), vp(0.0f)), vp_gt(rv, vp(0.0f)))));
+    if (phong) {
+      float rvs[FR_WS_LANES] __attribute__((aligned(64))), ns[FR_WS_LANES] __attribute__((aligned(64)));
+      float hl[FR_WS_LANES] __attribute__((aligned(64))) = {0};
+      vp_store(rvs, rv);
+      vp_store(ns, mat_field(&M, FR_WM_NS));
+      for (unsigned m = phong; m; m &= m - 1) {
+        int i = __builtin_ctz(m);
+        hl[i] = powf(rvs[i], ns[i]);
+      }
+      vpm ph = vpm_bits_to(phong);
+      lit = v3p_select(ph, v3p_add(lit, v3p_scale(ks, vp_load(hl))), lit);
+    }
+    v3p_store(out->l, l);
+    vp_store(out->ltfar, vp_mul(dist, vp(1.0f - 1e-4f)));
+    v3p_store(out->lw, v3p_mul(w, lit));
+  }
+  if (!in->bounce) return;
+  vpm bounces = vpm_and(hit, vp_gt(mat_field(&M, FR_WM_BOUNCES), vp(0.0f)));
+  if (!vpm_bits(bounces)) return;
+
+  /* mirror reflection, and for glass Fresnel's split between reflection and refraction */
+  vpf cosi = vp_neg(v3p_dot(d, nf));
+  v3p refl = v3p_add(d, v3p_scale(nf, vp_mul(vp(2.0f), cosi)));
+  v3p wr = v3p_mul(w, ks), wt = {vp(0.0f), vp(0.0f), vp(0.0f)}, tdir = wt;
+  vpm glass = vpm_and(bounces, vp_gt(mat_field(&M, FR_WM_GLASS), vp(0.0f)));
+  if (vpm_bits(glass)) {
+    vpf ior = mat_field(&M, FR_WM_IOR);
+    vpf eta = vp_select(entering, vp_div(vp(1.0f), ior), ior);
+    /* k = 1 - eta^2 (1 - cosi^2); k <= 0: total internal reflection, F = 1 */
+    vpf k = vp_sub(vp(1.0f), vp_mul(vp_mul(eta, eta), vp_sub(vp(1.0f), vp_mul(cosi, cosi))));
+    vpm tir = vp_le(k, vp(0.0f));
+    vpf cost = vp_select(tir, vp(0.0f), vp_sqrt(vp_max(k, vp(0.0f))));
+    vpf ec = vp_mul(eta, cosi), et = vp_mul(eta, cost);
+    vpf rs = vp_div(vp_sub(ec, cost), vp_add(ec, cost)), rp = vp_div(vp_sub(et, cosi), vp_add(et, cosi));
+    vpf F = vp_select(tir, vp(1.0f), vp_mul(vp(0.5f), vp_add(vp_mul(rs, rs), vp_mul(rp, rp))));
+    wr = v3p_select(glass, v3p_scale(w, F), wr);
+    wt = v3p_select(glass, v3p_scale(v3p_mul(w, mat_field3(&M, FR_WM_KT)), vp_sub(vp(1.0f), F)), wt);
+    tdir = v3p_add(v3p_scale(d, eta), v3p_scale(nf, vp_sub(ec, cost)));
+  }
+  out->refl = vpm_bits(vpm_and(bounces, vp_gt(v3p_max3(wr), vp(FR_WHITTED_MIN_WEIGHT))));
+  out->refr = vpm_bits(vpm_and(glass, vp_gt(v3p_max3(wt), vp(FR_WHITTED_MIN_WEIGHT))));
+  v3p_store(out->rd, refl);
+  v3p_store(out->rw, wr);
+  if (out->refr) {
+    v3p_store(out->td, v3p_norm(tdir));
+    v3p_store(out->tw, wt);
+  }
+}

@@ -1,0 +1,74 @@
+/*
+ * The Whitted renderer's shading, 16 hits at a time: what each hit adds to
+ * its pixel, and the shadow, reflection and refraction rays it spawns.
+ * Compiled once per ISA (src/render/whitted_shade.c); every level gives the
+ * same bits as the others.
+ *
+ * The renderer (whitted.c) fetches what each hit needs from memory, the
+ * geometric normal and the material, and afterwards writes the rays out;
+ * this is the arithmetic between, which as scalar code with a branch per
+ * material kind took about a third of a Whitted frame.
+ */
+#ifndef FR_RENDER_WHITTED_SHADE_H
+#define FR_RENDER_WHITTED_SHADE_H
+#include <stdint.h>
+#include "frusta.h"
+
+#define FR_WS_LANES 16
+
+/* a ray of a generation: its pixel, the weight it carries, its packet key
+ * (block * 2 + kind: 0 camera or reflection, 1 refraction) */
+typedef struct fr_wray {
+  fr_ray r;
+  float w[3];
+  uint16_t pix;
+  uint16_t key;
+} fr_wray;
+
+/* Materials as structure of arrays: field f of material i at soa[f * count + i]. */
+enum {
+  FR_WM_KD = 0,    /* 3: diffuse colour */
+  FR_WM_KS = 3,    /* 3: Phong highlight, or the mirror's reflectance */
+  FR_WM_KT = 6,    /* 3: glass: transmitted fraction */
+  FR_WM_NS = 9,    /* Phong exponent */
+  FR_WM_IOR,       /* glass: index of refraction */
+  FR_WM_GLASS,     /* 1 for glass, else 0 */
+  FR_WM_BOUNCES,   /* 1 for mirrors and glass: spawns reflection (and refraction) */
+  FR_WM_LIGHTS,    /* 1 where the point light adds colour: a shadow ray */
+  FR_WM_PHONG,     /* 1 for a diffuse surface with a highlight */
+  FR_WM_FIELDS
+};
+
+typedef struct fr_wshade_in {
+  const fr_wray *ray;   /* 16 rays (lanes past `valid` are not read) */
+  const fr_hit *hit;    /* their hits */
+  const float *ng;      /* 3 per ray: geometric normal, not unit */
+  const int32_t *mat;   /* 16, aligned: material index (any valid index for a miss) */
+  unsigned valid, hits; /* lanes present; lanes that hit */
+  const float *mats;    /* the material table, FR_WM_FIELDS x mat_count */
+  size_t mat_count;
+  float light[3], eps;
+  int bounce;           /* whether hits still spawn reflection and refraction */
+} fr_wshade_in;
+
+typedef struct fr_wshade_out {
+  float add[3][FR_WS_LANES] __attribute__((aligned(64))); /* colour added to the pixel */
+  float p[3][FR_WS_LANES] __attribute__((aligned(64)));   /* hit point: the new rays' origin */
+  float l[3][FR_WS_LANES] __attribute__((aligned(64))), ltfar[FR_WS_LANES] __attribute__((aligned(64)));
+  float lw[3][FR_WS_LANES] __attribute__((aligned(64)));  /* shadow ray: direction, tfar, weight if unoccluded */
+  float rd[3][FR_WS_LANES] __attribute__((aligned(64))), rw[3][FR_WS_LANES] __attribute__((aligned(64)));
+  float td[3][FR_WS_LANES] __attribute__((aligned(64))), tw[3][FR_WS_LANES] __attribute__((aligned(64)));
+  unsigned shadow, refl, refr; /* lanes that spawn a shadow, reflection, refraction ray */
+} fr_wshade_out;
+
+#define FR_WHITTED_MIN_WEIGHT 0.01f /* secondary rays carrying less are not traced */
+#define FR_WHITTED_AMBIENT 0.1f
+#define FR_WHITTED_BACKGROUND 0.05f
+
+#define FR_DECLARE_WSHADE(isa) void fr_whitted_shade16_##isa(const fr_wshade_in *in, fr_wshade_out *out);
+FR_DECLARE_WSHADE(avx512)
+FR_DECLARE_WSHADE(avx2)
+FR_DECLARE_WSHADE(scalar)
+/* the level fr_kernels_active() chose */
+void fr_whitted_shade16(const fr_wshade_in *in, fr_wshade_out *out);
+#endif
