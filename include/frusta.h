@@ -136,6 +136,8 @@ typedef struct fr_bvh_stats {
   double bvh2_sah, bvh2_leaf_fill;
   size_t bvh2_bytes;
   fr_wide_stats bvh4, bvh8;
+  size_t references;             /* triangles in the BVHs' leaves: more than the scene's where
+                                    long thin ones were split into pieces before the build */
   double build_seconds;          /* SAH build + every layout */
   int single_width;              /* the BVH fr_intersect1 uses: 4 or 8 */
 } fr_bvh_stats;

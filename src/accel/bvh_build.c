@@ -302,6 +302,14 @@ oom:
   return fr_fail(FR_ERR_NOMEM, "BVH build: out of memory for %zu primitives", n);
 }
 
+double fr_build_tree_sah(const fr_build_tree *t) {
+  if (!t->nnodes) return 0.0;
+  double root = aabb_half_area(t->nodes[0].box), sum = 0.0;
+  if (!(root > 0.0)) return 0.0;
+  for (size_t i = 0; i < t->nnodes; i++) sum += aabb_half_area(t->nodes[i].box) * (t->nodes[i].left < 0 ? t->nodes[i].count : 1);
+  return sum / root;
+}
+
 void fr_build_tree_free(fr_build_tree *t) {
   free(t->nodes);
   free(t->prims);

@@ -5,6 +5,7 @@
 #include <string.h>
 #include "base/alloc.h"
 #include "base/error.h"
+#include "accel/bvh_presplit.h"
 #include "base/timer.h"
 #include "geom/builtin_scene.h"
 #include "io/import.h"
@@ -148,7 +149,30 @@ static fr_error build_tree(fr_scene *s, fr_build_tree *tree, size_t *count) {
     free(ids);
     return fr_fail(FR_ERR_FORMAT, "%s: %s", s->name, m->ntris ? "every triangle is degenerate" : "no triangles and no spheres");
   }
+  /* FRUSTA_PRESPLIT=off|on overrides the choice (below), for measurements
+   * and tests */
+  const char *env = getenv("FRUSTA_PRESPLIT");
+  const int off = env && !strcmp(env, "off"), on = env && !strcmp(env, "on");
   fr_error e = fr_build_sah(boxes, ids, n, tree);
+  size_t refs = n;
+  /* Keep the presplit tree only where it wins clearly: its duplicated
+   * references cost memory and build time (hairball: SAH 3% lower, 70% more
+   * memory, 5% slower; SPD gears: SAH 20% lower, no faster; SPD rings: SAH
+   * 3.9x lower, single rays 2.1x faster). Running out of memory on the way
+   * just keeps the plain tree. */
+  if (!e && !off &&
+      fr_presplit(m, s->bounds, FR_PRESPLIT_DEFAULT, on ? 0.0 : FR_PRESPLIT_MIN_SHARE, &boxes, &ids, &refs) == FR_OK &&
+      refs != n) {
+    fr_build_tree split;
+    if (fr_build_sah(boxes, ids, refs, &split) == FR_OK) {
+      if (on || fr_build_tree_sah(&split) < FR_PRESPLIT_MIN_GAIN * fr_build_tree_sah(tree)) {
+        fr_build_tree_free(tree);
+        *tree = split;
+      } else {
+        fr_build_tree_free(&split);
+      }
+    }
+  }
   free(boxes);
   free(ids);
   return e;
@@ -287,6 +311,7 @@ fr_error fr_scene_stats(const fr_scene *s, fr_bvh_stats *st) {
     fr_bvhn_stats_get(src[i], &b);
     *dst[i] = (fr_wide_stats){b.inner, b.leaves, b.node_bytes, b.tri_bytes, b.sah, b.sah_blocks, b.node_fill, b.leaf_fill, b.depth, b.packet_tri_bytes, b.blocks, b.block_fill};
   }
+  st->references = s->bvh2.nprims;
   st->build_seconds = s->build_seconds;
   st->single_width = s->single_width;
   return FR_OK;

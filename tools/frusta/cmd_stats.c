@@ -88,8 +88,8 @@ int cmd_stats(int argc, char **argv) {
   fr_bvh_stats st;
   fr_scene_stats(s, &st);
   size_t nt = fr_scene_triangle_count(s);
-  printf("scene=%s tris=%zu skipped_degenerate=%zu threads=%d build_seconds=%.3f\n", s->name, nt,
-         fr_scene_skipped_triangles(s), threads, st.build_seconds);
+  printf("scene=%s tris=%zu skipped_degenerate=%zu references=%zu threads=%d build_seconds=%.3f\n", s->name, nt,
+         fr_scene_skipped_triangles(s), st.references, threads, st.build_seconds);
   printf("bvh2 inner=%zu leaves=%zu sah=%.2f leaf_fill=%.2f\n", st.bvh2_inner, st.bvh2_leaves, st.bvh2_sah, st.bvh2_leaf_fill);
   const fr_wide_stats *w[2] = {&st.bvh4, &st.bvh8};
   for (int i = 0; i < 2; i++)
