@@ -292,7 +292,7 @@ static void test_shade_kernel(void **state) {
     float ng[3 * FR_WS_LANES];
     int32_t mi[FR_WS_LANES];
     int n = 1 + (int)(fr_rng_u32(&rng) % FR_WS_LANES);
-    fr_wshade_in in = {rays, hits, ng, mi, (1u << n) - 1u, 0, mats.soa, mats.count, {0, 0, 0}, 1e-3f, trial % 4 != 0};
+    fr_wshade_in in = {rays, hits, ng, mi, (1u << n) - 1u, 0, mats.soa, mats.count, {0, 0, 0}, trial % 4 != 0};
     for (int a = 0; a < 3; a++) in.light[a] = 4.0f * fr_rng_float(&rng) - 2.0f;
     for (int l = 0; l < n; l++) {
       vec3 d = v3_norm(v3(2 * fr_rng_float(&rng) - 1, 2 * fr_rng_float(&rng) - 1, 2 * fr_rng_float(&rng) - 1));

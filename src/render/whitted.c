@@ -175,7 +175,7 @@ static int reserve(fr_whitted_scratch *S, size_t n) {
   if (!grow((void **)&S->cur, cap * sizeof *S->cur) || !grow((void **)&S->next, cap * sizeof *S->next) ||
       !grow((void **)&S->shadow, cap * sizeof *S->shadow) || !grow((void **)&S->rays, cap * sizeof *S->rays) ||
       !grow((void **)&S->hits, cap * sizeof *S->hits) || !grow((void **)&S->occ, cap) ||
-      !grow((void **)&S->ng, 3 * cap * sizeof *S->ng) || !grow((void **)&S->mat, (cap + FR_WS_LANES) * sizeof *S->mat))
+      !grow((void **)&S->ng, 3 * cap * sizeof *S->ng) || !grow((void **)&S->mat, cap * sizeof *S->mat))
     return 0;
   S->cap = cap;
   return 1;
@@ -263,8 +263,7 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
       fr_scene_geometric_normal(sc, h->prim, pp, ng);
       S->mat[i] = (int32_t)mat_index(sc, w->mats, h->prim);
     }
-    fr_wshade_in in = {.mats = w->mats->soa, .mat_count = w->mats->count, .eps = w->eps,
-                       .bounce = depth < max_depth};
+    fr_wshade_in in = {.mats = w->mats->soa, .mat_count = w->mats->count, .bounce = depth < max_depth};
     memcpy(in.light, &w->view.light, sizeof in.light);
     for (size_t i0 = 0; i0 < n; i0 += FR_WS_LANES) {
       const size_t lanes = n - i0 < FR_WS_LANES ? n - i0 : FR_WS_LANES;

@@ -47,7 +47,7 @@ typedef struct fr_wshade_in {
   unsigned valid, hits; /* lanes present; lanes that hit */
   const float *mats;    /* the material table, FR_WM_FIELDS x mat_count */
   size_t mat_count;
-  float light[3], eps;
+  float light[3];
   int bounce;           /* whether hits still spawn reflection and refraction */
 } fr_wshade_in;
 
