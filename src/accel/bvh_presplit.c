@@ -6,7 +6,7 @@
 #include "base/error.h"
 
 #define MAX_PIECES 64 /* references per triangle */
-#define MAX_DEPTH 48  /* cuts that miss the triangle's part do not count towards pieces */
+#define MAX_DEPTH 48  /* cuts that leave one side empty use up no pieces: this bounds them */
 
 static float tri_area(vec3 a, vec3 b, vec3 c) { return 0.5f * v3_len(v3_cross(v3_sub(b, a), v3_sub(c, a))); }
 

@@ -19,7 +19,7 @@
 #include "geom/mesh.h"
 
 /* Extra references, as a fraction of the triangles, the presplit may add. */
-#define FR_PRESPLIT_DEFAULT 1.0f
+#define FR_PRESPLIT_BUDGET 1.0f
 /* A triangle is cut when its box's area is more than this many times the
  * tightest box's for its area... */
 #define FR_PRESPLIT_RATIO 4.0f

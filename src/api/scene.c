@@ -3,9 +3,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "accel/bvh_presplit.h"
 #include "base/alloc.h"
 #include "base/error.h"
-#include "accel/bvh_presplit.h"
 #include "base/timer.h"
 #include "geom/builtin_scene.h"
 #include "io/import.h"
@@ -161,7 +161,7 @@ static fr_error build_tree(fr_scene *s, fr_build_tree *tree, size_t *count) {
    * 3.9x lower, single rays 2.1x faster). Running out of memory on the way
    * just keeps the plain tree. */
   if (!e && !off &&
-      fr_presplit(m, s->bounds, FR_PRESPLIT_DEFAULT, on ? 0.0 : FR_PRESPLIT_MIN_SHARE, &boxes, &ids, &refs) == FR_OK &&
+      fr_presplit(m, s->bounds, FR_PRESPLIT_BUDGET, on ? 0.0 : FR_PRESPLIT_MIN_SHARE, &boxes, &ids, &refs) == FR_OK &&
       refs != n) {
     fr_build_tree split;
     if (fr_build_sah(boxes, ids, refs, &split) == FR_OK) {
