@@ -229,7 +229,7 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
     }
     traced = n;
   }
-  for (int b = 0; b < per * per; b++)
+  for (int b = 0; b < per * per && traced < WT_PIX; b++) /* (all four quarters as frusta: nothing left) */
     for (int y = 0; y < side; y++)
       for (int x = 0; x < side; x++) {
         int X = tx + (b % per) * side + x, Y = ty + (b / per) * side + y;
