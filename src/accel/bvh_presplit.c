@@ -102,9 +102,9 @@ fr_error fr_presplit(const fr_mesh *m, aabb scene, float budget, double min_shar
   if (budget <= 0.0f || count == 0) return FR_OK;
   const size_t extra = (size_t)((double)budget * (double)count);
   float *ex = malloc(fr_mul_size(count, sizeof(float)));
-  int *cap = malloc(fr_mul_size(count, sizeof(int)));
-  if (!ex || !cap) {
-    free(ex); free(cap);
+  int *np = malloc(fr_mul_size(count, sizeof(int))); /* the pieces of each triangle: at most, then exactly */
+  if (!ex || !np) {
+    free(ex); free(np);
     return fr_fail(FR_ERR_NOMEM, "presplit: out of memory for %zu triangles", count);
   }
   double total = 0.0, box_area = 0.0;
@@ -115,40 +115,40 @@ fr_error fr_presplit(const fr_mesh *m, aabb scene, float budget, double min_shar
     ex[i] = excess((*boxes)[i], ar);
     float ratio = ar > 0.0f ? aabb_half_area((*boxes)[i]) / (2.0f * ar) : (float)MAX_PIECES;
     /* pieces beyond box area / (ratio x the ideal) would cut a part that fits its box */
-    cap[i] = ratio / FR_PRESPLIT_RATIO >= MAX_PIECES ? MAX_PIECES : (int)ceilf(ratio / FR_PRESPLIT_RATIO);
-    if (cap[i] < 1) cap[i] = 1;
+    np[i] = ratio / FR_PRESPLIT_RATIO >= MAX_PIECES ? MAX_PIECES : (int)ceilf(ratio / FR_PRESPLIT_RATIO);
+    if (np[i] < 1) np[i] = 1;
     total += ex[i];
     box_area += aabb_half_area((*boxes)[i]);
   }
-  if (total <= 0.0 || total < min_share * box_area) { free(ex); free(cap); return FR_OK; }
+  if (total <= 0.0 || total < min_share * box_area) { free(ex); free(np); return FR_OK; }
   /* pieces in proportion to the excess, rounded down (at most count + extra
-   * in all), each triangle's in cap[i] now */
+   * in all) */
   const double per = (double)extra / total;
   size_t pieces = 0;
   for (size_t i = 0; i < count; i++) {
     double want = (double)ex[i] * per;
     int k = 1 + (want >= MAX_PIECES - 1 ? MAX_PIECES - 1 : (int)want);
-    cap[i] = k < cap[i] ? k : cap[i];
-    pieces += (size_t)cap[i];
+    np[i] = k < np[i] ? k : np[i];
+    pieces += (size_t)np[i];
   }
   out_refs o = {malloc(fr_mul_size(pieces, sizeof(aabb))), malloc(fr_mul_size(pieces, sizeof(uint32_t))), 0};
   if (!o.boxes || !o.ids) {
-    free(ex); free(cap); free(o.boxes); free(o.ids);
+    free(ex); free(np); free(o.boxes); free(o.ids);
     return fr_fail(FR_ERR_NOMEM, "presplit: out of memory for %zu references", pieces);
   }
   for (size_t i = 0; i < count; i++) {
     const uint32_t id = (*ids)[i];
-    if (cap[i] == 1) {
+    if (np[i] == 1) {
       o.boxes[o.n] = (*boxes)[i];
       o.ids[o.n++] = id;
       continue;
     }
     const uint32_t *ix = m->idx + 3 * (size_t)id;
     vec3 v[3] = {v3_load(m->pos + 3 * (size_t)ix[0]), v3_load(m->pos + 3 * (size_t)ix[1]), v3_load(m->pos + 3 * (size_t)ix[2])};
-    split(v, id, (*boxes)[i], cap[i], scene, 0, &o);
+    split(v, id, (*boxes)[i], np[i], scene, 0, &o);
   }
   free(ex);
-  free(cap);
+  free(np);
   free(*boxes);
   free(*ids);
   *boxes = o.boxes;
