@@ -81,7 +81,7 @@ static void check_shadows_vs(const fr_scene *s, const fr_mft_batch *b, const fr_
         fr_mft_opts o = {corner != 0, shrink, corner == 2 ? fr_mft_opts_default().corner_cost : 0.0f};
         uint16_t occ[16];
         memset(occ, 0xAB, sizeof occ); /* poison: every frustum must be written */
-        isa_fns[i]->occluded(&s->bvh2, &o, b, T, occ);
+        isa_fns[i]->occluded(&s->bvh2_mft, &o, b, T, occ);
         if (first) {
           memcpy(ref, occ, sizeof ref);
           first = 0;
@@ -161,7 +161,7 @@ static void check_camera(const fr_scene *s, const fr_camera *cam, int x0, int y0
       if (!fr_isa_supported(isas[i])) continue;
       fr_mft_opts o = {corner != 0, 0, corner == 2 ? fr_mft_opts_default().corner_cost : 0.0f};
       memset(&h, 0xAB, sizeof h);
-      isa_fns[i]->intersect(&s->bvh2, &o, &b, &T, &h);
+      isa_fns[i]->intersect(&s->bvh2_mft, &o, &b, &T, &h);
       check_expand(isa_fns[i], &b, &T, &h);
       if (!first) {
         assert_memory_equal(&h, &ref, sizeof h);
@@ -478,7 +478,7 @@ static void soft_fallback(void **state) {
   w.threads = 1;
   fr_softshadow_opts so = {16, 0, FR_LIGHT_SETS_SPREAD};
   static float img[SZ * SZ * 3], vis_mft[SZ * SZ], vis_rays[SZ * SZ];
-  fr_mft_tracer mctx = {s, &s->bvh2, fr_mft_opts_default()};
+  fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
   ray_counter c = {fr_tracer_mft(&mctx), 0, 0};
   fr_tracer counted = {&c, counted_intersect, counted_occluded, counted_intersect_frusta, counted_occluded_frusta, 0};
   fr_workload_result r;

@@ -108,7 +108,7 @@ static void whitted_setup(fr_workload *w, fr_scene *s, const char *name, const f
 static void check_whitted_mft(fr_scene *s, const char *name, const fr_whitted_mats *mats) {
   fr_workload w;
   whitted_setup(&w, s, name, mats, 200, 150);
-  fr_mft_tracer mctx = {s, &s->bvh2, fr_mft_opts_default()};
+  fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
   checker c = {fr_tracer_mft(&mctx), s, 0, 0, 0, 0};
   fr_tracer t = {&c, check_intersect, check_occluded, check_intersect_frusta, NULL, 0};
   fr_workload_result r = fr_workload_run(&w, &t);

@@ -63,11 +63,41 @@ fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_le
   return FR_OK;
 }
 
+/* inner nodes of the tree at bi with leaves of up to max_leaf */
+static size_t count_inner(const fr_build_tree *t, int32_t bi, uint32_t max_leaf) {
+  const fr_build_node *n = &t->nodes[bi];
+  if (n->count <= max_leaf) return 0;
+  return 1 + count_inner(t, n->left, max_leaf) + count_inner(t, n->right, max_leaf);
+}
+
+fr_error fr_bvh2_shallow(const fr_build_tree *t, const fr_bvh2 *full, int max_leaf, fr_bvh2 *out) {
+  memset(out, 0, sizeof *out);
+  if (max_leaf < 1 || max_leaf > FR_BVH2_MAX_LEAF) return fr_fail(FR_ERR_ARG, "BVH2: leaf size %d", max_leaf);
+  size_t inner = count_inner(t, 0, (uint32_t)max_leaf);
+  if (!inner) inner = 1; /* the root a leaf: no node is used, but keep an array */
+  out->nodes = fr_alloc_aligned(fr_mul_size(inner, sizeof(fr_bvh2_node)), 64);
+  if (!out->nodes) return fr_fail(FR_ERR_NOMEM, "BVH2: out of memory");
+  memset(out->nodes, 0, inner * sizeof(fr_bvh2_node));
+  /* a leaf is a range of the build's leaf order, whatever the leaf size:
+   * the full tree's arrays serve both */
+  out->prims = full->prims;
+  out->tris = full->tris;
+  out->nprims = full->nprims;
+  out->borrowed = 1;
+  out->max_leaf = max_leaf;
+  out->bounds = t->nodes[0].box;
+  conv c = {t, out, (uint32_t)max_leaf};
+  out->root = convert(&c, 0);
+  return FR_OK;
+}
+
 void fr_bvh2_free(fr_bvh2 *b) {
   fr_free_aligned(b->nodes);
-  fr_free_aligned(b->prims);
-  fr_free_aligned(b->tris);
-  fr_free_aligned(b->spheres);
+  if (!b->borrowed) {
+    fr_free_aligned(b->prims);
+    fr_free_aligned(b->tris);
+    fr_free_aligned(b->spheres);
+  }
   memset(b, 0, sizeof *b);
 }
 

@@ -52,12 +52,17 @@ typedef struct fr_bvh2 {
   fr_sphere *spheres; /* a sphere tree (accel/sphere_bvh.h) has these instead */
   size_t nprims;
   int max_leaf;
+  int borrowed;      /* prims and tris belong to another tree (fr_bvh2_shallow) */
 } fr_bvh2;
 
 /* Leaves are cut where a subtree has at most max_leaf triangles (4: the
  * regular tree; more: the shallow tree the frusta kernels may prefer).
  * Without a mesh (m NULL) only the nodes and prims are made. */
 fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_leaf, fr_bvh2 *out);
+/* The tree of the same build with leaves of up to max_leaf triangles,
+ * sharing full's prims and triangles (full, made from t, must outlive it):
+ * only the nodes are its own. */
+fr_error fr_bvh2_shallow(const fr_build_tree *t, const fr_bvh2 *full, int max_leaf, fr_bvh2 *out);
 void fr_bvh2_free(fr_bvh2 *b);
 double fr_bvh2_sah(const fr_bvh2 *b);
 #endif

@@ -121,6 +121,7 @@ void fr_scene_release(fr_scene *s) {
   fr_mesh_free(&s->mesh);
   fr_spheres_free(&s->spheres);
   fr_bvh2_free(&s->sphere_bvh);
+  fr_bvh2_free(&s->bvh2_mft);
   fr_bvh2_free(&s->bvh2);
   fr_bvhn_free(&s->bvh4);
   fr_bvhn_free(&s->bvh8);
@@ -200,12 +201,13 @@ fr_error fr_scene_commit(fr_scene *s) {
   if (e) return e;
   s->skipped = m->ntris - n;
   e = fr_bvh2_from_build(&tree, m, FR_BUILD_MAX_LEAF, &s->bvh2);
+  if (!e) e = fr_bvh2_shallow(&tree, &s->bvh2, FR_MFT_LEAF, &s->bvh2_mft);
   if (!e) e = fr_bvhn_from_build(&tree, m, 4, &s->bvh4);
   if (!e) e = fr_bvhn_from_build(&tree, m, 8, &s->bvh8);
   if (!e) e = fr_sphere_bvh_build(&s->spheres, &s->sphere_bvh);
   fr_build_tree_free(&tree);
   if (e) {
-    fr_bvh2_free(&s->bvh2); fr_bvhn_free(&s->bvh4); fr_bvhn_free(&s->bvh8); fr_bvh2_free(&s->sphere_bvh);
+    fr_bvh2_free(&s->bvh2_mft); fr_bvh2_free(&s->bvh2); fr_bvhn_free(&s->bvh4); fr_bvhn_free(&s->bvh8); fr_bvh2_free(&s->sphere_bvh);
     return e;
   }
   s->bounds = aabb_merge(s->bounds, s->sphere_bvh.bounds);

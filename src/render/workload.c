@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "api/scene.h"
 #include "base/alloc.h"
 #include "base/rng.h"
 #include "base/timer.h"
@@ -370,7 +371,12 @@ static void mft_intersect_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_
 static unsigned mft_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t,
                                     uint16_t occ[FR_MFT_FRUSTA]) {
   const fr_mft_tracer *m = ctx;
-  return fr_mft_active()->occluded(m->bvh, &m->opts, b, t, occ);
+  return fr_mft_active()->occluded(m->shadow_bvh ? m->shadow_bvh : m->bvh, &m->opts, b, t, occ);
+}
+
+fr_mft_tracer fr_mft_tracer_of(const fr_scene *s, fr_mft_opts opts) {
+  fr_mft_tracer m = {s, &s->bvh2_mft, opts, &s->bvh2};
+  return m;
 }
 
 fr_tracer fr_tracer_mft(const fr_mft_tracer *ctx) {

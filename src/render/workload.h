@@ -91,9 +91,14 @@ fr_tracer fr_tracer_frusta(const fr_scene *s);
  * other ray as fr_tracer_frusta. The context must outlive the tracer. */
 typedef struct fr_mft_tracer {
   const fr_scene *scene;
-  const fr_bvh2 *bvh;
+  const fr_bvh2 *bvh;        /* camera frusta's tree */
   fr_mft_opts opts;
+  const fr_bvh2 *shadow_bvh; /* shadow frusta's (NULL: bvh) */
 } fr_mft_tracer;
+/* The scene's own trees: camera frusta through the shallow one (leaves of
+ * FR_MFT_LEAF), shadow frusta through the regular one (leaves of 4), where
+ * each measured fastest: see FR_MFT_LEAF. */
+fr_mft_tracer fr_mft_tracer_of(const fr_scene *s, fr_mft_opts opts);
 fr_tracer fr_tracer_mft(const fr_mft_tracer *ctx);
 
 /* The large-packet tracer: every call's rays in packets of side x side

@@ -143,7 +143,7 @@ int cmd_bench(int argc, char **argv) {
   fr_trace_options topt;
   fr_trace_options_default(&topt);
   fr_mft_opts mopt = fr_mft_opts_default();
-  int mft_leaf = FR_BUILD_MAX_LEAF, mft_no_fallback = 0;
+  int mft_leaf = FR_MFT_LEAF, mft_leaf_set = 0, mft_no_fallback = 0;
   fr_light_sets light_sets = FR_LIGHT_SETS_SPREAD;
   cli_whitted wo;
   cli_whitted_default(&wo);
@@ -175,6 +175,7 @@ int cmd_bench(int argc, char **argv) {
       } else if (!strcmp(a, "--mft-leaf")) {
         if (!cli_parse_int(val, 1, FR_BVH2_MAX_LEAF, &mft_leaf))
           return cli_error(CLI_USAGE_ERROR, "--mft-leaf wants 1..%d, got '%s'", FR_BVH2_MAX_LEAF, val);
+        mft_leaf_set = 1;
       } else if (!strcmp(a, "--prefetch")) {
         if (!strcmp(val, "auto")) topt.prefetch = -1;
         else if (!strcmp(val, "on") || !strcmp(val, "off")) topt.prefetch = !strcmp(val, "on");
@@ -245,14 +246,14 @@ int cmd_bench(int argc, char **argv) {
   /* multi-frusta tracing: the scene's binary BVH, or a shallower one */
   fr_bvh2 shallow;
   memset(&shallow, 0, sizeof shallow);
-  fr_mft_tracer mctx = {s, &s->bvh2, mopt};
-  if (want_mft && mft_leaf != FR_BUILD_MAX_LEAF) {
+  fr_mft_tracer mctx = fr_mft_tracer_of(s, mopt);
+  if (want_mft && mft_leaf_set) { /* --mft-leaf: one tree of that leaf size for camera and shadow frusta */
     if (fr_scene_build_bvh2(s, mft_leaf, &shallow)) { fr_scene_release(s); return cli_error(1, "%s", fr_last_error()); }
-    mctx.bvh = &shallow;
+    mctx.bvh = mctx.shadow_bvh = &shallow;
   }
   if (want_mft)
-    printf("mft_bvh leaf=%d inner=%zu leaves=%zu sah=%.2f corner_rays=%s corner_cost=%g shrink=%s fallback=%s\n", mctx.bvh->max_leaf,
-           mctx.bvh->nnodes, mctx.bvh->nleaves, fr_bvh2_sah(mctx.bvh), mopt.corner_rays ? "on" : "off",
+    printf("mft_bvh leaf=%d shadow_leaf=%d inner=%zu leaves=%zu sah=%.2f corner_rays=%s corner_cost=%g shrink=%s fallback=%s\n",
+           mctx.bvh->max_leaf, mctx.shadow_bvh->max_leaf, mctx.bvh->nnodes, mctx.bvh->nleaves, fr_bvh2_sah(mctx.bvh), mopt.corner_rays ? "on" : "off",
            (double)mopt.corner_cost, mopt.shrink ? "on" : "off", mft_no_fallback ? "off" : "on");
   fr_whitted_mats mats = {0};
   if ((all_wl || wk == FR_WL_WHITTED) && (rc = cli_whitted_setup(s, &wo, &mats, &w))) {

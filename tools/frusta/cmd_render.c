@@ -40,7 +40,7 @@ static int render_soft(fr_scene *s, fr_workload *w, const fr_softshadow_opts *so
   float *rimg = ref_out ? malloc(np * 3 * sizeof(float)) : NULL, *rvis = ref_out ? malloc(np * sizeof(float)) : NULL;
   int rc = 0;
   if (!img || !vis || (ref_out && (!rimg || !rvis))) { rc = cli_error(1, "out of memory for a %dx%d image", w->cam.width, w->cam.height); goto done; }
-  fr_mft_tracer ctx = {s, &s->bvh2, fr_mft_opts_default()};
+  fr_mft_tracer ctx = fr_mft_tracer_of(s, fr_mft_opts_default());
   fr_tracer t = mft ? fr_tracer_mft(&ctx) : fr_tracer_frusta(s);
   fr_workload_result r;
   if (fr_render_softshadow(w, &t, so, img, vis, &r)) { rc = cli_error(1, "%s", fr_last_error()); goto done; }
@@ -144,7 +144,7 @@ int cmd_render(int argc, char **argv) {
    * (the fastest measured, see README), or with --mft off or any of
    * --packet, --traversal, --cull: large packets of --packet x --packet */
   fr_lp_tracer lpc = {s, cli_lp_scene(s), wo.lp, wo.packet};
-  fr_mft_tracer mctx = {s, &s->bvh2, fr_mft_opts_default()};
+  fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
   if (w.kind == FR_WL_WHITTED && mft == 1 && wo.large_flags) {
     fr_whitted_mats_free(&mats); fr_scene_release(s); free(w.image);
     return cli_error(CLI_USAGE_ERROR, "--mft on and --packet/--traversal/--cull: large packets need --mft off");
