@@ -25,21 +25,39 @@ static uint32_t convert(conv *c, int32_t bi) {
   return self;
 }
 
+/* inner nodes of the tree at bi with leaves of up to max_leaf */
+static size_t count_inner(const fr_build_tree *t, int32_t bi, uint32_t max_leaf) {
+  const fr_build_node *n = &t->nodes[bi];
+  if (n->count <= max_leaf) return 0;
+  return 1 + count_inner(t, n->left, max_leaf) + count_inner(t, n->right, max_leaf);
+}
+
+/* out's nodes, root and bounds from the build tree; a leaf is a range of
+ * the build's leaf order (out's prims and tris), whatever its size */
+static fr_error make_nodes(const fr_build_tree *t, int max_leaf, fr_bvh2 *out) {
+  size_t inner = count_inner(t, 0, (uint32_t)max_leaf);
+  if (!inner) inner = 1; /* the root a leaf: no node is used, but keep an array */
+  out->nodes = fr_alloc_aligned(fr_mul_size(inner, sizeof(fr_bvh2_node)), 64);
+  if (!out->nodes) return fr_fail(FR_ERR_NOMEM, "BVH2: out of memory");
+  memset(out->nodes, 0, inner * sizeof(fr_bvh2_node));
+  out->max_leaf = max_leaf;
+  out->bounds = t->nodes[0].box;
+  conv c = {t, out, (uint32_t)max_leaf};
+  out->root = convert(&c, 0);
+  return FR_OK;
+}
+
 fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_leaf, fr_bvh2 *out) {
   memset(out, 0, sizeof *out);
   if (max_leaf < 1 || max_leaf > FR_BVH2_MAX_LEAF) return fr_fail(FR_ERR_ARG, "BVH2: leaf size %d", max_leaf);
-  size_t inner = t->nprims;
-  out->nodes = fr_alloc_aligned(fr_mul_size(inner, sizeof(fr_bvh2_node)), 64);
   out->prims = fr_alloc_aligned(fr_mul_size(t->nprims, sizeof(uint32_t)), 64);
   if (m) out->tris = fr_alloc_aligned(fr_mul_size(t->nprims, sizeof(fr_bvh2_tri)), 64);
-  if (!out->nodes || !out->prims || (m && !out->tris)) {
+  if (!out->prims || (m && !out->tris)) {
     fr_bvh2_free(out);
     return fr_fail(FR_ERR_NOMEM, "BVH2: out of memory");
   }
-  memset(out->nodes, 0, inner * sizeof(fr_bvh2_node));
   if (t->nprims) memcpy(out->prims, t->prims, t->nprims * sizeof(uint32_t));
   out->nprims = t->nprims;
-  out->max_leaf = max_leaf;
   for (size_t i = 0; m && i < t->nprims; i++) {
     fr_bvh2_tri *r = &out->tris[i];
     const uint32_t *ix = m->idx + 3 * (size_t)t->prims[i];
@@ -57,38 +75,21 @@ fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_le
     }
     r->pad[0] = r->pad[1] = 0;
   }
-  out->bounds = t->nodes[0].box;
-  conv c = {t, out, (uint32_t)max_leaf};
-  out->root = convert(&c, 0);
-  return FR_OK;
-}
-
-/* inner nodes of the tree at bi with leaves of up to max_leaf */
-static size_t count_inner(const fr_build_tree *t, int32_t bi, uint32_t max_leaf) {
-  const fr_build_node *n = &t->nodes[bi];
-  if (n->count <= max_leaf) return 0;
-  return 1 + count_inner(t, n->left, max_leaf) + count_inner(t, n->right, max_leaf);
+  fr_error e = make_nodes(t, max_leaf, out);
+  if (e) fr_bvh2_free(out);
+  return e;
 }
 
 fr_error fr_bvh2_shallow(const fr_build_tree *t, const fr_bvh2 *full, int max_leaf, fr_bvh2 *out) {
   memset(out, 0, sizeof *out);
   if (max_leaf < 1 || max_leaf > FR_BVH2_MAX_LEAF) return fr_fail(FR_ERR_ARG, "BVH2: leaf size %d", max_leaf);
-  size_t inner = count_inner(t, 0, (uint32_t)max_leaf);
-  if (!inner) inner = 1; /* the root a leaf: no node is used, but keep an array */
-  out->nodes = fr_alloc_aligned(fr_mul_size(inner, sizeof(fr_bvh2_node)), 64);
-  if (!out->nodes) return fr_fail(FR_ERR_NOMEM, "BVH2: out of memory");
-  memset(out->nodes, 0, inner * sizeof(fr_bvh2_node));
-  /* a leaf is a range of the build's leaf order, whatever the leaf size:
-   * the full tree's arrays serve both */
   out->prims = full->prims;
   out->tris = full->tris;
   out->nprims = full->nprims;
   out->borrowed = 1;
-  out->max_leaf = max_leaf;
-  out->bounds = t->nodes[0].box;
-  conv c = {t, out, (uint32_t)max_leaf};
-  out->root = convert(&c, 0);
-  return FR_OK;
+  fr_error e = make_nodes(t, max_leaf, out);
+  if (e) fr_bvh2_free(out);
+  return e;
 }
 
 void fr_bvh2_free(fr_bvh2 *b) {
