@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "api/scene.h"
+#include "base/alloc.h"
 #include "base/error.h"
 #include "base/vec3.h"
 #include "render/whitted_shade.h"
@@ -48,6 +49,11 @@ static void scene_defaults(const char *scene, const char **mirror, const char **
   else if (!strcmp(scene, "museum")) { *mirror = "museum5_0"; *glass = "museum5_1"; }
 }
 
+static uint32_t mat_index(const fr_scene *s, const fr_whitted_mats *m, uint32_t prim) {
+  uint32_t i = fr_scene_prim_material(s, prim);
+  return i == FR_INVALID_ID || i + 1 >= m->count ? (uint32_t)m->count - 1 : i;
+}
+
 fr_error fr_whitted_mats_build(const fr_scene *s, const char *mirror, const char *glass, fr_whitted_mats *out) {
   memset(out, 0, sizeof *out);
   fr_error err;
@@ -88,6 +94,14 @@ fr_error fr_whitted_mats_build(const fr_scene *s, const char *mirror, const char
   out->soa = malloc(FR_WM_FIELDS * out->count * sizeof *out->soa);
   if (!out->soa) { fr_whitted_mats_free(out); return fr_fail(FR_ERR_NOMEM, "out of memory for %zu materials", nm + 1); }
   fr_whitted_mats_soa(out);
+  out->ntris = fr_scene_triangle_count(s);
+  out->tri = malloc(fr_mul_size(out->ntris ? out->ntris : 1, sizeof *out->tri));
+  if (!out->tri) { fr_whitted_mats_free(out); return fr_fail(FR_ERR_NOMEM, "out of memory for %zu triangles", fr_scene_triangle_count(s)); }
+  for (size_t t = 0; t < out->ntris; t++) {
+    const float none[3] = {0, 0, 0}; /* the point matters for spheres only */
+    fr_scene_geometric_normal(s, (uint32_t)t, none, out->tri[t].ng);
+    out->tri[t].mat = (int32_t)mat_index(s, out, (uint32_t)t);
+  }
   return FR_OK;
 }
 
@@ -115,12 +129,8 @@ void fr_whitted_mats_soa(fr_whitted_mats *m) {
 void fr_whitted_mats_free(fr_whitted_mats *m) {
   free(m->mat);
   free(m->soa);
+  free(m->tri);
   memset(m, 0, sizeof *m);
-}
-
-static uint32_t mat_index(const fr_scene *s, const fr_whitted_mats *m, uint32_t prim) {
-  uint32_t i = fr_scene_prim_material(s, prim);
-  return i == FR_INVALID_ID || i + 1 >= m->count ? (uint32_t)m->count - 1 : i;
 }
 
 static const fr_whitted_mat *mat_of(const fr_scene *s, const fr_whitted_mats *m, uint32_t prim) {
@@ -258,7 +268,13 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
       S->mat[i] = 0;
       ng[0] = ng[1] = ng[2] = 0.0f;
       if (h->prim == FR_INVALID_ID) continue;
-      const float *o = S->cur[i].r.org, *d = S->cur[i].r.dir;
+      if (h->prim < w->mats->ntris) {
+        const fr_whitted_tri *r = &w->mats->tri[h->prim];
+        ng[0] = r->ng[0]; ng[1] = r->ng[1]; ng[2] = r->ng[2];
+        S->mat[i] = r->mat;
+        continue;
+      }
+      const float *o = S->cur[i].r.org, *d = S->cur[i].r.dir; /* a sphere: the normal is p - c */
       float pp[3] = {o[0] + d[0] * h->t, o[1] + d[1] * h->t, o[2] + d[2] * h->t};
       fr_scene_geometric_normal(sc, h->prim, pp, ng);
       S->mat[i] = (int32_t)mat_index(sc, w->mats, h->prim);

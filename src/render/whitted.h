@@ -31,10 +31,20 @@ typedef struct fr_whitted_mat {
 
 /* One entry per scene material, and one more (the last) for triangles
  * without a material. */
+/* What a hit on triangle t needs, in one 16-byte record: its geometric
+ * normal (v1 - v0) x (v2 - v0) and its material index. Read straight from
+ * the mesh, a hit cost two dependent loads and three vertex lines. */
+typedef struct fr_whitted_tri {
+  float ng[3];
+  int32_t mat;
+} fr_whitted_tri;
+
 typedef struct fr_whitted_mats {
   fr_whitted_mat *mat;
   size_t count;
-  float *soa; /* the same as the shading kernel reads it (render/whitted_shade.h) */
+  float *soa;          /* the same as the shading kernel reads it (render/whitted_shade.h) */
+  fr_whitted_tri *tri; /* one per scene triangle */
+  size_t ntris;
 } fr_whitted_mats;
 
 /* Which materials mirror and which refract. mirror and glass are
