@@ -29,8 +29,6 @@ typedef struct fr_whitted_mat {
   float ior;
 } fr_whitted_mat;
 
-/* One entry per scene material, and one more (the last) for triangles
- * without a material. */
 /* What a hit on triangle t needs, in one 16-byte record: its geometric
  * normal (v1 - v0) x (v2 - v0) and its material index. Read straight from
  * the mesh, a hit cost two dependent loads and three vertex lines. */
@@ -39,6 +37,8 @@ typedef struct fr_whitted_tri {
   int32_t mat;
 } fr_whitted_tri;
 
+/* One entry per scene material, and one more (the last) for triangles
+ * without a material; and the per-triangle records. */
 typedef struct fr_whitted_mats {
   fr_whitted_mat *mat;
   size_t count;

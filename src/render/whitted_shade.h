@@ -43,7 +43,7 @@ typedef struct fr_wshade_in {
   const fr_wray *ray;   /* 16 rays (lanes past `valid` are not read) */
   const fr_hit *hit;    /* their hits */
   const float *ng;      /* 3 per ray: geometric normal, not unit */
-  const int32_t *mat;   /* 16, aligned: material index (any valid index for a miss) */
+  const int32_t *mat;   /* per ray: material index (any valid index for a miss) */
   unsigned valid, hits; /* lanes present; lanes that hit */
   const float *mats;    /* the material table, FR_WM_FIELDS x mat_count */
   size_t mat_count;
