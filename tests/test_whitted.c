@@ -115,6 +115,13 @@ static void check_whitted_mft(fr_scene *s, const char *name, const fr_whitted_ma
   assert_int_equal(r.rays, (uint64_t)(c.rays + c.occluded_rays + c.frusta_rays));
   /* 12 x 9 blocks of 16x16 as frusta; the partial ones' camera rays, and the secondaries, as rays */
   assert_int_equal(c.frusta_rays, 12 * 9 * 256);
+  /* the stage times: every stage ran, and (one thread) they add up to the tiles' time, within the run's */
+  double staged = 0.0;
+  for (int i = 0; i < FR_STAGES; i++) {
+    assert_true(r.stage[i] > 0.0);
+    staged += r.stage[i];
+  }
+  assert_true(staged <= r.seconds * 1.0001 + 1e-6 && staged >= 0.5 * r.seconds);
   assert_true(c.rays > 200 * 150 - 12 * 9 * 256 && c.occluded_rays > 0);
   print_message("%s mft: %ld camera rays in frusta, %ld closest-hit rays, %ld shadow rays, %ld disagreements (all at "
                 "edges or range ends)\n", name, c.frusta_rays, c.rays, c.occluded_rays, c.disagree);

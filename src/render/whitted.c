@@ -6,6 +6,7 @@
 #include "api/scene.h"
 #include "base/alloc.h"
 #include "base/error.h"
+#include "base/timer.h"
 #include "base/vec3.h"
 #include "render/whitted_shade.h"
 #include "render/workload.h"
@@ -168,6 +169,7 @@ typedef struct fr_whitted_scratch {
   float *ng;                  /* a generation's geometric normals (3 per ray), not unit */
   int32_t *mat;               /* ... and material indices */
   vec3 colour[WT_PIX];
+  double stage[FR_STAGES];    /* seconds, over this thread's tiles */
 } fr_whitted_scratch;
 
 /* realloc that keeps the old block on failure */
@@ -192,6 +194,11 @@ static int reserve(fr_whitted_scratch *S, size_t n) {
 }
 
 fr_whitted_scratch *fr_whitted_scratch_new(void) { return calloc(1, sizeof(fr_whitted_scratch)); }
+
+void fr_whitted_scratch_stages(const fr_whitted_scratch *S, double stage[FR_STAGES]) {
+  if (S)
+    for (int i = 0; i < FR_STAGES; i++) stage[i] += S->stage[i];
+}
 
 void fr_whitted_scratch_free(fr_whitted_scratch *S) {
   if (!S) return;
@@ -219,6 +226,9 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
   const fr_scene *sc = w->scene;
   const int max_depth = w->max_depth > 0 ? w->max_depth : 4;
   if (!reserve(S, 2 * WT_PIX)) return 0;
+  /* a few clock reads per generation: stage times for bench (fr_workload_result) */
+  const double t_tile = fr_seconds();
+  double traced_s = 0.0;
   size_t n = 0, traced = 0;
   if (t->intersect_frusta && w->camera_set && side == WT) {
     /* a multi-frusta tracer traces the camera rays of every full 16x16
@@ -254,7 +264,13 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
   for (int i = 0; i < WT_PIX; i++) S->colour[i] = v3(0, 0, 0);
   uint64_t rays = 0;
   for (int depth = 0; n > 0; depth++) {
+    const double t_gen = fr_seconds();
     trace_runs(t, S->cur + traced, S->rays + traced, S->hits + traced, NULL, n - traced);
+    const double t_traced = fr_seconds();
+    /* the camera stage runs from the tile's start: making the rays is part of it */
+    const double dt = depth == 0 ? t_traced - t_tile : t_traced - t_gen;
+    S->stage[depth == 0 ? FR_STAGE_CAMERA : FR_STAGE_SECONDARY] += dt;
+    traced_s += dt;
     traced = 0;
     rays += n;
     size_t ns = 0, nn = 0;
@@ -316,7 +332,11 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
       }
     }
     /* shadow rays, packet by packet (they follow their block's order) */
+    const double t_shadow = fr_seconds();
     trace_runs(t, S->shadow, S->rays, NULL, S->occ, ns);
+    const double ds = fr_seconds() - t_shadow;
+    S->stage[FR_STAGE_SHADOW] += ds;
+    traced_s += ds;
     rays += ns;
     for (size_t i = 0; i < ns; i++)
       if (!S->occ[i]) S->colour[S->shadow[i].pix] = v3_add(S->colour[S->shadow[i].pix], v3_load(S->shadow[i].w));
@@ -328,6 +348,7 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
     for (size_t i = 0; i < nn; i++) S->cur[count[S->next[i].key]++] = S->next[i];
     n = nn;
   }
+  S->stage[FR_STAGE_SHADE] += fr_seconds() - t_tile - traced_s;
   if (w->image)
     for (int i = 0; i < WT_PIX; i++) {
       int X = tx + i % WT, Y = ty + i / WT;

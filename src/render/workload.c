@@ -291,7 +291,7 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
   /* the ray sets of this frame, shared by every tile */
   fr_workload run = *w0, *w = &run;
   fr_mft_sets *sets = fr_alloc_aligned(2 * sizeof(fr_mft_sets), 64);
-  if (!sets) { fr_workload_result none = {0, 0.0}; return none; }
+  if (!sets) { fr_workload_result none = {0, 0.0, {0}}; return none; }
   float e1[3] = {w->view.area_e1.x, w->view.area_e1.y, w->view.area_e1.z};
   float e2[3] = {w->view.area_e2.x, w->view.area_e2.y, w->view.area_e2.z};
   fr_mft_sets_light(&sets[0], e1, e2, w->seed, w->light_sets_kind);
@@ -302,6 +302,7 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
   const int tiles_x = (w->cam.width + tile - 1) / tile, tiles_y = (w->cam.height + tile - 1) / tile;
   const int ntiles = tiles_x * tiles_y;
   uint64_t total = 0;
+  double stage[FR_STAGES] = {0};
   int done = 0, last_pct = -1;
   double t0 = fr_seconds();
 #pragma omp parallel num_threads(w->threads) reduction(+ : total)
@@ -327,12 +328,15 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
       }
     }
     free(B);
+#pragma omp critical
+    fr_whitted_scratch_stages(WS, stage);
     fr_whitted_scratch_free(WS);
 #ifdef FRUSTA_COUNTERS
     fr_counters_flush();
 #endif
   }
-  fr_workload_result r = {total, fr_seconds() - t0};
+  fr_workload_result r = {total, fr_seconds() - t0, {0}};
+  memcpy(r.stage, stage, sizeof stage);
   if (w->progress && last_pct >= 0) fprintf(stderr, "\n");
   fr_free_aligned(sets);
   return r;

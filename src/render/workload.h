@@ -73,7 +73,18 @@ typedef struct fr_workload {
   const fr_mft_sets *camera_set;  /* the 4x4 pixels of a block */
 } fr_workload;
 
-typedef struct fr_workload_result { uint64_t rays; double seconds; } fr_workload_result;
+/* Where a Whitted frame's time goes, in seconds summed over the threads:
+ * the camera rays (made and traced: frusta make their own), the shadow
+ * rays, the reflection and refraction rays, and the rest of the tiles'
+ * time, the renderer's own (hits' normals and materials, shading, new
+ * rays), which is the same code whatever the tracer. */
+typedef enum fr_wl_stage { FR_STAGE_CAMERA, FR_STAGE_SHADOW, FR_STAGE_SECONDARY, FR_STAGE_SHADE, FR_STAGES } fr_wl_stage;
+
+typedef struct fr_workload_result {
+  uint64_t rays;
+  double seconds;
+  double stage[FR_STAGES]; /* the Whitted workload only (else 0) */
+} fr_workload_result;
 
 fr_workload_result fr_workload_run(const fr_workload *w, const fr_tracer *t);
 
@@ -116,5 +127,7 @@ fr_tracer fr_tracer_lp(const fr_lp_tracer *ctx);
 typedef struct fr_whitted_scratch fr_whitted_scratch;
 fr_whitted_scratch *fr_whitted_scratch_new(void);
 void fr_whitted_scratch_free(fr_whitted_scratch *s);
+/* Adds the time s's tiles spent in each stage to stage[]. */
+void fr_whitted_scratch_stages(const fr_whitted_scratch *s, double stage[FR_STAGES]);
 uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_scratch *s, int tx, int ty);
 #endif

@@ -59,6 +59,7 @@ typedef struct bench_run {
   fr_lp_tracer lpc;   /* large packets: the tracer's context */
   fr_tracer t;
   double secs[64];
+  double stage[64][FR_STAGES]; /* Whitted: each repetition's stage times */
   uint64_t rays;
   fr_counters c;      /* summed over the repetitions */
 } bench_run;
@@ -73,6 +74,17 @@ static void report(const fr_workload *w0, const bench_run *r, const char *scene,
   printf("scene=%s tris=%zu workload=%s tracer=%s mode=%s threads=%d rays=%llu seconds=%.4f mrays=%.2f median_seconds=%.4f median_mrays=%.2f\n",
          scene, tris, fr_workload_name(w0->kind), tracer, mode, w0->threads, (unsigned long long)rays, best,
          (double)rays / best * 1e-6, med, (double)rays / med * 1e-6);
+  if (w0->kind == FR_WL_WHITTED) {
+    /* the stages of the fastest repetition, in thread-seconds: which part of
+     * a Whitted frame the tracer speeds up, and how much is the renderer's */
+    int b = 0;
+    for (int i = 1; i < repeat; i++)
+      if (r->secs[i] < r->secs[b]) b = i;
+    const double *st = r->stage[b];
+    printf("stages tracer=%s mode=%s workload=%s camera_s=%.4f shadow_s=%.4f secondary_s=%.4f shade_s=%.4f\n", tracer,
+           mode, fr_workload_name(w0->kind), st[FR_STAGE_CAMERA], st[FR_STAGE_SHADOW], st[FR_STAGE_SECONDARY],
+           st[FR_STAGE_SHADE]);
+  }
   fr_counters c = r->c;
   if (fr_counters_enabled() && c.rays)
     printf("counters tracer=%s mode=%s workload=%s per_ray nodes=%.2f box_tests=%.2f leaves=%.2f tri_tests=%.2f\n", tracer, mode,
@@ -310,6 +322,7 @@ int cmd_bench(int argc, char **argv) {
         fr_counters c = fr_counters_read();
         fr_counters_add(&r->c, &c);
         r->secs[rep] = res.seconds;
+        memcpy(r->stage[rep], res.stage, sizeof res.stage);
         r->rays = res.rays;
       }
     fr_scene_set_bvh_width(s, width);
