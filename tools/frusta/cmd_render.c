@@ -19,14 +19,15 @@ static int onoff(const char *flag, const char *val, int *out) {
   return 0;
 }
 
-/* Mean absolute difference of two visibility images over the pixels that hit. */
-static double vis_mae(const float *a, const float *b, const float *img, size_t n) {
+/* Mean absolute difference of two images of ch channels per pixel, over
+ * the n pixels that hit (not background in the RGB image img). */
+static double mae(const float *a, const float *b, int ch, const float *img, size_t n) {
   double sum = 0.0;
   size_t cnt = 0;
   for (size_t i = 0; i < n; i++) {
     if (img[3 * i] == 0.05f && img[3 * i + 1] == 0.05f && img[3 * i + 2] == 0.05f) continue; /* background */
-    sum += fabs((double)a[i] - (double)b[i]);
-    cnt++;
+    for (int c = 0; c < ch; c++) sum += fabs((double)a[(size_t)ch * i + c] - (double)b[(size_t)ch * i + c]);
+    cnt += (size_t)ch;
   }
   return cnt ? sum / (double)cnt : 0.0;
 }
@@ -58,7 +59,7 @@ static int render_soft(fr_scene *s, fr_workload *w, const fr_softshadow_opts *so
     if (fr_render_softshadow(&rw, &t, &ro, rimg, rvis, &r)) { rc = cli_error(1, "%s", fr_last_error()); goto done; }
     if (fr_image_write(ref_out, w->cam.width, w->cam.height, rimg)) { rc = cli_error(1, "%s", fr_last_error()); goto done; }
     printf("reference light_samples=256 filter=off -> %s\nmae_visibility=%.4f mae_rgb=%.4f\n", ref_out,
-           vis_mae(vis, rvis, rimg, np), vis_mae(img, rimg, rimg, 3 * np) );
+           mae(vis, rvis, 1, rimg, np), mae(img, rimg, 3, rimg, np));
   }
 done:
   free(img); free(vis); free(rimg); free(rvis);

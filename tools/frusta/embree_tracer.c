@@ -133,7 +133,7 @@ int ebr_occluded1(ebr_scene *e, const fr_ray *r) {
   static void intersect_p##W(ebr_scene *e, struct RTCIntersectContext *ctx, const fr_ray *r, fr_hit *h, size_t n) { \
     for (size_t b = 0; b < n; b += W) {                                                                   \
       struct RTCRayHit##W rh;                                                                             \
-      int valid[W];                                                                                       \
+      int valid[W] __attribute__((aligned(64))); /* aligned as the packet: Embree loads it so */          \
       for (int i = 0; i < W; i++) {                                                                       \
         size_t k = b + (size_t)i < n ? b + (size_t)i : b;                                                 \
         valid[i] = b + (size_t)i < n ? -1 : 0;                                                            \
@@ -152,7 +152,7 @@ int ebr_occluded1(ebr_scene *e, const fr_ray *r) {
   static void occluded_p##W(ebr_scene *e, struct RTCIntersectContext *ctx, const fr_ray *r, uint8_t *o, size_t n) { \
     for (size_t b = 0; b < n; b += W) {                                                                   \
       struct RTCRay##W ry;                                                                                \
-      int valid[W];                                                                                       \
+      int valid[W] __attribute__((aligned(64))); /* aligned as the packet: Embree loads it so */          \
       for (int i = 0; i < W; i++) {                                                                       \
         size_t k = b + (size_t)i < n ? b + (size_t)i : b;                                                 \
         valid[i] = b + (size_t)i < n ? -1 : 0;                                                            \
