@@ -37,6 +37,20 @@
 #define GUARD 0x1p-19f   /* rounding allowance of a corner-ray dot product, relative to |d| |E| */
 #define STACK 256
 #define TINY 1e-18f
+/* When a frustum's bounds shrink to its active rays. Bounds made from more
+ * rays still hold the rest, so the choice is free. After every triangle
+ * that occludes some of its rays (the paper's CR), a frustum could shrink up
+ * to 15 times, and the reductions and rebuilt bounds cost more than they
+ * saved where a batch's rays end in a few large occluders (interleaved A/B,
+ * soft16 spread, shrinking off against on: conference 1.075x, sibenik
+ * 1.08x, kitchen 1.02x) but saved where they end a few at a time in fine
+ * geometry and the traversal goes on long (dragon 0.89x). So a frustum
+ * shrinks once half the rays its bounds were made from are gone (at most
+ * four times), and after every occlusion once its batch has fetched more
+ * than EAGER_FETCHED triangles (dragon's batches fetch ~110, conference's
+ * and sibenik's ~15, kitchen's ~60). */
+#define SHRINK_AT 2
+#define EAGER_FETCHED 64u
 
 /* The 16 frusta in structure-of-arrays form; lane f is frustum f. */
 typedef struct frusta {
@@ -59,6 +73,7 @@ typedef struct frusta {
   float rd[16][3][16] __attribute__((aligned(64)));
   unsigned rd_ready;
   unsigned cull_seen, cull_gone; /* frustum-triangle pairs the corner-ray cull saw and removed */
+  int bound_rays[16];            /* the rays its bounds were last made from (see SHRINK_AT) */
   int bounded;
   const fr_mft_set *set[16];
 } frusta;
@@ -144,6 +159,7 @@ static void frusta_bounds(frusta *F, const fr_mft_sets *T, unsigned lanes, const
 
 static void frusta_setup(frusta *F, const fr_mft_batch *B, const fr_mft_sets *T, unsigned valid, int bounded) {
   F->rd_ready = 0;
+  for (int f = 0; f < 16; f++) F->bound_rays[f] = 16;
   F->cull_seen = 2; /* a prior: half culled */
   F->cull_gone = 1;
   memset(F->pos, 0, sizeof F->pos);
@@ -391,8 +407,10 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
           if (!active[f]) {
             alive &= ~(1u << f);
             m &= ~(1u << f);
-          } else if (opt->shrink) {
+          } else if (opt->shrink &&
+                     (fetched > EAGER_FETCHED || SHRINK_AT * __builtin_popcount(active[f]) <= F.bound_rays[f])) {
             shrink |= 1u << f;
+            F.bound_rays[f] = __builtin_popcount(active[f]);
           }
         }
         /* a frustum's bounds next serve the next triangle: shrink the ones
