@@ -5,8 +5,10 @@
  * Node: both child boxes against all 16 frusta by interval arithmetic over
  * each frustum's box of ray directions (§4.1). An axis whose direction
  * interval contains 0 gets the straddling bound (the paper's "zero-interval
- * fix"); bounded frusta (shadows) are also tested with the box of the volume
- * they sweep. Nearer child first, by how many frusta enter it first.
+ * fix"). Nearer child first, by how many frusta enter it first. (A test of
+ * the box a bounded frustum sweeps, tried on shadow frusta, never culled a
+ * box the interval test kept: with t bounded by tfar, the interval test
+ * implies it on every axis.)
  *
  * Leaf, per triangle: for all 16 frusta at once, the three edge cross
  * products seen from each frustum's origin, then the corner rays against the
@@ -63,8 +65,6 @@ typedef struct frusta {
    * rl = 1/(the smallest); where they straddle 0, rs = 1/dhi > 0, rl = 1/dlo < 0 */
   float rs[3][16] __attribute__((aligned(64)));
   float rl[3][16] __attribute__((aligned(64)));
-  float vlo[3][16] __attribute__((aligned(64)));  /* box of the swept volume (bounded frusta) */
-  float vhi[3][16] __attribute__((aligned(64)));
   float corner[4][3][16] __attribute__((aligned(64)));
   float guard[16] __attribute__((aligned(64)));   /* GUARD * the largest |component| of a direction */
   unsigned pos[3], straddle[3]; /* lanes with directions > 0 / straddling 0, per axis */
@@ -74,7 +74,6 @@ typedef struct frusta {
   unsigned rd_ready;
   unsigned cull_seen, cull_gone; /* frustum-triangle pairs the corner-ray cull saw and removed */
   int bound_rays[16];            /* the rays its bounds were last made from (see SHRINK_AT) */
-  int bounded;
   const fr_mft_set *set[16];
 } frusta;
 
@@ -119,7 +118,7 @@ static void frusta_bounds(frusta *F, const fr_mft_sets *T, unsigned lanes, const
   const vpf zero = vp(0.0f), one = vp(1.0f), tiny = vp(TINY), ntiny = vp(-TINY);
   vpf big = zero;
   for (int a = 0; a < 3; a++) {
-    vpf s = vp_load(F->s[a]), o = vp_load(F->o[a]);
+    vpf s = vp_load(F->s[a]);
     /* rounding is monotonic: s + lo <= s + delta_k <= s + hi for the rays' own sums */
     vpf dlo = vp_add(s, vp_load(R->lo[a])), dhi = vp_add(s, vp_load(R->hi[a]));
     big = vp_max(big, vp_max(vp_abs(dlo), vp_abs(dhi)));
@@ -133,19 +132,6 @@ static void frusta_bounds(frusta *F, const fr_mft_sets *T, unsigned lanes, const
     vpf rl = vp_select(pos, vp_max(dlo, tiny), vp_select(vpm_bits_to(nb), vp_min(dhi, ntiny), vp_min(dlo, ntiny)));
     store_lanes(F->rs[a], m, vp_div(one, rs));
     store_lanes(F->rl[a], m, vp_div(one, rl));
-    if (F->bounded) {
-      /* o + t d over t in [tnear, tfar], d in [dlo, dhi]: bilinear, so the
-       * extremes are at the four combinations */
-      vpf t0 = vp_load(F->tnear), t1 = vp_load(F->tfar);
-      vpf p0 = vp_mul(t0, dlo), p1 = vp_mul(t0, dhi), p2 = vp_mul(t1, dlo), p3 = vp_mul(t1, dhi);
-      vpf mn = vp_min(vp_min(p0, p1), vp_min(p2, p3)), mx = vp_max(vp_max(p0, p1), vp_max(p2, p3));
-      vpf slack = vp_mul(vp_add(vp_abs(o), vp_max(vp_abs(mn), vp_abs(mx))), vp(0x1p-20f));
-      store_lanes(F->vlo[a], m, vp_sub(vp_add(o, mn), slack));
-      store_lanes(F->vhi[a], m, vp_add(vp_add(o, mx), slack));
-    } else {
-      store_lanes(F->vlo[a], m, vp(-INFINITY));
-      store_lanes(F->vhi[a], m, vp(INFINITY));
-    }
   }
   for (int j = 0; j < 4; j++) {
     vpf ca = vp_load(j & 1 ? R->amax : R->amin), cb = vp_load(j & 2 ? R->bmax : R->bmin);
@@ -157,14 +143,13 @@ static void frusta_bounds(frusta *F, const fr_mft_sets *T, unsigned lanes, const
   store_lanes(F->guard, m, vp_mul(vp(GUARD), big));
 }
 
-static void frusta_setup(frusta *F, const fr_mft_batch *B, const fr_mft_sets *T, unsigned valid, int bounded) {
+static void frusta_setup(frusta *F, const fr_mft_batch *B, const fr_mft_sets *T, unsigned valid) {
   F->rd_ready = 0;
   for (int f = 0; f < 16; f++) F->bound_rays[f] = 16;
   F->cull_seen = 2; /* a prior: half culled */
   F->cull_gone = 1;
   memset(F->pos, 0, sizeof F->pos);
   memset(F->straddle, 0, sizeof F->straddle);
-  F->bounded = bounded;
   for (int f = 0; f < 16; f++) {
     int lane_valid = (valid >> f) & 1;
     for (int a = 0; a < 3; a++) {
@@ -187,7 +172,6 @@ static void frusta_setup(frusta *F, const fr_mft_batch *B, const fr_mft_sets *T,
 FR_INLINE unsigned box_test(const frusta *F, const fr_bvh2_node *n, int k, unsigned m, vpf *tn_out) {
   const float *lo[3] = {n->lo_x, n->lo_y, n->lo_z}, *hi[3] = {n->hi_x, n->hi_y, n->hi_z};
   vpf tn = vp_load(F->tnear), tf = vp_load(F->tfar);
-  unsigned vol = 0xFFFFu;
   for (int a = 0; a < 3; a++) {
     vpf blo = vp(lo[a][k]), bhi = vp(hi[a][k]), o = vp_load(F->o[a]);
     vpf nlo = vp_sub(blo, o), nhi = vp_sub(bhi, o);
@@ -206,11 +190,9 @@ FR_INLINE unsigned box_test(const frusta *F, const fr_bvh2_node *n, int k, unsig
     }
     tn = vp_max(tn, enter);
     tf = vp_min(tf, leave);
-    if (F->bounded)
-      vol &= vpm_bits(vpm_and(vp_le(vp_load(F->vlo[a]), bhi), vp_ge(vp_load(F->vhi[a]), blo)));
   }
   *tn_out = tn;
-  return m & vol & vpm_bits(vp_le(tn, vp_mul(tf, vp(ROUND_UP))));
+  return m & vpm_bits(vp_le(tn, vp_mul(tf, vp(ROUND_UP))));
 }
 
 /* Per-leaf scratch: the cross products and plane distances of one triangle
@@ -374,7 +356,7 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
   FR_COUNT(mft_batches, 1);
   FR_COUNT(rays, 16 * __builtin_popcount(valid));
   if (!valid || !b->nodes) return 0;
-  frusta_setup(&F, B, T, valid, 1);
+  frusta_setup(&F, B, T, valid);
   unsigned fetched = 0;
   unsigned active[16];
   for (int f = 0; f < 16; f++) active[f] = (valid >> f) & 1 ? 0xFFFFu : 0;
@@ -443,7 +425,7 @@ static void intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft
   FR_COUNT(mft_batches, 1);
   FR_COUNT(rays, 16 * __builtin_popcount(valid));
   if (!valid || !b->nodes) return;
-  frusta_setup(&F, B, T, valid, 0);
+  frusta_setup(&F, B, T, valid);
   entry stack[STACK];
   int sp = 0;
   stack[sp++] = (entry){b->root, valid, NULL, 0};
