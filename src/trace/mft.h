@@ -15,8 +15,9 @@
  *
  * Every delta is a * e1 + b * e2 with the ray's 2D parameters (a, b), so the
  * four corner rays of a frustum are the corners of the (a, b) box of its
- * rays; after a leaf occludes some shadow rays they shrink to the box of the
- * rays still active (the paper's "CR" shrinking, §5.3).
+ * rays; once a leaf has occluded enough of a frustum's shadow rays they
+ * shrink to the box of the rays still active (the paper's "CR" shrinking,
+ * §5.3; when: SHRINK_AT in mft_traverse.c).
  */
 #ifndef FR_TRACE_MFT_H
 #define FR_TRACE_MFT_H

@@ -389,10 +389,12 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
           if (!active[f]) {
             alive &= ~(1u << f);
             m &= ~(1u << f);
-          } else if (opt->shrink &&
-                     (fetched > EAGER_FETCHED || SHRINK_AT * __builtin_popcount(active[f]) <= F.bound_rays[f])) {
-            shrink |= 1u << f;
-            F.bound_rays[f] = __builtin_popcount(active[f]);
+          } else if (opt->shrink) {
+            const int left_rays = __builtin_popcount(active[f]);
+            if (fetched > EAGER_FETCHED || SHRINK_AT * left_rays <= F.bound_rays[f]) {
+              shrink |= 1u << f;
+              F.bound_rays[f] = left_rays;
+            }
           }
         }
         /* a frustum's bounds next serve the next triangle: shrink the ones
