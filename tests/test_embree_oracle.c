@@ -56,12 +56,13 @@ static size_t make_rays(const fr_scene *s, fr_ray *rays, size_t cap) {
   return n;
 }
 
-/* The packet modes through the stream calls, at every ISA: against Embree's
+/* The packet and ray-stream modes through the stream calls, at every ISA: against Embree's
  * answers eh/eo. Returns the most disagreements (closest + any) of one mode
  * at one ISA. */
 static long check_packet_modes(fr_scene *s, const fr_ray *rays, size_t n, const fr_hit *eh, const uint8_t *eo) {
-  static const fr_trace_mode modes[] = {FR_TRACE_PACKET8, FR_TRACE_PACKET16, FR_TRACE_HYBRID16, FR_TRACE_AUTO};
-  static const char *names[] = {"packet8", "packet16", "hybrid16", "auto"};
+  static const fr_trace_mode modes[] = {FR_TRACE_PACKET8, FR_TRACE_PACKET16, FR_TRACE_HYBRID16, FR_TRACE_AUTO,
+                                        FR_TRACE_RAYSTREAM};
+  static const char *names[] = {"packet8", "packet16", "hybrid16", "auto", "raystream"};
   fr_hit *h = malloc(n * sizeof *h);
   uint8_t *occ = malloc(n);
   long total = 0;
@@ -70,7 +71,7 @@ static long check_packet_modes(fr_scene *s, const fr_ray *rays, size_t n, const 
   for (int isa = 0; isa < 3; isa++) {
     if (!fr_isa_supported((fr_isa)isa)) continue;
     fr_set_isa((fr_isa)isa);
-    for (int m = 0; m < 4; m++) {
+    for (int m = 0; m < 5; m++) {
       fr_trace_options o;
       fr_trace_options_default(&o);
       o.mode = modes[m];

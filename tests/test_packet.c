@@ -68,6 +68,7 @@ static const config configs[] = {
     {"hybrid16/bvh8", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 0}, {"packet16/mailbox", FR_TRACE_PACKET16, 0, 4, 1, 1, 1, 0},
     {"packet16/no-aa", FR_TRACE_PACKET16, 0, 4, 0, 0, 1, 0}, {"packet16/no-ia", FR_TRACE_PACKET16, 0, 4, 0, 1, 0, 0},
     {"auto", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0},
+    {"raystream", FR_TRACE_RAYSTREAM, 7, 4, 0, 1, 1, 0},
     /* prefetching, which these small scenes leave off by default */
     {"hybrid16/bvh8/prefetch", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 1},
 };
@@ -251,6 +252,53 @@ static void test_leaf_against_scalar(void **st) {
   assert_true(hits > 500);
 }
 
+/* Ray streams (FR_TRACE_RAYSTREAM): one call over a long stream of every
+ * kind of ray, octants mixed, some invalid, at both BVH widths and every ISA,
+ * must give each ray exactly the single-ray kernel's any-hit answer: the
+ * stream runs the same box and triangle tests per ray, only in another order. */
+static void test_raystream(void **st) {
+  (void)st;
+  fr_rng r = fr_rng_seed(31, 5);
+  vec3 center = v3(3.0f, -2.0f, 1.0f);
+  float size = 2.0f;
+  scene_data sd = make_scene(&r, 3000, center, size);
+  fr_scene *s = commit_scene(&sd);
+  enum { N = 16 * 150 };
+  static fr_ray rays[N];
+  static uint8_t occ[N];
+  int expect[2][N];
+  for (int p = 0; p < N / 16; p++) make_packet(&r, p % KIND_COUNT, center, size, &sd, rays + 16 * p);
+  rays[17].dir[1] = NAN;
+  rays[40].tnear = 5.0f; rays[40].tfar = 1.0f;
+  long occluded = 0;
+  for (int wi = 0; wi < 2; wi++) {
+    int width = wi ? 8 : 4;
+    assert_int_equal(fr_scene_set_bvh_width(s, width), FR_OK);
+    assert_int_equal(fr_set_isa(FR_ISA_SCALAR), FR_OK);
+    for (int i = 0; i < N; i++) expect[wi][i] = fr_occluded1(s, &rays[i]);
+    for (int isa = 0; isa < 3; isa++) {
+      if (!fr_isa_supported((fr_isa)isa)) continue;
+      assert_int_equal(fr_set_isa((fr_isa)isa), FR_OK);
+      fr_trace_options o;
+      fr_trace_options_default(&o);
+      o.mode = FR_TRACE_RAYSTREAM;
+      assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+      memset(occ, 0x5A, sizeof occ);
+      fr_occluded_stream(s, rays, occ, N);
+      for (int i = 0; i < N; i++)
+        if (occ[i] != expect[wi][i])
+          fail_msg("raystream width %d isa %d ray %d: occluded %d vs single %d", width, isa, i, occ[i], expect[wi][i]);
+    }
+  }
+  for (int i = 0; i < N; i++) occluded += expect[1][i];
+  print_message("%d rays, %ld occluded, raystream = single at both widths\n", N, occluded);
+  assert_true(occluded > N / 10 && occluded < N - N / 10);
+  assert_int_equal(expect[1][17], 0);
+  assert_int_equal(expect[1][40], 0);
+  fr_scene_release(s);
+  free_scene(&sd);
+}
+
 /* The option checks of the API. */
 static void test_options(void **st) {
   (void)st;
@@ -284,6 +332,7 @@ int main(void) {
       cmocka_unit_test(test_packets_far),
       cmocka_unit_test(test_packets_tiny),
       cmocka_unit_test(test_leaf_against_scalar),
+      cmocka_unit_test(test_raystream),
       cmocka_unit_test(test_options),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -18,7 +18,7 @@ void fr_trace_options_default(fr_trace_options *o) {
 
 fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o) {
   if (!s || !o) return fr_fail(FR_ERR_ARG, "fr_scene_set_trace_options: NULL argument");
-  if (o->mode < FR_TRACE_AUTO || o->mode > FR_TRACE_HYBRID16) return fr_fail(FR_ERR_ARG, "unknown trace mode %d", (int)o->mode);
+  if (o->mode < FR_TRACE_AUTO || o->mode > FR_TRACE_RAYSTREAM) return fr_fail(FR_ERR_ARG, "unknown trace mode %d", (int)o->mode);
   if (o->hybrid_threshold < 0 || o->hybrid_threshold > 16)
     return fr_fail(FR_ERR_ARG, "hybrid threshold %d (0..16)", o->hybrid_threshold);
   if (o->packet_bvh_width != 4 && o->packet_bvh_width != 8)
@@ -153,7 +153,7 @@ static int group_plan(const fr_scene *s, size_t n, int *threshold) {
  * the r-th run of rays that may share packets (one run per octant in auto
  * mode). Returns the number of runs. */
 static int chunk_order(const fr_scene *s, const fr_ray *rays, size_t n, uint32_t *order, size_t *run_end) {
-  if (s->trace.mode != FR_TRACE_AUTO) {
+  if (s->trace.mode != FR_TRACE_AUTO && s->trace.mode != FR_TRACE_RAYSTREAM) {
     for (size_t i = 0; i < n; i++) order[i] = (uint32_t)i;
     run_end[0] = n;
     return 1;
@@ -218,10 +218,32 @@ static void triangles_intersect_stream(const fr_scene *s, const fr_ray *rays, fr
   });
 }
 
+/* Ray streams: each octant run of a chunk in groups of up to FR_STREAM_MAX. */
+static void raystream_occluded(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
+  const fr_kernels *k = fr_kernels_active();
+  const fr_bvhn *b = s->single_width == 4 ? &s->bvh4 : &s->bvh8;
+  const fr_stream_fns *st = s->single_width == 4 ? k->s4 : k->s8;
+  uint32_t order[STREAM_CHUNK];
+  size_t run_end[8];
+  for (size_t c0 = 0; c0 < n; c0 += STREAM_CHUNK) {
+    size_t cn = n - c0 < STREAM_CHUNK ? n - c0 : STREAM_CHUNK;
+    int runs = chunk_order(s, rays + c0, cn, order, run_end);
+    size_t g = 0;
+    for (int r = 0; r < runs; r++)
+      for (size_t m; g < run_end[r]; g += m) {
+        m = run_end[r] - g < FR_STREAM_MAX ? run_end[r] - g : FR_STREAM_MAX;
+        const uint32_t *idx = order + g;
+        uint32_t o = st->occluded(b, rays + c0, idx, (int)m);
+        for (size_t i = 0; i < m; i++) occ[c0 + idx[i]] = (uint8_t)((o >> i) & 1);
+      }
+  }
+}
+
 static void triangles_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
   const fr_bvhn *sb;
   const fr_trace_fns *single = single_fns(s, &sb);
   if (s->trace.mode == FR_TRACE_SINGLE) { single->occluded_stream(sb, rays, occ, n); return; }
+  if (s->trace.mode == FR_TRACE_RAYSTREAM) { raystream_occluded(s, rays, occ, n); return; }
   FOR_EACH_GROUP(s, rays, n, {
     fr_packet_opts po;
     const fr_bvhn *pb;

@@ -10,6 +10,7 @@
  *
  *   vfloat4 / vmask4   four lanes: BVH4 node tests, 4-triangle leaves
  *   vfloat8            eight lanes: BVH8 node tests (comparisons give bit masks)
+ *   vbits8             eight 32-bit sets: per child, the rays of a stream that hit it
  */
 #ifndef FR_BASE_SIMD_H
 #define FR_BASE_SIMD_H
@@ -88,6 +89,25 @@ FR_INLINE int vf8_le_bits(vfloat8 a, vfloat8 b) { return _mm256_cmp_ps_mask(a.v,
 FR_INLINE int vf8_le_bits(vfloat8 a, vfloat8 b) { return _mm256_movemask_ps(_mm256_cmp_ps(a.v, b.v, _CMP_LE_OQ)); }
 #endif
 
+/* eight 32-bit sets, one per child of a node: which rays of a stream hit it */
+typedef struct vbits8 { __m256i v; } vbits8;
+FR_INLINE vbits8 vb8_zero(void) { vbits8 r = {_mm256_setzero_si256()}; return r; }
+FR_INLINE void vb8_store(uint32_t *p, vbits8 a) { _mm256_storeu_si256((__m256i *)p, a.v); }
+/* adds bit to the sets of the lanes in `lanes` */
+#if defined(FR_BUILD_ISA_AVX512)
+FR_INLINE vbits8 vb8_or_where(vbits8 a, int lanes, uint32_t bit) {
+  vbits8 r = {_mm256_mask_or_epi32(a.v, (__mmask8)lanes, a.v, _mm256_set1_epi32((int)bit))};
+  return r;
+}
+#else
+FR_INLINE vbits8 vb8_or_where(vbits8 a, int lanes, uint32_t bit) {
+  const __m256i lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+  __m256i sel = _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(lanes), lane_bit), lane_bit);
+  vbits8 r = {_mm256_or_si256(a.v, _mm256_and_si256(sel, _mm256_set1_epi32((int)bit)))};
+  return r;
+}
+#endif
+
 #else /* FR_ISA_SCALAR: plain C, one lane at a time */
 
 typedef struct vfloat4 { float f[4]; } vfloat4;
@@ -126,6 +146,14 @@ FR_INLINE vfloat8 vf8_mul(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] * b.f[i])
 FR_INLINE vfloat8 vf8_min(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] < b.f[i] ? a.f[i] : b.f[i])
 FR_INLINE vfloat8 vf8_max(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] > b.f[i] ? a.f[i] : b.f[i])
 FR_INLINE int vf8_le_bits(vfloat8 a, vfloat8 b) { int m = 0; for (int i = 0; i < 8; i++) m |= (a.f[i] <= b.f[i]) << i; return m; }
+
+typedef struct vbits8 { uint32_t u[8]; } vbits8;
+FR_INLINE vbits8 vb8_zero(void) { vbits8 r = {{0}}; return r; }
+FR_INLINE void vb8_store(uint32_t *p, vbits8 a) { for (int i = 0; i < 8; i++) p[i] = a.u[i]; }
+FR_INLINE vbits8 vb8_or_where(vbits8 a, int lanes, uint32_t bit) {
+  for (; lanes; lanes &= lanes - 1) a.u[__builtin_ctz((unsigned)lanes)] |= bit;
+  return a;
+}
 #endif
 
 /* cross and dot of 3-vectors held as three vfloat4 (structure of arrays) */

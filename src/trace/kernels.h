@@ -45,14 +45,26 @@ typedef struct fr_packet_fns {
   unsigned (*occluded_idx)(const fr_bvhn *b, const fr_packet_opts *o, const fr_ray *rays, const uint32_t *idx, int n);
 } fr_packet_fns;
 
+/* Ray-stream kernels for one ISA and BVH width (bvhn_stream.c). */
+#define FR_STREAM_MAX 32 /* rays in a stream group: one bit each */
+typedef struct fr_stream_fns {
+  /* Any hit for rays[idx[0..n)], 1 <= n <= FR_STREAM_MAX, all of one
+   * direction octant for speed (any rays give correct answers); returns the
+   * bits i of the rays occluded. */
+  uint32_t (*occluded)(const fr_bvhn *b, const fr_ray *rays, const uint32_t *idx, int n);
+} fr_stream_fns;
+
 typedef struct fr_kernels {
   fr_isa isa;
   const fr_trace_fns *w4, *w8;
   const fr_packet_fns *p8w4, *p16w4, *p8w8, *p16w8;
+  const fr_stream_fns *s4, *s8;
 } fr_kernels;
 
 extern const fr_trace_fns fr_trace_w4_avx512, fr_trace_w4_avx2, fr_trace_w4_scalar;
 extern const fr_trace_fns fr_trace_w8_avx512, fr_trace_w8_avx2, fr_trace_w8_scalar;
+extern const fr_stream_fns fr_stream_w4_avx512, fr_stream_w4_avx2, fr_stream_w4_scalar;
+extern const fr_stream_fns fr_stream_w8_avx512, fr_stream_w8_avx2, fr_stream_w8_scalar;
 #define FR_DECLARE_PACKET(isa)                                                                    \
   extern const fr_packet_fns fr_packet_p8_w4_##isa, fr_packet_p16_w4_##isa, fr_packet_p8_w8_##isa, \
       fr_packet_p16_w8_##isa;

@@ -21,17 +21,18 @@
 /* single: the default single-ray BVH (8-wide); single4: the MIC paper's BVH4;
  * packet8/packet16: packets alone; hybrid16: packets dropping to single rays;
  * auto: what fr_intersect_stream does by default; mft: camera rays and soft
- * shadows by multi-frusta tracing, the other rays as auto; packetNxN: large
+ * shadows by multi-frusta tracing, the other rays as auto; raystream: any-hit
+ * rays in ray streams of up to 32 (closest hits as auto); packetNxN: large
  * packets of N x N rays on the binary BVH (--traversal, --cull). */
 static const char *frusta_modes[] = {"single", "single4", "packet8", "packet16", "hybrid16", "auto", "mft",
-                                     "packet2x2", "packet4x4", "packet8x8", "packet16x16", "packet32x32"};
-#define N_FRUSTA_MODES 12
+                                     "raystream", "packet2x2", "packet4x4", "packet8x8", "packet16x16", "packet32x32"};
+#define N_FRUSTA_MODES 13
 #define MODE_MFT 6
-#define MODE_LARGE 7 /* packet2x2 .. packet32x32 */
+#define MODE_LARGE 8 /* packet2x2 .. packet32x32 */
 
 static void set_frusta_mode(fr_scene *s, int m, const fr_trace_options *base, int single_width) {
   static const fr_trace_mode modes[] = {FR_TRACE_SINGLE, FR_TRACE_SINGLE, FR_TRACE_PACKET8, FR_TRACE_PACKET16,
-                                        FR_TRACE_HYBRID16, FR_TRACE_AUTO, FR_TRACE_AUTO};
+                                        FR_TRACE_HYBRID16, FR_TRACE_AUTO, FR_TRACE_AUTO, FR_TRACE_RAYSTREAM};
   fr_trace_options o = *base;
   o.mode = m < MODE_LARGE ? modes[m] : FR_TRACE_AUTO;
   fr_scene_set_trace_options(s, &o);
@@ -139,7 +140,7 @@ static int parse_modes(const char *list, int use_frusta, int use_embree, unsigne
     if (use_embree && ebr_mode_parse(tok, &em)) { *esel |= 1u << em; known = 1; }
     if (!known)
       return cli_error(CLI_USAGE_ERROR, "no tracer in use has mode '%s' (frusta: single, single4, packet8, packet16, "
-                       "hybrid16, auto, mft, packet2x2 .. packet32x32; embree: single, packet4, packet8, packet16, "
+                       "hybrid16, auto, mft, raystream, packet2x2 .. packet32x32; embree: single, packet4, packet8, packet16, "
                        "stream; or all)", tok);
   }
   if (!*fsel && !*esel) return cli_error(CLI_USAGE_ERROR, "--mode: no mode given");
