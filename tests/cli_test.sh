@@ -85,7 +85,7 @@ agree() {
     exit($bad == 0 && $hits > 50 ? 0 : 1);' "$1" "$2"
 }
 agree "$T/f.hits" "$T/e.hits" && ok || bad "frusta and embree hit files disagree"
-for m in packet8 packet16 hybrid16 auto; do
+for m in packet8 packet16 hybrid16 auto raystream; do
   expect 0 "$F" trace --builtin "$T/r.rays" --query closest --out "$T/$m.hits" --mode $m
   agree "$T/$m.hits" "$T/e.hits" && ok || bad "frusta --mode $m and embree hit files disagree"
   expect 0 "$F" trace --builtin "$T/r.rays" --query any --out "$T/$m.occl" --mode $m

@@ -435,11 +435,12 @@ static void light_sets_are_nets(void **state) {
  * many triangles each (render/workload.c). On the dragon at 64x64 both paths
  * run: the visibility must match the stream tracer's, pixel by pixel, up to
  * rays grazing an edge. */
-typedef struct ray_counter { fr_tracer inner; size_t rays, batches; } ray_counter;
+typedef struct ray_counter { fr_tracer inner; size_t rays, batches, stream_rays; } ray_counter;
 
 static void counted_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
   ray_counter *c = ctx;
   c->rays += n;
+  if (coherent == FR_RAYS_DIVERGENT) c->stream_rays += n;
   c->inner.occluded(c->inner.ctx, rays, occ, n, coherent);
 }
 
@@ -479,14 +480,15 @@ static void soft_fallback(void **state) {
   fr_softshadow_opts so = {16, 0, FR_LIGHT_SETS_SPREAD};
   static float img[SZ * SZ * 3], vis_mft[SZ * SZ], vis_rays[SZ * SZ];
   fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
-  ray_counter c = {fr_tracer_mft(&mctx), 0, 0};
+  ray_counter c = {fr_tracer_mft(&mctx), 0, 0, 0};
   fr_tracer counted = {&c, counted_intersect, counted_occluded, counted_intersect_frusta, counted_occluded_frusta, 0};
   fr_workload_result r;
   assert_int_equal(fr_render_softshadow(&w, &counted, &so, img, vis_mft, &r), FR_OK);
   fr_tracer rays = fr_tracer_frusta(s);
   assert_int_equal(fr_render_softshadow(&w, &rays, &so, img, vis_rays, &r), FR_OK);
-  print_message("dragon soft shadows: %zu frusta batches, %zu rays as rays\n", c.batches, c.rays);
-  assert_true(c.batches > 0 && c.rays > 0); /* both paths ran */
+  print_message("dragon soft shadows: %zu frusta batches, %zu rays as rays, %zu of them in ray streams\n", c.batches,
+                c.rays, c.stream_rays);
+  assert_true(c.batches > 0 && c.rays > c.stream_rays && c.stream_rays > 0); /* all three paths ran */
   double sum = 0.0;
   for (int i = 0; i < SZ * SZ; i++) {
     float d = fabsf(vis_mft[i] - vis_rays[i]);

@@ -39,6 +39,10 @@ fr_error fr_scene_build_bvh2(fr_scene *s, int max_leaf, fr_bvh2 *out);
  * batches) and sibenik soft16 measured 0.91x (3/6). Overbeck's large
  * packets lost 10% with 8 (Whitted kitchen 16x16, museum 32x32). */
 #define FR_MFT_LEAF 8
+/* fr_occluded_stream as ray streams (FR_TRACE_RAYSTREAM) whatever the
+ * scene's trace mode: for callers that know their rays diverge at the
+ * scale of the triangles (multi-frusta tiles that fell back to rays). */
+void fr_occluded_raystream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n);
 /* The first sphere's prim number (the triangle count). */
 static inline uint32_t fr_scene_sphere_base(const fr_scene *s) { return (uint32_t)s->mesh.ntris; }
 #endif

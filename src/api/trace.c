@@ -149,11 +149,16 @@ static int group_plan(const fr_scene *s, size_t n, int *threshold) {
   }
 }
 
+/* Auto mode, and ray streams (whose closest hits go as auto), sort. */
+static inline int sorts_by_octant(const fr_scene *s) {
+  return s->trace.mode == FR_TRACE_AUTO || s->trace.mode == FR_TRACE_RAYSTREAM;
+}
+
 /* The order in which a chunk's rays are grouped into packets; run_end[r] ends
  * the r-th run of rays that may share packets (one run per octant in auto
  * mode). Returns the number of runs. */
-static int chunk_order(const fr_scene *s, const fr_ray *rays, size_t n, uint32_t *order, size_t *run_end) {
-  if (s->trace.mode != FR_TRACE_AUTO && s->trace.mode != FR_TRACE_RAYSTREAM) {
+static int chunk_order(int sort, const fr_ray *rays, size_t n, uint32_t *order, size_t *run_end) {
+  if (!sort) {
     for (size_t i = 0; i < n; i++) order[i] = (uint32_t)i;
     run_end[0] = n;
     return 1;
@@ -191,7 +196,7 @@ static int chunk_order(const fr_scene *s, const fr_ray *rays, size_t n, uint32_t
     size_t group = (s)->trace.mode == FR_TRACE_PACKET8 ? 8 : 16;                                  \
     for (size_t c0 = 0; c0 < (n); c0 += STREAM_CHUNK) {                                           \
       size_t cn = (n) - c0 < STREAM_CHUNK ? (n) - c0 : STREAM_CHUNK;                              \
-      int runs = chunk_order((s), (rays) + c0, cn, order, run_end);                               \
+      int runs = chunk_order(sorts_by_octant(s), (rays) + c0, cn, order, run_end);               \
       size_t g = 0;                                                                               \
       for (int r = 0; r < runs; r++)                                                              \
         for (size_t m; g < run_end[r]; g += m) {                                                  \
@@ -227,7 +232,7 @@ static void raystream_occluded(const fr_scene *s, const fr_ray *rays, uint8_t *o
   size_t run_end[8];
   for (size_t c0 = 0; c0 < n; c0 += STREAM_CHUNK) {
     size_t cn = n - c0 < STREAM_CHUNK ? n - c0 : STREAM_CHUNK;
-    int runs = chunk_order(s, rays + c0, cn, order, run_end);
+    int runs = chunk_order(1, rays + c0, cn, order, run_end);
     size_t g = 0;
     for (int r = 0; r < runs; r++)
       for (size_t m; g < run_end[r]; g += m) {
@@ -259,6 +264,12 @@ void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, si
   if (!s->committed) { for (size_t i = 0; i < n; i++) fr_hit_miss(&hits[i]); return; }
   triangles_intersect_stream(s, rays, hits, n);
   if (has_spheres(s)) spheres_stream(s, rays, hits, n);
+}
+
+void fr_occluded_raystream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
+  if (!s->committed) { memset(occ, 0, n); return; }
+  raystream_occluded(s, rays, occ, n);
+  if (has_spheres(s)) spheres_occluded_stream(s, rays, occ, n);
 }
 
 void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {

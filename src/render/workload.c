@@ -84,6 +84,16 @@ void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, 
  * thread, so that a tile's image does not depend on which thread traced
  * what. */
 #define SOFT_FRUSTA_MAX_TRIS 8
+/* Where the first batch's frusta fetched more than this many triangles each,
+ * the tile's rays part ways at the scale of the triangles, and ray streams
+ * (trace/bvhn_stream.c) beat hybrid packets: against packets for every
+ * fallen-back tile, interleaved, 1 thread, 1024x1024, mft soft16, 6 pairs
+ * (CONCURRENT=1 bench/ab.sh): dragon 1.25x (5/6; 72% of its fallen-back
+ * batches go as streams), kitchen 1.03x (4/6; 48%); conference sends 55 of
+ * its 3523 this way. Streams for all fallen-back tiles (a bound of 8) read
+ * 0.89x on conference (1/4), but runs there that changed nothing read 0.91x
+ * and 0.94x: this setup's noise; 24 gave dragon 1.12x, 64 1.05x. */
+#define SOFT_STREAM_MIN_TRIS 16
 
 /* Soft shadows: pixels 16 j .. 16 j + 15 with a primary hit are the frusta of
  * batch j: origin p, rays p + t (c + s e1 + q e2 - p) for the samples of the
@@ -93,7 +103,7 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
   const fr_mft_sets *T = w->light_sets;
   vec3 centre = v3_add(w->view.area_c, v3_scale(v3_add(w->view.area_e1, w->view.area_e2), 0.5f));
   uint64_t rays = 0;
-  int m = 0, as_rays = !t->occluded_frusta;
+  int m = 0, as_rays = !t->occluded_frusta, as_streams = 0;
   uint8_t by_rays[TILE_PIX] = {0};
   for (int j = 0; j < (n + 15) / 16; j++) {
     fr_mft_batch b;
@@ -119,9 +129,11 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
         lit[16 * j + f] = (float)(16 - __builtin_popcount(occ[f])) / 16.0f;
       }
       as_rays = !w->mft_no_fallback && fetched > SOFT_FRUSTA_MAX_TRIS * (unsigned)__builtin_popcount(b.valid);
+      as_streams = fetched > SOFT_STREAM_MIN_TRIS * (unsigned)__builtin_popcount(b.valid);
       continue;
     }
     if (t->occluded_frusta && b.valid) FR_COUNT(mft_ray_batches, 1);
+    if (as_streams && b.valid) FR_COUNT(mft_stream_batches, 1);
     for (unsigned v = b.valid; v; v &= v - 1) {
       int f = __builtin_ctz(v);
       by_rays[16 * j + f] = 1;
@@ -135,7 +147,7 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
     }
   }
   if (m) {
-    t->occluded(t->ctx, B->rays, B->occ, (size_t)m, 0);
+    t->occluded(t->ctx, B->rays, B->occ, (size_t)m, as_streams ? FR_RAYS_DIVERGENT : 0);
     int cnt[TILE_PIX] = {0};
     for (int k = 0; k < m; k++) cnt[B->owner[k]] += !B->occ[k];
     for (int i = 0; i < n; i++)
@@ -363,8 +375,9 @@ static void mft_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int c
 }
 
 static void mft_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
-  (void)coherent;
-  fr_occluded_stream(((const fr_mft_tracer *)ctx)->scene, rays, occ, n);
+  const fr_scene *s = ((const fr_mft_tracer *)ctx)->scene;
+  if (coherent == FR_RAYS_DIVERGENT) fr_occluded_raystream(s, rays, occ, n);
+  else fr_occluded_stream(s, rays, occ, n);
 }
 
 static void mft_intersect_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *hits) {

@@ -29,10 +29,16 @@ int fr_workload_parse(const char *name, fr_workload_kind *k);
  * these are NULL the engine makes the same rays (fr_mft_ray) and hands them to
  * intersect / occluded, so every tracer traces the same rays.
  *
+ * The last argument of intersect / occluded is a hint: 1 for rays the
+ * workload knows to be coherent, FR_RAYS_DIVERGENT for rays known to part
+ * ways at the scale of the triangles (soft-shadow tiles whose frusta fetched
+ * many triangles), 0 otherwise.
+ *
  * The Whitted workload hands each packet to intersect / occluded in its own
  * call: the rays of one block of packet_side x packet_side pixels (or their
  * reflection, refraction or shadow rays); packet_side 0 means blocks of
  * 32x32, the whole tile. */
+#define FR_RAYS_DIVERGENT (-1)
 typedef struct fr_tracer {
   void *ctx;
   void (*intersect)(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent);

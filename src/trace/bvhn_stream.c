@@ -56,8 +56,8 @@ FR_INLINE int stream_node(const node_t *n, const ray_pre *pre, const float *tfar
   return hit;
 }
 
-/* Bits of the rays hit; rays[idx[0..n)], n <= FR_STREAM_MAX. */
-static uint32_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t *idx, int n) {
+/* Bits of the rays hit in the subtree at root; rays[idx[0..n)], n <= FR_STREAM_MAX. */
+static uint32_t occluded_subtree(const fr_bvhn *b, uint32_t root, const fr_ray *rays, const uint32_t *idx, int n) {
   ray_pre pre[FR_STREAM_MAX];
   float tfar[FR_STREAM_MAX];
   uint32_t active = 0, occ = 0;
@@ -75,7 +75,7 @@ static uint32_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint3
   }
   stream_entry stack[STACK_SIZE];
   int sp = 0;
-  stack[sp++] = (stream_entry){b->root, active};
+  stack[sp++] = (stream_entry){root, active};
   while (sp) {
     stream_entry top = stack[--sp];
     uint32_t m = top.rays & active; /* rays occluded since the push are done */
@@ -116,6 +116,10 @@ static uint32_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint3
   return occ;
 }
 
+static uint32_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t *idx, int n) {
+  return occluded_subtree(b, b->root, rays, idx, n);
+}
+
 #define STREAM_NAME2(w, isa) fr_stream_w##w##_##isa
 #define STREAM_NAME(w, isa) STREAM_NAME2(w, isa)
-const fr_stream_fns STREAM_NAME(FR_WIDTH, FR_ISA_SUFFIX) = {occluded_group};
+const fr_stream_fns STREAM_NAME(FR_WIDTH, FR_ISA_SUFFIX) = {occluded_group, occluded_subtree};

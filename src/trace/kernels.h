@@ -24,6 +24,17 @@ typedef struct fr_trace_fns {
   int (*occluded_subtree)(const fr_bvhn *b, uint32_t ref, const fr_ray *ray);
 } fr_trace_fns;
 
+/* Ray-stream kernels for one ISA and BVH width (bvhn_stream.c). */
+#define FR_STREAM_MAX 32 /* rays in a stream group: one bit each */
+typedef struct fr_stream_fns {
+  /* Any hit for rays[idx[0..n)], 1 <= n <= FR_STREAM_MAX, all of one
+   * direction octant for speed (any rays give correct answers); returns the
+   * bits i of the rays occluded. */
+  uint32_t (*occluded)(const fr_bvhn *b, const fr_ray *rays, const uint32_t *idx, int n);
+  /* the same within the subtree at ref (the hybrid's last phase) */
+  uint32_t (*occluded_subtree)(const fr_bvhn *b, uint32_t ref, const fr_ray *rays, const uint32_t *idx, int n);
+} fr_stream_fns;
+
 /* How the packet kernels run (the switches exist for measurement). */
 typedef struct fr_packet_opts {
   int hybrid_threshold;   /* trace a popped subtree ray by ray when at most this many rays are active; 0: never */
@@ -31,6 +42,7 @@ typedef struct fr_packet_opts {
   int axis_aligned;       /* Shevtsov's fast path for axis-aligned triangles */
   int ia_cull;            /* cull nodes for the whole packet by interval arithmetic first */
   const fr_trace_fns *single; /* the single-ray kernels of the same ISA and width */
+  const fr_stream_fns *stream; /* any hit: the hybrid's rays finish a subtree as one ray stream; NULL: one by one */
 } fr_packet_opts;
 
 /* Packet kernels for one ISA, packet size and BVH width. valid: bit i for ray i. */
@@ -44,15 +56,6 @@ typedef struct fr_packet_fns {
                         fr_hit *hits);
   unsigned (*occluded_idx)(const fr_bvhn *b, const fr_packet_opts *o, const fr_ray *rays, const uint32_t *idx, int n);
 } fr_packet_fns;
-
-/* Ray-stream kernels for one ISA and BVH width (bvhn_stream.c). */
-#define FR_STREAM_MAX 32 /* rays in a stream group: one bit each */
-typedef struct fr_stream_fns {
-  /* Any hit for rays[idx[0..n)], 1 <= n <= FR_STREAM_MAX, all of one
-   * direction octant for speed (any rays give correct answers); returns the
-   * bits i of the rays occluded. */
-  uint32_t (*occluded)(const fr_bvhn *b, const fr_ray *rays, const uint32_t *idx, int n);
-} fr_stream_fns;
 
 typedef struct fr_kernels {
   fr_isa isa;

@@ -1,7 +1,8 @@
 /* frusta trace SCENE RAYS --query closest|any --out FILE: answers a ray file
  * (../shared/spec/rayfile.md) with frusta, or with Embree for comparison.
  * --mode picks frusta's kernels: single rays (default), or the stream calls
- * in packet8, packet16, hybrid16 or auto mode over consecutive rays. */
+ * in packet8, packet16, hybrid16, auto or raystream mode over consecutive
+ * rays. */
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,7 +14,7 @@
 
 int cmd_trace(int argc, char **argv) {
   const char *scene = NULL, *rays_path = NULL, *out = NULL, *query = NULL, *tracer = "frusta";
-  static const char *mode_names[] = {"auto", "single", "packet8", "packet16", "hybrid16"}; /* fr_trace_mode order */
+  static const char *mode_names[] = {"auto", "single", "packet8", "packet16", "hybrid16", "raystream"}; /* fr_trace_mode order */
   int mode = FR_TRACE_SINGLE;
   for (int i = 0; i < argc; i++) {
     const char *a = argv[i];
@@ -26,9 +27,9 @@ int cmd_trace(int argc, char **argv) {
       else if (a[2] == 't') tracer = v;
       else if (a[2] == 'm') {
         mode = -1;
-        for (int m = 0; m < 5; m++)
+        for (int m = 0; m < (int)(sizeof mode_names / sizeof mode_names[0]); m++)
           if (strcmp(v, mode_names[m]) == 0) mode = m;
-        if (mode < 0) return cli_error(CLI_USAGE_ERROR, "--mode is single, packet8, packet16, hybrid16 or auto, not '%s'", v);
+        if (mode < 0) return cli_error(CLI_USAGE_ERROR, "--mode is single, packet8, packet16, hybrid16, auto or raystream, not '%s'", v);
       } else if (cli_set_isa(v)) return 1;
     } else if (a[0] == '-' && !cli_is_builtin(a)) {
       return cli_error(CLI_USAGE_ERROR, "trace: unknown option '%s'", a);

@@ -172,7 +172,7 @@ PACKET_FUNCS(16)
 static struct RTCIntersectContext make_context(int coherent) {
   struct RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  ctx.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  ctx.flags = coherent > 0 ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
   return ctx;
 }
 

@@ -17,8 +17,8 @@ static void usage(FILE *f) {
           "  bench  SCENE|--builtin --workload W|all --mode M[,M..]|all [--tracer frusta|embree|both] [--threads N]\n"
           "         [--size WxH] [view flags] [--light x,y,z] [--area c,e1,e2] [--repeat K]\n"
           "         (the K repetitions of all runs picked are interleaved round-robin)\n"
-          "         frusta modes: single single4 packet8 packet16 hybrid16 auto mft packet2x2 packet4x4 packet8x8\n"
-          "         packet16x16 packet32x32 (--traversal, --cull; workload whitted: --mirror --glass --depth);\n"
+          "         frusta modes: single single4 packet8 packet16 hybrid16 auto mft raystream packet2x2 packet4x4\n"
+          "         packet8x8 packet16x16 packet32x32 (--traversal, --cull; workload whitted: --mirror --glass --depth);\n"
           "         embree: single packet4\n"
           "         packet8 packet16 stream; packet switches: [--threshold N] [--packet-width 4|8]\n"
           "         [--mailbox on|off] [--axis-aligned on|off] [--ia on|off]; single rays: [--prefetch\n"
@@ -26,7 +26,7 @@ static void usage(FILE *f) {
           "         spread|cells] [--corner-rays on|off] [--corner-cost C] [--shrink on|off] [--mft-leaf N]\n"
           "         [--mft-fallback on|off]\n"
           "  trace  SCENE RAYS --query closest|any --out FILE [--tracer frusta|embree]\n"
-          "         [--mode single|packet8|packet16|hybrid16|auto]\n"
+          "         [--mode single|packet8|packet16|hybrid16|auto|raystream]\n"
           "  stats  SCENE|--builtin [--embree] [--workload W [--threshold N] [--packet-width 4|8]]\n"
           "Scenes: PLY, OBJ(+MTL) and what Assimp reads, optionally .zst. FRUSTA_ISA=avx512|avx2|scalar forces an ISA.\n");
 }
