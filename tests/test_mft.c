@@ -449,9 +449,9 @@ static void counted_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, i
   c->inner.intersect(c->inner.ctx, rays, hits, n, coherent);
 }
 
-static void counted_intersect_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *h) {
+static unsigned counted_intersect_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *h) {
   ray_counter *c = ctx;
-  c->inner.intersect_frusta(c->inner.ctx, b, t, h);
+  return c->inner.intersect_frusta(c->inner.ctx, b, t, h);
 }
 
 static unsigned counted_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[16]) {

@@ -56,9 +56,9 @@ static void check_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int
 }
 
 /* camera frusta: each ray as fr_mft_ray makes it, in its units */
-static void check_intersect_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *hits) {
+static unsigned check_intersect_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *hits) {
   checker *c = ctx;
-  c->inner.intersect_frusta(c->inner.ctx, b, t, hits);
+  unsigned fetched = c->inner.intersect_frusta(c->inner.ctx, b, t, hits);
   mesh_ref m = scene_mesh(c->s);
   for (int f = 0; f < FR_MFT_FRUSTA; f++) {
     if (!((b->valid >> f) & 1)) continue;
@@ -70,6 +70,7 @@ static void check_intersect_frusta(void *ctx, const fr_mft_batch *b, const fr_mf
       check_hit(c, &m, &r, &got, (size_t)k, FR_MFT_RAYS);
     }
   }
+  return fetched;
 }
 
 static void check_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {

@@ -67,13 +67,14 @@ static vec3 albedo(const fr_scene *s, uint32_t prim) {
   return mat ? v3(mat->diffuse[0], mat->diffuse[1], mat->diffuse[2]) : v3(0.8f, 0.8f, 0.8f);
 }
 
-void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, fr_ray *rays, fr_hit *hits) {
+unsigned fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, fr_ray *rays, fr_hit *hits) {
   fr_mft_batch b;
   static _Thread_local fr_mft_hits h;
   const fr_mft_sets *cam_set = w->camera_set;
   fr_mft_batch_camera(&b, &w->cam, tx, ty);
-  t->intersect_frusta(t->ctx, &b, cam_set, &h);
+  unsigned fetched = t->intersect_frusta(t->ctx, &b, cam_set, &h);
   fr_mft_active()->expand(&b, cam_set, &h, rays, hits);
+  return fetched;
 }
 
 /* Frusta that fetch more triangles than this each (the tile's first batch
@@ -94,16 +95,28 @@ void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, 
  * 0.89x on conference (1/4), but runs there that changed nothing read 0.91x
  * and 0.94x: this setup's noise; 24 gave dragon 1.12x, 64 1.05x. */
 #define SOFT_STREAM_MIN_TRIS 16
+/* A tile whose camera frusta fetched more than this many triangles each
+ * skips shadow frusta altogether: its first batch of them would fetch too
+ * many as well (at 1024x1024 this sends 1840 more of dragon's batches to
+ * ray streams, 16 of conference's, 48 of kitchen's, none of sibenik's).
+ * Interleaved, 2 repetitions, 5 pairs, otherwise as above:
+ * dragon soft16 1.07x (5/5), conference 1.00x (3/5). A bound of 16 gave
+ * dragon 1.10x (5/5) but conference 0.945x (0/5), kitchen and sibenik
+ * 0.99x (0/5 each). */
+#define SOFT_CAMERA_MAX_TRIS 32u
 
 /* Soft shadows: pixels 16 j .. 16 j + 15 with a primary hit are the frusta of
  * batch j: origin p, rays p + t (c + s e1 + q e2 - p) for the samples of the
  * pixel's interleaved set, t in (eps / |light centre - p|, 1 - 1e-4). Returns
- * the shadow rays traced; lit[i] gets pixel i's unoccluded fraction. */
-static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *B, int n, float *lit) {
+ * the shadow rays traced; lit[i] gets pixel i's unoccluded fraction.
+ * cam_fetched: the triangles the tile's camera frusta fetched (0 if none). */
+static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *B, int n, float *lit, unsigned cam_fetched) {
   const fr_mft_sets *T = w->light_sets;
   vec3 centre = v3_add(w->view.area_c, v3_scale(v3_add(w->view.area_e1, w->view.area_e2), 0.5f));
   uint64_t rays = 0;
   int m = 0, as_rays = !t->occluded_frusta, as_streams = 0;
+  if (t->occluded_frusta && !w->mft_no_fallback && cam_fetched > SOFT_CAMERA_MAX_TRIS * FR_MFT_FRUSTA)
+    as_rays = as_streams = 1;
   uint8_t by_rays[TILE_PIX] = {0};
   for (int j = 0; j < (n + 15) / 16; j++) {
     fr_mft_batch b;
@@ -177,8 +190,9 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
           n++;
         }
   uint64_t rays = (uint64_t)n;
+  unsigned cam_fetched = 0;
   if (frusta)
-    fr_camera_frusta(w, t, tx, ty, B->prim_ray, B->prim_hit);
+    cam_fetched = fr_camera_frusta(w, t, tx, ty, B->prim_ray, B->prim_hit);
   else
     t->intersect(t->ctx, B->rays, B->prim_hit, (size_t)n, 1);
   float lit[TILE_PIX];
@@ -190,7 +204,7 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
     break;
   case FR_WL_SOFT16:
     for (int i = 0; i < n; i++) lit[i] = 0.0f;
-    rays += soft_shadows(w, t, B, n, lit);
+    rays += soft_shadows(w, t, B, n, lit, cam_fetched);
     break;
   case FR_WL_SHADOW:
   case FR_WL_AO16: {
@@ -380,9 +394,9 @@ static void mft_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int co
   else fr_occluded_stream(s, rays, occ, n);
 }
 
-static void mft_intersect_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *hits) {
+static unsigned mft_intersect_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *hits) {
   const fr_mft_tracer *m = ctx;
-  fr_mft_active()->intersect(m->bvh, &m->opts, b, t, hits);
+  return fr_mft_active()->intersect(m->bvh, &m->opts, b, t, hits);
 }
 
 static unsigned mft_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t,

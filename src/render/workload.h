@@ -43,8 +43,8 @@ typedef struct fr_tracer {
   void *ctx;
   void (*intersect)(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent);
   void (*occluded)(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent);
-  void (*intersect_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *hits);
-  /* returns the triangles the batch fetched (see soft_shadows in workload.c) */
+  unsigned (*intersect_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *hits);
+  /* both return the triangles the batch fetched (see soft_shadows in workload.c) */
   unsigned (*occluded_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[FR_MFT_FRUSTA]);
   int packet_side;
 } fr_tracer;
@@ -98,7 +98,7 @@ fr_workload_result fr_workload_run(const fr_workload *w, const fr_tracer *t);
  * (t->intersect_frusta): ray and hit 16 f + k are pixel (tx + 4 (f % 4) +
  * k % 4, ty + 4 (f / 4) + k / 4). The rays are fr_mft_ray's with unit
  * directions, as fr_camera_ray makes them, and the hits are in their units. */
-void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, fr_ray *rays, fr_hit *hits);
+unsigned fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, fr_ray *rays, fr_hit *hits);
 
 /* The frusta tracer: streams as the scene's trace options say. */
 fr_tracer fr_tracer_frusta(const fr_scene *s);

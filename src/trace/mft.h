@@ -90,8 +90,9 @@ typedef struct fr_mft_fns {
    * triangles the batch's leaves fetched (what it cost) */
   unsigned (*occluded)(const fr_bvh2 *b, const fr_mft_opts *o, const fr_mft_batch *batch, const fr_mft_sets *sets,
                    uint16_t occ[FR_MFT_FRUSTA]);
-  void (*intersect)(const fr_bvh2 *b, const fr_mft_opts *o, const fr_mft_batch *batch, const fr_mft_sets *sets,
-                    fr_mft_hits *hits);
+  /* returns the triangles fetched, as occluded does */
+  unsigned (*intersect)(const fr_bvh2 *b, const fr_mft_opts *o, const fr_mft_batch *batch, const fr_mft_sets *sets,
+                        fr_mft_hits *hits);
   /* rays[16 f + k] = ray k of frustum f with its direction normalized,
    * hits[16 f + k] its hit with t in units of that direction (ng zero), for
    * all 16 frusta (src/trace/mft_expand.c) */

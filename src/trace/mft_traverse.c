@@ -412,8 +412,8 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
   return fetched;
 }
 
-static void intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B, const fr_mft_sets *T,
-                          fr_mft_hits *H) {
+static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B, const fr_mft_sets *T,
+                              fr_mft_hits *H) {
   frusta F;
   tri_frusta X;
   unsigned valid = B->valid & 0xFFFFu;
@@ -426,8 +426,9 @@ static void intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft
     }
   FR_COUNT(mft_batches, 1);
   FR_COUNT(rays, 16 * __builtin_popcount(valid));
-  if (!valid || !b->nodes) return;
+  if (!valid || !b->nodes) return 0;
   frusta_setup(&F, B, T, valid);
+  unsigned fetched = 0;
   entry stack[STACK];
   int sp = 0;
   stack[sp++] = (entry){b->root, valid, NULL, 0};
@@ -442,6 +443,7 @@ static void intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft
       static const unsigned all[16] = {0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu,
                                        0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu};
       unsigned changed = 0, rays[16], m = leaf_rays(&F, &e, e.mask, all, (const float(*)[16])H->t, rays);
+      if (m) fetched += count;
       for (uint32_t i = first; i < first + count && m; i++) {
         const fr_bvh2_tri *r = &b->tris[i];
         unsigned left = leaf_tri_cull(&F, r, m, opt, &X);
@@ -469,6 +471,7 @@ static void intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft
   for (int f = 0; f < 16; f++)
     for (int k = 0; k < 16; k++)
       if (H->prim[f][k] == FR_INVALID_ID) H->t[f][k] = INFINITY;
+  return fetched;
 }
 
 const fr_mft_fns FR_ISA_FN(fr_mft) = {occluded_mft, intersect_mft, FR_ISA_FN(fr_mft_expand)};
