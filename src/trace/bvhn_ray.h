@@ -46,20 +46,34 @@ static inline void ray_setup(ray_pre *r, const fr_ray *ray) {
   r->tnear = ray->tnear;
 }
 
+/* A node's near and far planes as ray r meets them (its direction signs). */
+typedef struct node_planes { vnode nx, ny, nz, fx, fy, fz; } node_planes;
+
+FR_INLINE node_planes load_planes(const node_t *n, const ray_pre *r) {
+  const float *f = (const float *)n;
+  node_planes p = {VN_LOAD(f + r->near_x), VN_LOAD(f + r->near_y), VN_LOAD(f + r->near_z),
+                   VN_LOAD(f + (r->near_x ^ W)), VN_LOAD(f + (r->near_y ^ W)), VN_LOAD(f + (r->near_z ^ W))};
+  return p;
+}
+
 /* Returns the children's entry distances; *mask gets those hit within
  * [tnear, tfar]. (o - plane) * -rdir is (plane - o) * rdir exactly. */
-FR_INLINE vnode box_test(const node_t *n, const ray_pre *r, float tfar, int *mask) {
-  const float *f = (const float *)n;
-  vnode tnx = VN_MUL(VN_SUB(r->ox, VN_LOAD(f + r->near_x)), r->nrx);
-  vnode tny = VN_MUL(VN_SUB(r->oy, VN_LOAD(f + r->near_y)), r->nry);
-  vnode tnz = VN_MUL(VN_SUB(r->oz, VN_LOAD(f + r->near_z)), r->nrz);
-  vnode tfx = VN_MUL(VN_SUB(r->ox, VN_LOAD(f + (r->near_x ^ W))), r->nrx);
-  vnode tfy = VN_MUL(VN_SUB(r->oy, VN_LOAD(f + (r->near_y ^ W))), r->nry);
-  vnode tfz = VN_MUL(VN_SUB(r->oz, VN_LOAD(f + (r->near_z ^ W))), r->nrz);
+FR_INLINE vnode planes_test(const node_planes *p, const ray_pre *r, float tfar, int *mask) {
+  vnode tnx = VN_MUL(VN_SUB(r->ox, p->nx), r->nrx);
+  vnode tny = VN_MUL(VN_SUB(r->oy, p->ny), r->nry);
+  vnode tnz = VN_MUL(VN_SUB(r->oz, p->nz), r->nrz);
+  vnode tfx = VN_MUL(VN_SUB(r->ox, p->fx), r->nrx);
+  vnode tfy = VN_MUL(VN_SUB(r->oy, p->fy), r->nry);
+  vnode tfz = VN_MUL(VN_SUB(r->oz, p->fz), r->nrz);
   vnode tn = VN_MAX(VN_MAX(tnx, tny), VN_MAX(tnz, VN(r->tnear)));
   vnode tf = VN_MIN(VN_MIN(tfx, tfy), VN_MIN(tfz, VN(tfar)));
   *mask = VN_LE_BITS(tn, VN_MUL(tf, VN(ROUND_UP)));
   return tn;
+}
+
+FR_INLINE vnode box_test(const node_t *n, const ray_pre *r, float tfar, int *mask) {
+  node_planes p = load_planes(n, r);
+  return planes_test(&p, r, tfar, mask);
 }
 
 /* A BVH8 node's child references are its fourth line, read only once the

@@ -22,25 +22,16 @@ typedef struct stream_entry { uint32_t ref, rays; } stream_entry;
  * loaded once for all. */
 FR_INLINE int stream_node(const node_t *n, const ray_pre *pre, const float *tfar, uint32_t m, int uniform,
                           uint32_t child_rays[8]) {
-  const float *f = (const float *)n;
   if (W == 8) __builtin_prefetch(n->child);
   FR_COUNT(nodes, (uint64_t)__builtin_popcount(m));
   FR_COUNT(box_tests, (uint64_t)n->nchildren * (uint64_t)__builtin_popcount(m));
   vbits8 acc = vb8_zero();
   int hit = 0;
   if (uniform) {
-    const ray_pre *r0 = &pre[__builtin_ctz(m)];
-    vnode nx = VN_LOAD(f + r0->near_x), fx = VN_LOAD(f + (r0->near_x ^ W));
-    vnode ny = VN_LOAD(f + r0->near_y), fy = VN_LOAD(f + (r0->near_y ^ W));
-    vnode nz = VN_LOAD(f + r0->near_z), fz = VN_LOAD(f + (r0->near_z ^ W));
+    const node_planes p = load_planes(n, &pre[__builtin_ctz(m)]);
     for (; m; m &= m - 1) {
-      int i = __builtin_ctz(m);
-      const ray_pre *r = &pre[i];
-      vnode tn = VN_MAX(VN_MAX(VN_MUL(VN_SUB(r->ox, nx), r->nrx), VN_MUL(VN_SUB(r->oy, ny), r->nry)),
-                        VN_MAX(VN_MUL(VN_SUB(r->oz, nz), r->nrz), VN(r->tnear)));
-      vnode tf = VN_MIN(VN_MIN(VN_MUL(VN_SUB(r->ox, fx), r->nrx), VN_MUL(VN_SUB(r->oy, fy), r->nry)),
-                        VN_MIN(VN_MUL(VN_SUB(r->oz, fz), r->nrz), VN(tfar[i])));
-      int bits = VN_LE_BITS(tn, VN_MUL(tf, VN(ROUND_UP)));
+      int i = __builtin_ctz(m), bits;
+      (void)planes_test(&p, &pre[i], tfar[i], &bits);
       hit |= bits;
       acc = vb8_or_where(acc, bits, 1u << i);
     }
@@ -56,8 +47,8 @@ FR_INLINE int stream_node(const node_t *n, const ray_pre *pre, const float *tfar
   return hit;
 }
 
-/* Bits of the rays hit in the subtree at root; rays[idx[0..n)], n <= FR_STREAM_MAX. */
-static uint32_t occluded_subtree(const fr_bvhn *b, uint32_t root, const fr_ray *rays, const uint32_t *idx, int n) {
+/* Bits of the rays hit; rays[idx[0..n)], n <= FR_STREAM_MAX. */
+static uint32_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t *idx, int n) {
   ray_pre pre[FR_STREAM_MAX];
   float tfar[FR_STREAM_MAX];
   uint32_t active = 0, occ = 0;
@@ -75,7 +66,7 @@ static uint32_t occluded_subtree(const fr_bvhn *b, uint32_t root, const fr_ray *
   }
   stream_entry stack[STACK_SIZE];
   int sp = 0;
-  stack[sp++] = (stream_entry){root, active};
+  stack[sp++] = (stream_entry){b->root, active};
   while (sp) {
     stream_entry top = stack[--sp];
     uint32_t m = top.rays & active; /* rays occluded since the push are done */
@@ -116,10 +107,6 @@ static uint32_t occluded_subtree(const fr_bvhn *b, uint32_t root, const fr_ray *
   return occ;
 }
 
-static uint32_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t *idx, int n) {
-  return occluded_subtree(b, b->root, rays, idx, n);
-}
-
 #define STREAM_NAME2(w, isa) fr_stream_w##w##_##isa
 #define STREAM_NAME(w, isa) STREAM_NAME2(w, isa)
-const fr_stream_fns STREAM_NAME(FR_WIDTH, FR_ISA_SUFFIX) = {occluded_group, occluded_subtree};
+const fr_stream_fns STREAM_NAME(FR_WIDTH, FR_ISA_SUFFIX) = {occluded_group};

@@ -31,8 +31,6 @@ typedef struct fr_stream_fns {
    * direction octant for speed (any rays give correct answers); returns the
    * bits i of the rays occluded. */
   uint32_t (*occluded)(const fr_bvhn *b, const fr_ray *rays, const uint32_t *idx, int n);
-  /* the same within the subtree at ref (the hybrid's last phase) */
-  uint32_t (*occluded_subtree)(const fr_bvhn *b, uint32_t ref, const fr_ray *rays, const uint32_t *idx, int n);
 } fr_stream_fns;
 
 /* How the packet kernels run (the switches exist for measurement). */
@@ -42,7 +40,6 @@ typedef struct fr_packet_opts {
   int axis_aligned;       /* Shevtsov's fast path for axis-aligned triangles */
   int ia_cull;            /* cull nodes for the whole packet by interval arithmetic first */
   const fr_trace_fns *single; /* the single-ray kernels of the same ISA and width */
-  const fr_stream_fns *stream; /* any hit: the hybrid's rays finish a subtree as one ray stream; NULL: one by one */
 } fr_packet_opts;
 
 /* Packet kernels for one ISA, packet size and BVH width. valid: bit i for ray i. */
