@@ -159,6 +159,9 @@ expect 2 "$F" render --builtin=cubes --out "$T/sf2.png"
 [ ! -e "$T/sf2.png" ] && ok || bad "an unknown built-in scene left an output file"
 expect 0 "$F" bench --builtin --size 32x32 --workload soft16 --mode mft --repeat 1 --mft-leaf 8 --shrink off --light-sets cells
 grep -q 'mode=mft' "$T/out" && ok || bad "bench mft line"
+expect 0 "$F" bench --builtin --size 32x32 --workload soft16 --mode mft --repeat 1 --shrink corners
+grep -q 'shrink=corners' "$T/out" && ok || bad "bench --shrink corners"
+expect 2 "$F" bench --builtin --size 32x32 --workload soft16 --mode mft --repeat 1 --shrink intervals
 expect 0 "$F" bench --builtin --size 32x32 --workload soft16 --mode mft --repeat 1 --mft-fallback off
 grep -q ' fallback=off' "$T/out" && ok || bad "bench mft fallback off"
 expect 2 "$F" bench --builtin --workload soft16 --mode mft --mft-fallback maybe

@@ -4,8 +4,8 @@
  * interleaved light samples each) with any-hit, camera frusta (16 blocks of
  * 4x4 pixels) with closest hit, and those turned back into rays of unit
  * direction. Every ISA; corner-ray culling off, for every triangle, and only
- * where it pays (the default); shrinking on and off: all must agree bit for
- * bit.
+ * where it pays (the default); shrinking off, of the corner rays alone and
+ * of corner rays and intervals (the default): all must agree bit for bit.
  *
  * The MFT test and the single-ray test are both watertight but round
  * differently, so a ray that passes within rounding of an edge may get either
@@ -75,7 +75,7 @@ static void check_shadows_vs(const fr_scene *s, const fr_mft_batch *b, const fr_
   int first = 1;
   /* corner: 0 off, 1 for every triangle, 2 where it pays by the default cost */
   for (int corner = 0; corner < 3; corner++)
-    for (int shrink = 0; shrink < 2; shrink++)
+    for (int shrink = FR_MFT_SHRINK_OFF; shrink <= FR_MFT_SHRINK_ALL; shrink++)
       for (int i = 0; i < 3; i++) {
         if (!fr_isa_supported(isas[i])) continue;
         fr_mft_opts o = {corner != 0, shrink, corner == 2 ? fr_mft_opts_default().corner_cost : 0.0f};

@@ -32,7 +32,7 @@ void fr_mft_set_finish(fr_mft_sets *t, int s) {
 #define FR_MFT_CORNER_COST 2.5f
 
 fr_mft_opts fr_mft_opts_default(void) {
-  fr_mft_opts o = {1, 1, FR_MFT_CORNER_COST};
+  fr_mft_opts o = {1, FR_MFT_SHRINK_ALL, FR_MFT_CORNER_COST};
   return o;
 }
 

@@ -74,10 +74,15 @@ typedef struct fr_mft_hits {
   uint32_t prim[FR_MFT_FRUSTA][FR_MFT_RAYS] __attribute__((aligned(64)));
 } fr_mft_hits;
 
+/* What a shadow frustum's bounds shrink to the rays still active (the
+ * paper's Table 2): nothing, the corner rays (its "CR"), or the corner rays
+ * and the direction intervals of the box test. */
+enum { FR_MFT_SHRINK_OFF, FR_MFT_SHRINK_CORNERS, FR_MFT_SHRINK_ALL };
+
 /* What to do (switches for measurement). */
 typedef struct fr_mft_opts {
   int corner_rays;  /* cull frusta against a triangle's edges and plane with corner rays */
-  int shrink;       /* shadows: shrink corner rays and intervals to the active rays */
+  int shrink;       /* shadows: shrink to the active rays (FR_MFT_SHRINK_...) */
   float corner_cost; /* ... only where it is expected to spare more 16-ray tests than this (see
                         mft_traverse.c); 0: for every triangle */
 } fr_mft_opts;

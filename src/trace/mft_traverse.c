@@ -86,8 +86,9 @@ typedef struct ray_box {
 } ray_box;
 
 /* Lane f of R: the box of the rays of frustum f in `rays` (all 16: the set's
- * own box; fewer after shrinking: masked reductions). */
-static void ray_box_of(const frusta *F, int f, unsigned rays, ray_box *R) {
+ * own box; fewer after shrinking: masked reductions), their delta vectors'
+ * box only with `deltas`. */
+static void ray_box_of(const frusta *F, int f, unsigned rays, ray_box *R, int deltas) {
   const fr_mft_set *S = F->set[f];
   if (rays == 0xFFFFu) {
     R->amin[f] = S->amin; R->amax[f] = S->amax; R->bmin[f] = S->bmin; R->bmax[f] = S->bmax;
@@ -101,7 +102,7 @@ static void ray_box_of(const frusta *F, int f, unsigned rays, ray_box *R) {
   R->amax[f] = vp_reduce_max(vp_select(m, vp_load(S->a), ninf));
   R->bmin[f] = vp_reduce_min(vp_select(m, vp_load(S->b), inf));
   R->bmax[f] = vp_reduce_max(vp_select(m, vp_load(S->b), ninf));
-  for (int a = 0; a < 3; a++) {
+  for (int a = 0; a < 3 && deltas; a++) {
     vpf d = vp_load(dl[a]);
     R->lo[a][f] = vp_reduce_min(vp_select(m, d, inf));
     R->hi[a][f] = vp_reduce_max(vp_select(m, d, ninf));
@@ -112,12 +113,14 @@ static void ray_box_of(const frusta *F, int f, unsigned rays, ray_box *R) {
 static inline void store_lanes(float *p, vpm m, vpf v) { vp_store(p, vp_select(m, v, vp_load(p))); }
 
 /* The bounds of the frusta in `lanes` from their ray boxes, all lanes at
- * once (frustum by frustum this was a quarter of soft16's time). */
-static void frusta_bounds(frusta *F, const fr_mft_sets *T, unsigned lanes, const ray_box *R) {
+ * once (frustum by frustum this was a quarter of soft16's time): the corner
+ * rays always, the direction intervals only with `intervals` (without, the
+ * intervals of more rays stay, which still hold these). */
+static void frusta_bounds(frusta *F, const fr_mft_sets *T, unsigned lanes, const ray_box *R, int intervals) {
   const vpm m = vpm_bits_to(lanes);
   const vpf zero = vp(0.0f), one = vp(1.0f), tiny = vp(TINY), ntiny = vp(-TINY);
   vpf big = zero;
-  for (int a = 0; a < 3; a++) {
+  for (int a = 0; a < 3 && intervals; a++) {
     vpf s = vp_load(F->s[a]);
     /* rounding is monotonic: s + lo <= s + delta_k <= s + hi for the rays' own sums */
     vpf dlo = vp_add(s, vp_load(R->lo[a])), dhi = vp_add(s, vp_load(R->hi[a]));
@@ -140,7 +143,8 @@ static void frusta_bounds(frusta *F, const fr_mft_sets *T, unsigned lanes, const
       store_lanes(F->corner[j][a], m, vp_add(vp_load(F->s[a]), c));
     }
   }
-  store_lanes(F->guard, m, vp_mul(vp(GUARD), big));
+  /* without intervals the guard of more rays stays: larger, so still safe */
+  if (intervals) store_lanes(F->guard, m, vp_mul(vp(GUARD), big));
 }
 
 static void frusta_setup(frusta *F, const fr_mft_batch *B, const fr_mft_sets *T, unsigned valid) {
@@ -161,8 +165,8 @@ static void frusta_setup(frusta *F, const fr_mft_batch *B, const fr_mft_sets *T,
     F->set[f] = &T->set[lane_valid ? B->set[f] % FR_MFT_SETS : 0];
   }
   ray_box R;
-  for (int f = 0; f < 16; f++) ray_box_of(F, f, 0xFFFFu, &R);
-  frusta_bounds(F, T, 0xFFFFu, &R);
+  for (int f = 0; f < 16; f++) ray_box_of(F, f, 0xFFFFu, &R, 1);
+  frusta_bounds(F, T, 0xFFFFu, &R, 1);
 }
 
 #define dot3 fr_dot3v
@@ -402,8 +406,10 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
         if (shrink) {
           ray_box R;
           memset(&R, 0, sizeof R);
-          for (unsigned l = shrink; l; l &= l - 1) ray_box_of(&F, __builtin_ctz(l), active[__builtin_ctz(l)], &R);
-          frusta_bounds(&F, T, shrink, &R);
+          const int intervals = opt->shrink == FR_MFT_SHRINK_ALL;
+          for (unsigned l = shrink; l; l &= l - 1)
+            ray_box_of(&F, __builtin_ctz(l), active[__builtin_ctz(l)], &R, intervals);
+          frusta_bounds(&F, T, shrink, &R, intervals);
         }
       }
       break;

@@ -176,8 +176,14 @@ int cmd_bench(int argc, char **argv) {
         if (!strcmp(val, "spread")) light_sets = FR_LIGHT_SETS_SPREAD;
         else if (!strcmp(val, "cells")) light_sets = FR_LIGHT_SETS_CELLS;
         else return cli_error(CLI_USAGE_ERROR, "--light-sets is spread or cells, not '%s'", val);
-      } else if (!strcmp(a, "--corner-rays") || !strcmp(a, "--shrink")) {
-        if (parse_onoff(a, val, !strcmp(a, "--shrink") ? &mopt.shrink : &mopt.corner_rays)) return CLI_USAGE_ERROR;
+      } else if (!strcmp(a, "--shrink")) {
+        /* on: corner rays and intervals (the default); corners: the paper's CR alone */
+        if (!strcmp(val, "off")) mopt.shrink = FR_MFT_SHRINK_OFF;
+        else if (!strcmp(val, "corners")) mopt.shrink = FR_MFT_SHRINK_CORNERS;
+        else if (!strcmp(val, "on")) mopt.shrink = FR_MFT_SHRINK_ALL;
+        else return cli_error(CLI_USAGE_ERROR, "--shrink is on, corners or off, not '%s'", val);
+      } else if (!strcmp(a, "--corner-rays")) {
+        if (parse_onoff(a, val, &mopt.corner_rays)) return CLI_USAGE_ERROR;
       } else if (!strcmp(a, "--mft-fallback")) {
         int on = 1;
         if (parse_onoff(a, val, &on)) return CLI_USAGE_ERROR;
@@ -267,7 +273,7 @@ int cmd_bench(int argc, char **argv) {
   if (want_mft)
     printf("mft_bvh leaf=%d shadow_leaf=%d inner=%zu leaves=%zu sah=%.2f corner_rays=%s corner_cost=%g shrink=%s fallback=%s\n",
            mctx.bvh->max_leaf, mctx.shadow_bvh->max_leaf, mctx.bvh->nnodes, mctx.bvh->nleaves, fr_bvh2_sah(mctx.bvh), mopt.corner_rays ? "on" : "off",
-           (double)mopt.corner_cost, mopt.shrink ? "on" : "off", mft_no_fallback ? "off" : "on");
+           (double)mopt.corner_cost, mopt.shrink == FR_MFT_SHRINK_ALL ? "on" : mopt.shrink == FR_MFT_SHRINK_CORNERS ? "corners" : "off", mft_no_fallback ? "off" : "on");
   fr_whitted_mats mats = {0};
   if ((all_wl || wk == FR_WL_WHITTED) && (rc = cli_whitted_setup(s, &wo, &mats, &w))) {
     fr_bvh2_free(&shallow);

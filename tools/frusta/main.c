@@ -23,7 +23,7 @@ static void usage(FILE *f) {
           "         packet8 packet16 stream; packet switches: [--threshold N] [--packet-width 4|8]\n"
           "         [--mailbox on|off] [--axis-aligned on|off] [--ia on|off]; single rays: [--prefetch\n"
           "         on|off|auto]; multi-frusta: [--light-sets\n"
-          "         spread|cells] [--corner-rays on|off] [--corner-cost C] [--shrink on|off] [--mft-leaf N]\n"
+          "         spread|cells] [--corner-rays on|off] [--corner-cost C] [--shrink on|corners|off] [--mft-leaf N]\n"
           "         [--mft-fallback on|off]\n"
           "  trace  SCENE RAYS --query closest|any --out FILE [--tracer frusta|embree]\n"
           "         [--mode single|packet8|packet16|hybrid16|auto|raystream]\n"
