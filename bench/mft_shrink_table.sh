@@ -7,18 +7,18 @@
 # 1024x1024, best of REPEAT per process; the line gives the best and the mean
 # over rounds. With a counters build in build-count/ it also records, per
 # variant, the frusta's box tests and triangle tests per batch.
-# env: SIZE (1024x1024) REPEAT (3) THREADS (2) ROUNDS (3)
+# env: SIZE (1024x1024) REPEAT (3) THREADS (2) ROUNDS (5)
 #      SCENES ("conference kitchen sibenik dragon") SETS ("spread cells")
 set -euo pipefail
 cd "$(dirname "$0")/.."
-SIZE=${SIZE:-1024x1024}; REPEAT=${REPEAT:-3}; THREADS=${THREADS:-2}; ROUNDS=${ROUNDS:-3}
+SIZE=${SIZE:-1024x1024}; REPEAT=${REPEAT:-3}; THREADS=${THREADS:-2}; ROUNDS=${ROUNDS:-5}
 SCENES=${SCENES:-conference kitchen sibenik dragon}; SETS=${SETS:-spread cells}
 RAW=bench/results/mft-shrink-raw.txt
 mkdir -p bench/results
 : >"$RAW"
 run() { # binary scene sets shrink repeat: the bench's result and counters lines
   "$1" bench "../shared/scenes/$2/$2.ply.zst" --workload soft16 --mode mft --light-sets "$3" --shrink "$4" \
-    --threads "$THREADS" --size "$SIZE" --repeat "$5" | grep -E '^(scene=|counters)' | sed "s/^/sets=$3 shrink=$4 /"
+    --threads "$THREADS" --size "$SIZE" --repeat "$5" | grep -E '^(scene=|counters)' | sed "s/^/sets=$3 shrink=$4 /; s/^\(.*\)counters /scene=$2 \1/"
 }
 for s in $SCENES; do
   for ls in $SETS; do
@@ -37,5 +37,5 @@ awk '/ scene=/ {
   if (!(k in seen)) { seen[k] = 1; order[++m] = k }
 }
 END { for (j = 1; j <= m; j++) { k = order[j]; printf "%s best=%.2f mean=%.2f rounds=%d\n", k, best[k], sum[k] / n[k], n[k] } }' "$RAW"
-grep per_batch "$RAW" | sed 's/counters tracer=frusta mode=mft workload=soft16 //' || true
+grep per_batch "$RAW" | sed 's/tracer=frusta mode=mft workload=soft16 //' || true
 echo "raw lines in $RAW"
