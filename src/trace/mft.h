@@ -17,7 +17,7 @@
  * four corner rays of a frustum are the corners of the (a, b) box of its
  * rays; once a leaf has occluded enough of a frustum's shadow rays they
  * shrink to the box of the rays still active (the paper's "CR" shrinking,
- * §5.3; when: SHRINK_AT in mft_traverse.c).
+ * §5.3; when: EAGER_FETCHED in mft_traverse.c).
  */
 #ifndef FR_TRACE_MFT_H
 #define FR_TRACE_MFT_H

@@ -46,12 +46,13 @@
  * saved where a batch's rays end in a few large occluders (interleaved A/B,
  * soft16 spread, shrinking off against on: conference 1.075x, sibenik
  * 1.08x, kitchen 1.02x) but saved where they end a few at a time in fine
- * geometry and the traversal goes on long (dragon 0.89x). So a frustum
- * shrinks once half the rays its bounds were made from are gone (at most
- * four times), and after every occlusion once its batch has fetched more
- * than EAGER_FETCHED triangles (dragon's batches fetch ~110, conference's
- * and sibenik's ~15, kitchen's ~60). */
-#define SHRINK_AT 2
+ * geometry and the traversal goes on long (dragon 0.89x). So frusta shrink
+ * after every occlusion only once their batch has fetched more than
+ * EAGER_FETCHED triangles (dragon's batches fetch ~110, conference's and
+ * sibenik's ~15, kitchen's ~60). A second rule, shrinking once half the
+ * rays the bounds were made from are gone, in any batch, cost sibenik 9%
+ * (6/6 pairs) and kitchen 10% (5/6) and gained dragon 1-2% (2/6 pairs each
+ * way; CONCURRENT=1 bench/ab.sh, 1 thread, 1024x1024, soft16 mft): dropped. */
 #define EAGER_FETCHED 64u
 
 /* The 16 frusta in structure-of-arrays form; lane f is frustum f. */
@@ -73,7 +74,6 @@ typedef struct frusta {
   float rd[16][3][16] __attribute__((aligned(64)));
   unsigned rd_ready;
   unsigned cull_seen, cull_gone; /* frustum-triangle pairs the corner-ray cull saw and removed */
-  int bound_rays[16];            /* the rays its bounds were last made from (see SHRINK_AT) */
   const fr_mft_set *set[16];
 } frusta;
 
@@ -149,7 +149,6 @@ static void frusta_bounds(frusta *F, const fr_mft_sets *T, unsigned lanes, const
 
 static void frusta_setup(frusta *F, const fr_mft_batch *B, const fr_mft_sets *T, unsigned valid) {
   F->rd_ready = 0;
-  for (int f = 0; f < 16; f++) F->bound_rays[f] = 16;
   F->cull_seen = 2; /* a prior: half culled */
   F->cull_gone = 1;
   memset(F->pos, 0, sizeof F->pos);
@@ -393,12 +392,8 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
           if (!active[f]) {
             alive &= ~(1u << f);
             m &= ~(1u << f);
-          } else if (opt->shrink) {
-            const int left_rays = __builtin_popcount(active[f]);
-            if (fetched > EAGER_FETCHED || SHRINK_AT * left_rays <= F.bound_rays[f]) {
-              shrink |= 1u << f;
-              F.bound_rays[f] = left_rays;
-            }
+          } else if (opt->shrink && fetched > EAGER_FETCHED) {
+            shrink |= 1u << f;
           }
         }
         /* a frustum's bounds next serve the next triangle: shrink the ones
