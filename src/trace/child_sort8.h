@@ -19,6 +19,7 @@
 #ifndef FR_TRACE_CHILD_SORT8_H
 #define FR_TRACE_CHILD_SORT8_H
 #include <stdint.h>
+#include <string.h>
 #include "base/simd.h"
 
 #if defined(FR_BUILD_ISA_AVX512) || defined(FR_BUILD_ISA_AVX2)
@@ -32,10 +33,35 @@
     key = _mm256_blend_epi32(_mm256_min_epi32(key, other_), _mm256_max_epi32(key, other_), imm);          \
   } while (0)
 
+/* One child's key, as the network below makes it. */
+static inline int32_t fr_child_key(float d, int slot) {
+  int32_t b;
+  memcpy(&b, &d, sizeof b);
+  b ^= (int32_t)((uint32_t)(b >> 31) >> 1);
+  return (b & ~7) | slot;
+}
+
+/* Two hits, the commonest case after one: the same order from two scalar
+ * keys, picked by conditional moves. It runs about as many instructions as
+ * the network but gets the nearest child, whose node load comes next, some
+ * 20 cycles sooner than the six dependent layers; single-ray diffuse8 gained
+ * 1.04x on four scenes (README, Performance). */
+FR_INLINE uint32_t fr_child_sort2(const uint32_t *child, int i0, int i1, __m256 dist, void *out) {
+  float d[8] __attribute__((aligned(32)));
+  _mm256_store_ps(d, dist);
+  int swap = fr_child_key(d[i1], i1) < fr_child_key(d[i0], i0);
+  int nr = swap ? i1 : i0, fr = swap ? i0 : i1;
+  struct { uint32_t ref; float dist; } e[2] = {{child[fr], d[fr]}, {child[nr], d[nr]}};
+  memcpy(out, e, sizeof e);
+  return child[nr];
+}
+
 /* Writes the eight (child, distance) pairs, hits farthest first, to out
  * (room for eight 8-byte entries: child in the low word) and returns the
  * nearest hit child. mask holds at least one hit. */
 FR_INLINE uint32_t fr_child_sort8(const uint32_t *child, int mask, __m256 dist, void *out) {
+  unsigned rest = (unsigned)mask & ((unsigned)mask - 1);
+  if (rest && !(rest & (rest - 1))) return fr_child_sort2(child, __builtin_ctz((unsigned)mask), __builtin_ctz(rest), dist, out);
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   __m256i bits = _mm256_castps_si256(dist);
   /* negative floats: flip all but the sign bit, so integer order is float order */
