@@ -41,8 +41,8 @@ static inline int32_t fr_child_key(float d, int slot) {
   return (b & ~7) | slot;
 }
 
-/* Two hits, the commonest case after one: the same order from two scalar
- * keys, picked by conditional moves. It runs about as many instructions as
+/* Exactly two hits: the same order from two scalar keys, picked by
+ * conditional moves. It runs about as many instructions as
  * the network but gets the nearest child, whose node load comes next, some
  * 20 cycles sooner than the six dependent layers; single-ray diffuse8 gained
  * 1.04x on four scenes (README, Performance). */
@@ -56,9 +56,9 @@ FR_INLINE uint32_t fr_child_sort2(const uint32_t *child, int i0, int i1, __m256 
   return child[nr];
 }
 
-/* Writes the eight (child, distance) pairs, hits farthest first, to out
- * (room for eight 8-byte entries: child in the low word) and returns the
- * nearest hit child. mask holds at least one hit. */
+/* Writes the hit children's (child, distance) pairs, farthest first, to out
+ * (room for eight 8-byte entries, child in the low word; up to all eight are
+ * written) and returns the nearest hit child. mask holds at least one hit. */
 FR_INLINE uint32_t fr_child_sort8(const uint32_t *child, int mask, __m256 dist, void *out) {
   unsigned rest = (unsigned)mask & ((unsigned)mask - 1);
   if (rest && !(rest & (rest - 1))) return fr_child_sort2(child, __builtin_ctz((unsigned)mask), __builtin_ctz(rest), dist, out);
