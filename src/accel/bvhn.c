@@ -11,6 +11,12 @@ typedef struct conv {
   fr_bvhn *b;
   size_t node_bytes;
   int max_blocks; /* per leaf */
+  /* The optimal collapse (see plan_node): per binary node of more than
+   * FR_BUILD_MAX_LEAF triangles, its row in the tables below, else -1. */
+  int32_t *row;
+  float *cost;   /* [row * W + s - 1]: least cost of the subtree as s roots */
+  uint8_t *pick; /* [row * (W + 1) + s]: how (see plan_node) */
+  int dp;        /* 0: the greedy collapse (FRUSTA_COLLAPSE=greedy) */
 } conv;
 
 static void fill_block(conv *c, fr_tri4 *blk, uint32_t first, uint32_t count) {
@@ -79,31 +85,10 @@ static int leaf_pays(conv *c, const fr_build_node *n) {
 static float *node_floats(conv *c, uint32_t i) { return (float *)((char *)c->b->nodes + (size_t)i * c->node_bytes); }
 static uint32_t *node_children(conv *c, uint32_t i) { return (uint32_t *)(node_floats(c, i) + 6 * c->b->width); }
 
-/* Collapses the binary tree: a node adopts the children of its largest child
- * that holds more than four triangles until it has W children; children of at
- * most four triangles become leaves. (Opening those small leaves too, to fill
- * every slot as Embree does, lowers the per-triangle SAH but leaves 4-wide
- * triangle tests 40-60% empty: measured slower for BVH8, no faster for BVH4,
- * and 40% more memory.) */
-static uint32_t convert(conv *c, int32_t bi, int depth) {
-  const fr_build_node *n = &c->t->nodes[bi];
+/* Emits a wide node over the binary subtrees kids[0..nk) and converts them. */
+static uint32_t convert(conv *c, int32_t bi, int depth);
+static uint32_t emit_node(conv *c, const int32_t *kids, int nk, int depth) {
   const int W = c->b->width;
-  if (depth > c->b->depth) c->b->depth = depth;
-  if (n->count <= FR_BUILD_MAX_LEAF || leaf_pays(c, n)) return make_leaf(c, n);
-  int32_t kids[8] = {n->left, n->right};
-  int nk = 2;
-  while (nk < W) {
-    int best = -1;
-    float area = -1.0f;
-    for (int k = 0; k < nk; k++) {
-      const fr_build_node *ch = &c->t->nodes[kids[k]];
-      if (ch->count > FR_BUILD_MAX_LEAF && aabb_half_area(ch->box) > area) { area = aabb_half_area(ch->box); best = k; }
-    }
-    if (best < 0) break;
-    const fr_build_node *ch = &c->t->nodes[kids[best]];
-    kids[best] = ch->left;
-    kids[nk++] = ch->right;
-  }
   uint32_t self = (uint32_t)c->b->nnodes++;
   float *f = node_floats(c, self);
   uint32_t *child = node_children(c, self);
@@ -120,6 +105,119 @@ static uint32_t convert(conv *c, int32_t bi, int depth) {
     node_children(c, self)[k] = r;
   }
   return self;
+}
+
+/* The optimal collapse (Ylitie, Karras, Laine, "Efficient Incoherent Ray
+ * Traversal on GPUs Through Compressed Wide BVHs", HPG 2017, §3): bottom up,
+ * the least SAH cost of each binary subtree when it fills s = 1..W slots of
+ * its wide parent, with Embree's costs (a node visit and a block test both
+ * 1, times the box's area). One slot: a leaf (at most max_blocks blocks) or
+ * a wide node whose W slots are shared out between the two children. More
+ * slots: the subtree as one root, or its children sharing them. Subtrees of
+ * at most four triangles stay one leaf, as in the greedy collapse.
+ * pick[s] for s >= 2: 0 = as one root, k = k slots to the left child;
+ * pick[0]: the left child's share when the node is a wide node; pick[1]: 1
+ * when it is a wide node rather than a leaf. */
+static float plan_cost(const conv *c, int32_t bi, int s) {
+  int32_t r = c->row[bi];
+  if (r < 0) return aabb_half_area(c->t->nodes[bi].box) * fr_build_blocks(c->t->nodes[bi].count);
+  return c->cost[(size_t)r * (size_t)c->b->width + (size_t)s - 1];
+}
+
+static void plan_node(conv *c, int32_t bi) {
+  const fr_build_node *n = &c->t->nodes[bi];
+  const int W = c->b->width;
+  if (c->row[bi] < 0) return;
+  plan_node(c, n->left);
+  plan_node(c, n->right);
+  float *cost = c->cost + (size_t)c->row[bi] * (size_t)W;
+  uint8_t *pick = c->pick + (size_t)c->row[bi] * (size_t)(W + 1);
+  float share[8 + 1];
+  uint8_t share_k[8 + 1];
+  for (int s = 2; s <= W; s++) {
+    share[s] = INFINITY;
+    share_k[s] = 1;
+    for (int k = 1; k < s; k++) {
+      float x = plan_cost(c, n->left, k) + plan_cost(c, n->right, s - k);
+      if (x < share[s]) { share[s] = x; share_k[s] = (uint8_t)k; }
+    }
+  }
+  float a = aabb_half_area(n->box);
+  float leaf = n->count <= FR_BUILD_MAX_LEAF * (uint32_t)c->max_blocks ? a * fr_build_blocks(n->count) : INFINITY;
+  float inner = a + share[W];
+  cost[0] = leaf <= inner ? leaf : inner;
+  pick[0] = share_k[W];
+  pick[1] = !(leaf <= inner);
+  for (int s = 2; s <= W; s++) {
+    int split = share[s] < cost[s - 2];
+    cost[s - 1] = split ? share[s] : cost[s - 2];
+    pick[s] = split ? share_k[s] : 0;
+  }
+}
+
+/* The binary subtrees that fill s slots of a wide node, as planned. */
+static void plan_roots(const conv *c, int32_t bi, int s, int32_t *kids, int *nk) {
+  int32_t r = c->row[bi];
+  const uint8_t *pick = r < 0 ? NULL : c->pick + (size_t)r * (size_t)(c->b->width + 1);
+  while (s > 1 && (!pick || pick[s] == 0)) s--;
+  if (s == 1) { kids[(*nk)++] = bi; return; }
+  plan_roots(c, c->t->nodes[bi].left, pick[s], kids, nk);
+  plan_roots(c, c->t->nodes[bi].right, s - pick[s], kids, nk);
+}
+
+/* Collapses the binary tree. With the plan: as planned. Greedily: a node
+ * adopts the children of its largest child that holds more than four
+ * triangles until it has W children; children of at most four triangles
+ * become leaves. (Opening those small leaves too, to fill every slot as
+ * Embree does, lowers the per-triangle SAH but leaves 4-wide triangle tests
+ * 40-60% empty: measured slower for BVH8, no faster for BVH4, and 40% more
+ * memory.) */
+static uint32_t convert(conv *c, int32_t bi, int depth) {
+  const fr_build_node *n = &c->t->nodes[bi];
+  const int W = c->b->width;
+  if (depth > c->b->depth) c->b->depth = depth;
+  int32_t kids[8];
+  int nk = 0;
+  if (c->dp) {
+    int32_t r = c->row[bi];
+    const uint8_t *pick = r < 0 ? NULL : c->pick + (size_t)r * (size_t)(W + 1);
+    if (!pick || !pick[1]) return make_leaf(c, n);
+    plan_roots(c, n->left, pick[0], kids, &nk);
+    plan_roots(c, n->right, W - pick[0], kids, &nk);
+    return emit_node(c, kids, nk, depth);
+  }
+  if (n->count <= FR_BUILD_MAX_LEAF || leaf_pays(c, n)) return make_leaf(c, n);
+  kids[0] = n->left; kids[1] = n->right;
+  nk = 2;
+  while (nk < W) {
+    int best = -1;
+    float area = -1.0f;
+    for (int k = 0; k < nk; k++) {
+      const fr_build_node *ch = &c->t->nodes[kids[k]];
+      if (ch->count > FR_BUILD_MAX_LEAF && aabb_half_area(ch->box) > area) { area = aabb_half_area(ch->box); best = k; }
+    }
+    if (best < 0) break;
+    const fr_build_node *ch = &c->t->nodes[kids[best]];
+    kids[best] = ch->left;
+    kids[nk++] = ch->right;
+  }
+  return emit_node(c, kids, nk, depth);
+}
+
+/* Rows of the plan's tables for the nodes of more than four triangles. */
+static fr_error plan_tables(conv *c) {
+  const size_t nn = c->t->nnodes, W = (size_t)c->b->width;
+  c->row = malloc(fr_mul_size(nn, sizeof *c->row));
+  size_t rows = 0;
+  if (c->row)
+    for (size_t i = 0; i < nn; i++) c->row[i] = c->t->nodes[i].count > FR_BUILD_MAX_LEAF ? (int32_t)rows++ : -1;
+  c->cost = malloc(fr_mul_size(rows ? rows : 1, W * sizeof *c->cost));
+  c->pick = malloc(fr_mul_size(rows ? rows : 1, W + 1));
+  if (!c->row || !c->cost || !c->pick) {
+    free(c->row); free(c->cost); free(c->pick);
+    return fr_fail(FR_ERR_NOMEM, "BVH%d: out of memory", c->b->width);
+  }
+  return FR_OK;
 }
 
 fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width, fr_bvhn *out) {
@@ -142,8 +240,16 @@ fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width,
   const char *env = getenv("FRUSTA_LEAF_BLOCKS");
   int mb = FR_BVHN_DEFAULT_LEAF_BLOCKS;
   if (env && env[0] >= '1' && env[0] <= '0' + FR_BVHN_MAX_LEAF_BLOCKS && !env[1]) mb = env[0] - '0';
-  conv c = {t, m, out, node_bytes, mb};
+  conv c = {t, m, out, node_bytes, mb, NULL, NULL, NULL, 1};
+  const char *how = getenv("FRUSTA_COLLAPSE"); /* greedy: the old rule, for measurements */
+  if ((how && !strcmp(how, "greedy")) || !t->nprims) c.dp = 0; /* no triangles: one empty leaf */
+  if (c.dp) {
+    fr_error e = plan_tables(&c);
+    if (e) { fr_bvhn_free(out); return e; }
+    plan_node(&c, 0);
+  }
   out->root = convert(&c, 0, 1);
+  free(c.row); free(c.cost); free(c.pick);
   out->prefetch = fr_bvhn_prefetch_auto(out);
   return FR_OK;
 }
