@@ -118,6 +118,12 @@ static uint32_t emit_node(conv *c, const int32_t *kids, int nk, int depth) {
  * pick[s] for s >= 2: 0 = as one root, k = k slots to the left child;
  * pick[0]: the left child's share when the node is a wide node; pick[1]: 1
  * when it is a wide node rather than a leaf. */
+/* Node bi's pick row, or NULL for a subtree of at most four triangles. */
+static uint8_t *plan_pick(const conv *c, int32_t bi) {
+  int32_t r = c->row[bi];
+  return r < 0 ? NULL : c->pick + (size_t)r * (size_t)(c->b->width + 1);
+}
+
 static float plan_cost(const conv *c, int32_t bi, int s) {
   int32_t r = c->row[bi];
   if (r < 0) return aabb_half_area(c->t->nodes[bi].box) * fr_build_blocks(c->t->nodes[bi].count);
@@ -131,7 +137,7 @@ static void plan_node(conv *c, int32_t bi) {
   plan_node(c, n->left);
   plan_node(c, n->right);
   float *cost = c->cost + (size_t)c->row[bi] * (size_t)W;
-  uint8_t *pick = c->pick + (size_t)c->row[bi] * (size_t)(W + 1);
+  uint8_t *pick = plan_pick(c, bi);
   float share[8 + 1];
   uint8_t share_k[8 + 1];
   for (int s = 2; s <= W; s++) {
@@ -157,8 +163,7 @@ static void plan_node(conv *c, int32_t bi) {
 
 /* The binary subtrees that fill s slots of a wide node, as planned. */
 static void plan_roots(const conv *c, int32_t bi, int s, int32_t *kids, int *nk) {
-  int32_t r = c->row[bi];
-  const uint8_t *pick = r < 0 ? NULL : c->pick + (size_t)r * (size_t)(c->b->width + 1);
+  const uint8_t *pick = plan_pick(c, bi);
   while (s > 1 && (!pick || pick[s] == 0)) s--;
   if (s == 1) { kids[(*nk)++] = bi; return; }
   plan_roots(c, c->t->nodes[bi].left, pick[s], kids, nk);
@@ -179,8 +184,7 @@ static uint32_t convert(conv *c, int32_t bi, int depth) {
   int32_t kids[8];
   int nk = 0;
   if (c->dp) {
-    int32_t r = c->row[bi];
-    const uint8_t *pick = r < 0 ? NULL : c->pick + (size_t)r * (size_t)(W + 1);
+    const uint8_t *pick = plan_pick(c, bi);
     if (!pick || !pick[1]) return make_leaf(c, n);
     plan_roots(c, n->left, pick[0], kids, &nk);
     plan_roots(c, n->right, W - pick[0], kids, &nk);
