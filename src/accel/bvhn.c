@@ -66,6 +66,9 @@ static uint32_t make_leaf(conv *c, const fr_build_node *n) {
   return FR_BVHN_LEAF_REF(first, nb);
 }
 
+/* A node's cost as one leaf by SAH: its area times its 4-triangle blocks. */
+static float leaf_cost(const fr_build_node *n) { return aabb_half_area(n->box) * fr_build_blocks(n->count); }
+
 /* Whether a node of more than four triangles ends as a leaf of several
  * blocks: when testing all its blocks costs no more than visiting it and
  * testing its two halves' blocks (Embree's rule, node visit and block test
@@ -75,10 +78,7 @@ static int leaf_pays(conv *c, const fr_build_node *n) {
   /* n has more than FR_BUILD_MAX_LEAF triangles, so it has two children */
   if (n->count > FR_BUILD_MAX_LEAF * (uint32_t)c->max_blocks) return 0;
   const fr_build_node *l = &c->t->nodes[n->left], *r = &c->t->nodes[n->right];
-  float a = aabb_half_area(n->box);
-  float leaf = a * fr_build_blocks(n->count);
-  float split = a + aabb_half_area(l->box) * fr_build_blocks(l->count) + aabb_half_area(r->box) * fr_build_blocks(r->count);
-  return leaf <= split;
+  return leaf_cost(n) <= aabb_half_area(n->box) + leaf_cost(l) + leaf_cost(r);
 }
 
 /* Node i's float arrays (generic over the width). */
@@ -107,6 +107,12 @@ static uint32_t emit_node(conv *c, const int32_t *kids, int nk, int depth) {
   return self;
 }
 
+/* Node bi's pick row, or NULL for a subtree of at most four triangles. */
+static uint8_t *plan_pick(const conv *c, int32_t bi) {
+  int32_t r = c->row[bi];
+  return r < 0 ? NULL : c->pick + (size_t)r * (size_t)(c->b->width + 1);
+}
+
 /* The optimal collapse (Ylitie, Karras, Laine, "Efficient Incoherent Ray
  * Traversal on GPUs Through Compressed Wide BVHs", HPG 2017, §3): bottom up,
  * the least SAH cost of each binary subtree when it fills s = 1..W slots of
@@ -118,15 +124,9 @@ static uint32_t emit_node(conv *c, const int32_t *kids, int nk, int depth) {
  * pick[s] for s >= 2: 0 = as one root, k = k slots to the left child;
  * pick[0]: the left child's share when the node is a wide node; pick[1]: 1
  * when it is a wide node rather than a leaf. */
-/* Node bi's pick row, or NULL for a subtree of at most four triangles. */
-static uint8_t *plan_pick(const conv *c, int32_t bi) {
-  int32_t r = c->row[bi];
-  return r < 0 ? NULL : c->pick + (size_t)r * (size_t)(c->b->width + 1);
-}
-
 static float plan_cost(const conv *c, int32_t bi, int s) {
   int32_t r = c->row[bi];
-  if (r < 0) return aabb_half_area(c->t->nodes[bi].box) * fr_build_blocks(c->t->nodes[bi].count);
+  if (r < 0) return leaf_cost(&c->t->nodes[bi]);
   return c->cost[(size_t)r * (size_t)c->b->width + (size_t)s - 1];
 }
 
@@ -149,7 +149,7 @@ static void plan_node(conv *c, int32_t bi) {
     }
   }
   float a = aabb_half_area(n->box);
-  float leaf = n->count <= FR_BUILD_MAX_LEAF * (uint32_t)c->max_blocks ? a * fr_build_blocks(n->count) : INFINITY;
+  float leaf = n->count <= FR_BUILD_MAX_LEAF * (uint32_t)c->max_blocks ? leaf_cost(n) : INFINITY;
   float inner = a + share[W];
   cost[0] = leaf <= inner ? leaf : inner;
   pick[0] = share_k[W];
