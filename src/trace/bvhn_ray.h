@@ -88,13 +88,17 @@ FR_INLINE vnode visit_node(const node_t *n, const ray_pre *r, float tfar, int *m
 
 typedef struct tri4_result { vfloat4 t, e1, e2, inv; int mask; } tri4_result;
 
-/* Edge values of exactly zero are recomputed in double, lane by lane (rare). */
-static void exact_edges(vfloat4 *e0, vfloat4 *e1, vfloat4 *e2, vfloat4 ax, vfloat4 ay, vfloat4 bx, vfloat4 by,
-                        vfloat4 cx, vfloat4 cy, int lanes) {
+typedef struct tri4_edges { vfloat4 e0, e1, e2; } tri4_edges;
+
+/* Edge values of exactly zero are recomputed in double, lane by lane (rare).
+ * The edges go in and come back by value: passing their addresses kept them
+ * in memory, three stores per block on the hot path of every leaf. */
+static __attribute__((noinline, cold)) tri4_edges exact_edges(tri4_edges e, vfloat4 ax, vfloat4 ay, vfloat4 bx,
+                                                              vfloat4 by, vfloat4 cx, vfloat4 cy, int lanes) {
   float E0[4] __attribute__((aligned(16))), E1[4] __attribute__((aligned(16))), E2[4] __attribute__((aligned(16)));
   float AX[4] __attribute__((aligned(16))), AY[4] __attribute__((aligned(16))), BX[4] __attribute__((aligned(16)));
   float BY[4] __attribute__((aligned(16))), CX[4] __attribute__((aligned(16))), CY[4] __attribute__((aligned(16)));
-  vf4_store(E0, *e0); vf4_store(E1, *e1); vf4_store(E2, *e2);
+  vf4_store(E0, e.e0); vf4_store(E1, e.e1); vf4_store(E2, e.e2);
   vf4_store(AX, ax); vf4_store(AY, ay); vf4_store(BX, bx); vf4_store(BY, by); vf4_store(CX, cx); vf4_store(CY, cy);
   for (int i = 0; i < 4; i++) {
     if (!((lanes >> i) & 1)) continue;
@@ -102,7 +106,8 @@ static void exact_edges(vfloat4 *e0, vfloat4 *e1, vfloat4 *e2, vfloat4 ax, vfloa
     E1[i] = (float)((double)AX[i] * CY[i] - (double)AY[i] * CX[i]);
     E2[i] = (float)((double)BX[i] * AY[i] - (double)BY[i] * AX[i]);
   }
-  *e0 = vf4_load(E0); *e1 = vf4_load(E1); *e2 = vf4_load(E2);
+  tri4_edges out = {vf4_load(E0), vf4_load(E1), vf4_load(E2)};
+  return out;
 }
 
 /* Four triangles against one ray; mask of lanes hit in (tnear, tfar). The
@@ -129,7 +134,11 @@ FR_INLINE void tri4_test(const fr_tri4 *tr, const ray_pre *r, float tfar, tri4_r
   vfloat4 e2 = vf4_sub(vf4_mul(bx, ay), vf4_mul(by, ax));
   vfloat4 zero = vf4(0.0f);
   int zeros = vm4_bits(vm4_or(vm4_or(vf4_eq(e0, zero), vf4_eq(e1, zero)), vf4_eq(e2, zero)));
-  if (__builtin_expect(zeros != 0, 0)) exact_edges(&e0, &e1, &e2, ax, ay, bx, by, cx, cy, zeros);
+  if (__builtin_expect(zeros != 0, 0)) {
+    tri4_edges in = {e0, e1, e2};
+    tri4_edges ex = exact_edges(in, ax, ay, bx, by, cx, cy, zeros);
+    e0 = ex.e0; e1 = ex.e1; e2 = ex.e2;
+  }
   vfloat4 lo = vf4_min(e0, vf4_min(e1, e2)), hi = vf4_max(e0, vf4_max(e1, e2));
   vmask4 inside = vm4_or(vf4_ge(lo, zero), vf4_le(hi, zero));
   res->mask = 0;
