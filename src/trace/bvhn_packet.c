@@ -342,8 +342,11 @@ static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
   valid = packet_setup(&pk, valid, in);
   FR_COUNT(packets, 1);
   FR_COUNT(rays, __builtin_popcount(valid));
-  uint32_t best[P];
-  for (int i = 0; i < P; i++) best[i] = FR_INVALID_ID;
+  /* Each lane's best triangle (4 * block + lane) as the bits of a float, in
+   * a register: a hit updates it with one select instead of a store per lane. */
+  typedef union { float f[P]; uint32_t u[P]; } lane_ids;
+  union { uint32_t u; float f; } id_bits = {FR_INVALID_ID};
+  vpf best = vp(id_bits.f);
   pregs R;
   for (int a = 0; a < 3; a++) { R.o[a] = vp_load(pk.o[a]); R.rd[a] = vp_load(pk.rd[a]); }
   R.tnear = vp_load(pk.tnear);
@@ -382,14 +385,15 @@ static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
       FR_COUNT(switches, 1);
       FR_COUNT(switch_rays, nactive);
       float TF[P] __attribute__((aligned(64))), UU[P] __attribute__((aligned(64))), VV[P] __attribute__((aligned(64)));
-      vp_store(TF, tfar); vp_store(UU, U); vp_store(VV, V);
+      lane_ids B __attribute__((aligned(64)));
+      vp_store(TF, tfar); vp_store(UU, U); vp_store(VV, V); vp_store(B.f, best);
       for (unsigned m = active; m; m &= m - 1) {
         int i = __builtin_ctz(m);
         fr_ray r = lane_ray(&pk, i, TF[i]);
         fr_subtree_hit h;
-        if (o->single->intersect_subtree(b, ref, &r, &h)) { TF[i] = h.t; UU[i] = h.u; VV[i] = h.v; best[i] = h.id; }
+        if (o->single->intersect_subtree(b, ref, &r, &h)) { TF[i] = h.t; UU[i] = h.u; VV[i] = h.v; B.u[i] = h.id; }
       }
-      tfar = vp_load(TF); U = vp_load(UU); V = vp_load(VV);
+      tfar = vp_load(TF); U = vp_load(UU); V = vp_load(VV); best = vp_load(B.f);
       tmax_stale = 1;
       continue;
     }
@@ -409,7 +413,8 @@ static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
         tfar = vp_select(hm, t, tfar);
         U = vp_select(hm, u, U);
         V = vp_select(hm, v, V);
-        for (unsigned m = hit; m; m &= m - 1) best[__builtin_ctz(m)] = 4 * li + (uint32_t)j;
+        id_bits.u = 4 * li + (uint32_t)j;
+        best = vp_select(hm, vp(id_bits.f), best);
         /* finish() reads the hit triangles' vertices: start loading them now */
         const char *blk = (const char *)&b->tris[li + (uint32_t)j / 4];
         __builtin_prefetch(blk);
@@ -466,7 +471,9 @@ static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
     }
   }
 
-  finish(b, &pk, best, tfar, U, V, out);
+  lane_ids B __attribute__((aligned(64)));
+  vp_store(B.f, best);
+  finish(b, &pk, B.u, tfar, U, V, out);
 }
 
 static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const fr_ray16 *in,
