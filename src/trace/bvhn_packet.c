@@ -279,6 +279,13 @@ static inline fr_ray lane_ray(const packet *pk, int i, float tfar) {
 /* A closest-hit packet's answers in registers (prim as float bit patterns). */
 typedef struct hit_regs { vpf t, u, v, prim, ng[3]; } hit_regs;
 
+/* A triangle id as the bits of a float lane, and a packet's ids as both. */
+FR_INLINE vpf vp_id(uint32_t id) {
+  union { uint32_t u; float f; } c = {id};
+  return vp(c.f);
+}
+typedef union { float f[P]; uint32_t u[P]; } lane_ids;
+
 /* The answers of fr_hit_finish, for all lanes at once: the hit triangles'
  * vertices gathered lane by lane, the double-precision t of
  * fr_tri_refine_lane in one loop the compiler vectorizes, the normal as
@@ -295,8 +302,7 @@ static void finish(const fr_bvhn *b, const packet *pk, const uint32_t *best, vpf
     ix[i] = ok ? (int32_t)((best[i] >> 2) * REC + (best[i] & 3)) : 0;
   }
   const vpf zero = vp(0.0f);
-  union { uint32_t u; float f; } invalid = {FR_INVALID_ID};
-  h->t = vp(INFINITY); h->u = h->v = zero; h->prim = vp(invalid.f);
+  h->t = vp(INFINITY); h->u = h->v = zero; h->prim = vp_id(FR_INVALID_ID);
   h->ng[0] = h->ng[1] = h->ng[2] = zero;
   if (!hit) return;
   /* A[3 * vertex + axis]; ix counts floats from b->tris, so it must fit an int32 */
@@ -344,9 +350,7 @@ static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
   FR_COUNT(rays, __builtin_popcount(valid));
   /* Each lane's best triangle (4 * block + lane) as the bits of a float, in
    * a register: a hit updates it with one select instead of a store per lane. */
-  typedef union { float f[P]; uint32_t u[P]; } lane_ids;
-  union { uint32_t u; float f; } id_bits = {FR_INVALID_ID};
-  vpf best = vp(id_bits.f);
+  vpf best = vp_id(FR_INVALID_ID);
   pregs R;
   for (int a = 0; a < 3; a++) { R.o[a] = vp_load(pk.o[a]); R.rd[a] = vp_load(pk.rd[a]); }
   R.tnear = vp_load(pk.tnear);
@@ -413,8 +417,7 @@ static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
         tfar = vp_select(hm, t, tfar);
         U = vp_select(hm, u, U);
         V = vp_select(hm, v, V);
-        id_bits.u = 4 * li + (uint32_t)j;
-        best = vp_select(hm, vp(id_bits.f), best);
+        best = vp_select(hm, vp_id(4 * li + (uint32_t)j), best);
         /* finish() reads the hit triangles' vertices: start loading them now */
         const char *blk = (const char *)&b->tris[li + (uint32_t)j / 4];
         __builtin_prefetch(blk);
