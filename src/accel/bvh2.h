@@ -65,4 +65,19 @@ fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_le
 fr_error fr_bvh2_shallow(const fr_build_tree *t, const fr_bvh2 *full, int max_leaf, fr_bvh2 *out);
 void fr_bvh2_free(fr_bvh2 *b);
 double fr_bvh2_sah(const fr_bvh2 *b);
+
+/* Starts loading what child reference ref will be read for: its node, or
+ * the first max_lines cache lines of its leaf's triangles (spheres in a
+ * sphere tree). A traversal calls it on children it means to visit soon. */
+static inline void fr_bvh2_prefetch(const fr_bvh2 *b, uint32_t ref, uint32_t max_lines) {
+  if (!(ref & FR_BVH2_LEAF)) {
+    __builtin_prefetch(&b->nodes[ref]);
+    return;
+  }
+  uint32_t first = ref & FR_BVH2_FIRST_MASK, count = (ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
+  if (b->tris)
+    for (uint32_t i = 0; i < count && i < max_lines; i++) __builtin_prefetch(&b->tris[first + i]);
+  else if (b->spheres) /* four to a line */
+    for (uint32_t i = 0; i < count && i < 4 * max_lines; i += 4) __builtin_prefetch(&b->spheres[first + i]);
+}
 #endif

@@ -333,6 +333,13 @@ static void leaf(state *S, const entry *e, int closest) {
   }
 }
 
+/* Both children are pushed untested (narrow tests them when popped), and
+ * their nodes or first leaf lines are prefetched as they are pushed. 0
+ * turns that off, for measurement. */
+#ifndef LP_PREFETCH_LINES
+#define LP_PREFETCH_LINES 4
+#endif
+
 /* The packet through one tree (triangles or spheres). */
 static void walk(state *S0, const fr_bvh2 *b, int closest) {
   state S = *S0;
@@ -370,6 +377,10 @@ static void walk(state *S0, const fr_bvh2 *b, int closest) {
     c1.ref = n->child[near]; c1.parent = n; c1.slot = near;
     stack[sp++] = c0;
     stack[sp++] = c1;
+#if LP_PREFETCH_LINES
+    fr_bvh2_prefetch(b, c1.ref, LP_PREFETCH_LINES);
+    fr_bvh2_prefetch(b, c0.ref, LP_PREFETCH_LINES);
+#endif
   }
   S0->live = S.live;
 }
