@@ -245,13 +245,26 @@ typedef struct stack_entry {
   const float *box;
 } stack_entry;
 
+/* prefetch_ref for the packet kernels: their leaves read the Shevtsov
+ * records (48 bytes, four per block), not the blocks. */
+FR_INLINE void prefetch_packet_ref(const fr_bvhn *b, uint32_t ref) {
+  if (!(ref & FR_BVHN_LEAF)) {
+    prefetch_ref(b, ref);
+    return;
+  }
+  const char *p = (const char *)&b->shev[4 * (size_t)FR_BVHN_LEAF_FIRST(ref)];
+  __builtin_prefetch(p);
+  __builtin_prefetch(p + 64);
+  __builtin_prefetch(p + 128);
+}
+
 /* Pushes the children in keep for a lazy test: sorted farthest first (closest
  * hit), or in slot order so that the last slot pops first (any hit). */
 FR_INLINE int push_lazy(const fr_bvhn *b, stack_entry *stack, int sp, const node_t *n, int keep, unsigned active,
                         const float *lo, int sorted) {
   const float *f = (const float *)n;
   if (b->prefetch)
-    for (int m = keep; m; m &= m - 1) prefetch_ref(b, n->child[__builtin_ctz((unsigned)m)]);
+    for (int m = keep; m; m &= m - 1) prefetch_packet_ref(b, n->child[__builtin_ctz((unsigned)m)]);
   if (!sorted) {
     for (; keep; keep &= keep - 1) {
       int c = __builtin_ctz((unsigned)keep);
@@ -468,6 +481,7 @@ static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
     }
     for (int a = 0; a < nh; a++) {
       int x = order[a];
+      if (b->prefetch) prefetch_packet_ref(b, n->child[hc[x]]);
       stack[sp] = (stack_entry){n->child[hc[x]], hmask[x], 0, 0.0f, NULL};
       vp_store(stack_tn[sp], vp_load(tn_c[x]));
       sp++;
@@ -577,7 +591,9 @@ static unsigned occluded_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigne
         int c = __builtin_ctz((unsigned)cand);
         vpf tn;
         unsigned hm = child_test(f, c, &pk, &R, tfar, active, &tn);
-        if (hm) stack[sp++] = (stack_entry){n->child[c], hm, 0, 0.0f, NULL};
+        if (!hm) continue;
+        if (b->prefetch) prefetch_packet_ref(b, n->child[c]);
+        stack[sp++] = (stack_entry){n->child[c], hm, 0, 0.0f, NULL};
       }
     }
   next:
