@@ -162,6 +162,13 @@ static void check_scene(vec3 center, float size, uint64_t seed) {
                 fail_msg("%s isa %d packet %d ray %d: occluded %d vs single %d", cn, isa, p, i, (occ16 >> i) & 1, occ1[i]);
             }
           }
+          /* all lanes valid, packet kernel only: the stream ran the very
+           * packet the packet call did (its rays loaded and its answers
+           * stored as whole records), so even the triangle must match */
+          if (valid == 0xFFFFu && configs[c].threshold == 0 && configs[c].mode != FR_TRACE_AUTO &&
+              configs[c].mode != FR_TRACE_RAYSTREAM && hs[i].prim != h16.prim[i])
+            fail_msg("%s stream isa %d packet %d ray %d: prim %u vs the packet's %u", configs[c].name, isa, p, i,
+                     hs[i].prim, h16.prim[i]);
           if (((valid >> i) & 1) && hs[i].prim == h16.prim[i]) {
             /* the stream's gathered rays and scattered answers: every field
              * as the packet call's (u, v only where both ran the packet

@@ -200,6 +200,10 @@ FR_INLINE void vp_store_records(float *dst, const vpf *f, int nf) {
   for (int i = 0; i < P; i++)
     for (int k = 0; k < nf; k++) memcpy(dst + nf * i + k, &f[k].f[i], sizeof(float));
 }
+FR_INLINE void vp_load_records8(const float *src, vpf f[8]) {
+  for (int i = 0; i < P; i++)
+    for (int k = 0; k < 8; k++) memcpy(&f[k].f[i], src + 8 * i + k, sizeof(float));
+}
 #else
 /* rows r[0..8) of 8 lanes to records 0..7 (8 floats each), in place */
 FR_INLINE void fr_transpose8(__m256 r[8]) {
@@ -228,6 +232,25 @@ FR_INLINE __m256 fr_vp_half(vpf a, int h) {
 #else
   return a.v[h];
 #endif
+}
+/* The inverse for records of 8 floats: f[k] gets field k of records
+ * src[0..P). Eight rows are loaded and transposed at a time, where a
+ * gather per field loads each float on its own. */
+FR_INLINE void vp_load_records8(const float *src, vpf f[8]) {
+  __m256 r[P / 8][8];
+  for (int h = 0; h < P / 8; h++) {
+    for (int i = 0; i < 8; i++) r[h][i] = _mm256_loadu_ps(src + 8 * (8 * h + i));
+    fr_transpose8(r[h]);
+  }
+  for (int k = 0; k < 8; k++) {
+#if defined(FR_BUILD_ISA_AVX512) && P == 16
+    f[k].v = _mm512_insertf32x8(_mm512_castps256_ps512(r[0][k]), r[1][k], 1);
+#elif defined(FR_BUILD_ISA_AVX512)
+    f[k].v = r[0][k];
+#else
+    for (int h = 0; h < P / 8; h++) f[k].v[h] = r[h][k];
+#endif
+  }
 }
 FR_INLINE void vp_store_records(float *dst, const vpf *f, int nf) {
   const __m256i seven = _mm256_setr_epi32(-1, -1, -1, -1, -1, -1, -1, 0);

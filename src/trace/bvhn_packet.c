@@ -71,11 +71,29 @@ FR_INLINE void lane_offsets(const uint32_t *idx, int n, int32_t stride, int32_t 
   for (int i = 0; i < P; i++) out[i] = stride * (int32_t)idx[i < n ? i : 0];
 }
 
+/* Whether idx[0..n) is a full packet of consecutive rays, as a renderer's
+ * calls in one octant give: their rays and hits are then whole records in
+ * a row, moved by transposes instead of gathers and scatters. */
+FR_INLINE int lanes_in_a_row(const uint32_t *idx, int n) {
+  if (n < P) return 0;
+  int ok = 1;
+  for (int i = 0; i < P; i++) ok &= idx[i] == idx[0] + (uint32_t)i;
+  return ok;
+}
+
 _Static_assert(sizeof(fr_ray) == 8 * sizeof(float), "fr_ray is gathered as 8 floats");
 static unsigned load_aos(const fr_ray *rays, const uint32_t *idx, int n, rays_in *r) {
+  const float *f = (const float *)rays;
+  if (lanes_in_a_row(idx, n)) {
+    vpf rec[8];
+    vp_load_records8(f + 8 * (size_t)idx[0], rec);
+    for (int a = 0; a < 3; a++) { r->o[a] = rec[a]; r->d[a] = rec[4 + a]; }
+    r->tnear = rec[3];
+    r->tfar = rec[7];
+    return FR_PACKET_ALL;
+  }
   int32_t gi[P] __attribute__((aligned(64)));
   lane_offsets(idx, n, 8, gi);
-  const float *f = (const float *)rays;
   for (int a = 0; a < 3; a++) {
     r->o[a] = vp_gather(f + a, gi);
     r->d[a] = vp_gather(f + 4 + a, gi);
@@ -527,9 +545,14 @@ static void intersect_rays_idx(const fr_bvhn *b, const fr_packet_opts *o, const 
   const unsigned asked = load_aos(rays, idx, n, &r);
   hit_regs h;
   intersect_rays(b, o, asked, &r, &h);
+  float *f = (float *)hits;
+  if (lanes_in_a_row(idx, n)) {
+    const vpf rec[7] = {h.t, h.u, h.v, h.prim, h.ng[0], h.ng[1], h.ng[2]};
+    vp_store_records(f + 7 * (size_t)idx[0], rec, 7);
+    return;
+  }
   int32_t si[P] __attribute__((aligned(64)));
   lane_offsets(idx, n, 7, si);
-  float *f = (float *)hits;
   vp_scatter(f, si, asked, h.t); vp_scatter(f + 1, si, asked, h.u); vp_scatter(f + 2, si, asked, h.v);
   vp_scatter(f + 3, si, asked, h.prim);
   for (int a = 0; a < 3; a++) vp_scatter(f + 4 + a, si, asked, h.ng[a]);
