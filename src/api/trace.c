@@ -1,6 +1,10 @@
 /* The public tracing calls: single rays, packets of 16, streams, and the
  * choice between the kernels (trace/kernels.h) they make. */
+#include <stddef.h>
 #include <string.h>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 #include "base/error.h"
 #include "scene.h"
 #include "trace/kernels.h"
@@ -154,6 +158,19 @@ static inline int sorts_by_octant(const fr_scene *s) {
   return s->trace.mode == FR_TRACE_AUTO || s->trace.mode == FR_TRACE_RAYSTREAM;
 }
 
+/* A ray's direction octant: bit a is dir[a]'s sign bit. dir and tfar are one
+ * 16-byte row of fr_ray, so SSE reads the three bits with one move mask (a
+ * third of chunk_order's instructions went to the scalar form). */
+_Static_assert(offsetof(fr_ray, tfar) == offsetof(fr_ray, dir) + 3 * sizeof(float), "dir and tfar share a row");
+static inline unsigned ray_octant(const fr_ray *r) {
+#if defined(__SSE__)
+  return (unsigned)_mm_movemask_ps(_mm_loadu_ps(r->dir)) & 7u;
+#else
+  const float *d = r->dir;
+  return (unsigned)((__builtin_signbit(d[0]) != 0) | (__builtin_signbit(d[1]) != 0) << 1 | (__builtin_signbit(d[2]) != 0) << 2);
+#endif
+}
+
 /* The order in which a chunk's rays are grouped into packets; run_end[r] ends
  * the r-th run of rays that may share packets (one run per octant in auto
  * mode). Returns the number of runs. */
@@ -167,8 +184,7 @@ static int chunk_order(int sort, const fr_ray *rays, size_t n, uint32_t *order, 
   uint8_t oct[STREAM_CHUNK];
   unsigned some = 0, every = 7;
   for (size_t i = 0; i < n; i++) {
-    const float *d = rays[i].dir;
-    oct[i] = (uint8_t)((__builtin_signbit(d[0]) != 0) | (__builtin_signbit(d[1]) != 0) << 1 | (__builtin_signbit(d[2]) != 0) << 2);
+    oct[i] = (uint8_t)ray_octant(&rays[i]);
     some |= oct[i];
     every &= oct[i];
     start[oct[i] + 1]++;
