@@ -254,7 +254,7 @@ static void raystream_occluded(const fr_scene *s, const fr_ray *rays, uint8_t *o
       for (size_t m; g < run_end[r]; g += m) {
         m = run_end[r] - g < FR_STREAM_MAX ? run_end[r] - g : FR_STREAM_MAX;
         const uint32_t *idx = order + g;
-        uint32_t o = st->occluded(b, rays + c0, idx, (int)m);
+        uint64_t o = st->occluded(b, rays + c0, idx, (int)m);
         for (size_t i = 0; i < m; i++) occ[c0 + idx[i]] = (uint8_t)((o >> i) & 1);
       }
   }

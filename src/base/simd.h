@@ -10,7 +10,7 @@
  *
  *   vfloat4 / vmask4   four lanes: BVH4 node tests, 4-triangle leaves
  *   vfloat8            eight lanes: BVH8 node tests (comparisons give bit masks)
- *   vbits8             eight 32-bit sets: per child, the rays of a stream that hit it
+ *   vbits8             eight 64-bit sets: per child, the rays of a stream that hit it
  */
 #ifndef FR_BASE_SIMD_H
 #define FR_BASE_SIMD_H
@@ -89,21 +89,30 @@ FR_INLINE int vf8_le_bits(vfloat8 a, vfloat8 b) { return _mm256_cmp_ps_mask(a.v,
 FR_INLINE int vf8_le_bits(vfloat8 a, vfloat8 b) { return _mm256_movemask_ps(_mm256_cmp_ps(a.v, b.v, _CMP_LE_OQ)); }
 #endif
 
-/* eight 32-bit sets, one per child of a node: which rays of a stream hit it */
-typedef struct vbits8 { __m256i v; } vbits8;
-FR_INLINE vbits8 vb8_zero(void) { vbits8 r = {_mm256_setzero_si256()}; return r; }
-FR_INLINE void vb8_store(uint32_t *p, vbits8 a) { _mm256_storeu_si256((__m256i *)p, a.v); }
-/* adds bit to the sets of the lanes in `lanes` */
+/* eight 64-bit sets, one per child of a node: which rays of a stream hit it */
 #if defined(FR_BUILD_ISA_AVX512)
-FR_INLINE vbits8 vb8_or_where(vbits8 a, int lanes, uint32_t bit) {
-  vbits8 r = {_mm256_mask_or_epi32(a.v, (__mmask8)lanes, a.v, _mm256_set1_epi32((int)bit))};
+typedef struct vbits8 { __m512i v; } vbits8;
+FR_INLINE vbits8 vb8_zero(void) { vbits8 r = {_mm512_setzero_si512()}; return r; }
+FR_INLINE void vb8_store(uint64_t *p, vbits8 a) { _mm512_storeu_si512((void *)p, a.v); }
+/* adds bit to the sets of the lanes in `lanes` */
+FR_INLINE vbits8 vb8_or_where(vbits8 a, int lanes, uint64_t bit) {
+  vbits8 r = {_mm512_mask_or_epi64(a.v, (__mmask8)lanes, a.v, _mm512_set1_epi64((long long)bit))};
   return r;
 }
 #else
-FR_INLINE vbits8 vb8_or_where(vbits8 a, int lanes, uint32_t bit) {
-  const __m256i lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
-  __m256i sel = _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(lanes), lane_bit), lane_bit);
-  vbits8 r = {_mm256_or_si256(a.v, _mm256_and_si256(sel, _mm256_set1_epi32((int)bit)))};
+/* AVX2: children 0-3 in lo, 4-7 in hi */
+typedef struct vbits8 { __m256i lo, hi; } vbits8;
+FR_INLINE vbits8 vb8_zero(void) { vbits8 r = {_mm256_setzero_si256(), _mm256_setzero_si256()}; return r; }
+FR_INLINE void vb8_store(uint64_t *p, vbits8 a) {
+  _mm256_storeu_si256((__m256i *)p, a.lo);
+  _mm256_storeu_si256((__m256i *)(p + 4), a.hi);
+}
+FR_INLINE vbits8 vb8_or_where(vbits8 a, int lanes, uint64_t bit) {
+  const __m256i lane_lo = _mm256_setr_epi64x(1, 2, 4, 8), lane_hi = _mm256_setr_epi64x(16, 32, 64, 128);
+  const __m256i l = _mm256_set1_epi64x(lanes), b = _mm256_set1_epi64x((long long)bit);
+  __m256i sel_lo = _mm256_cmpeq_epi64(_mm256_and_si256(l, lane_lo), lane_lo);
+  __m256i sel_hi = _mm256_cmpeq_epi64(_mm256_and_si256(l, lane_hi), lane_hi);
+  vbits8 r = {_mm256_or_si256(a.lo, _mm256_and_si256(sel_lo, b)), _mm256_or_si256(a.hi, _mm256_and_si256(sel_hi, b))};
   return r;
 }
 #endif
@@ -147,10 +156,10 @@ FR_INLINE vfloat8 vf8_min(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] < b.f[i] ? a.f[
 FR_INLINE vfloat8 vf8_max(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] > b.f[i] ? a.f[i] : b.f[i])
 FR_INLINE int vf8_le_bits(vfloat8 a, vfloat8 b) { int m = 0; for (int i = 0; i < 8; i++) m |= (a.f[i] <= b.f[i]) << i; return m; }
 
-typedef struct vbits8 { uint32_t u[8]; } vbits8;
+typedef struct vbits8 { uint64_t u[8]; } vbits8;
 FR_INLINE vbits8 vb8_zero(void) { vbits8 r = {{0}}; return r; }
-FR_INLINE void vb8_store(uint32_t *p, vbits8 a) { for (int i = 0; i < 8; i++) p[i] = a.u[i]; }
-FR_INLINE vbits8 vb8_or_where(vbits8 a, int lanes, uint32_t bit) {
+FR_INLINE void vb8_store(uint64_t *p, vbits8 a) { for (int i = 0; i < 8; i++) p[i] = a.u[i]; }
+FR_INLINE vbits8 vb8_or_where(vbits8 a, int lanes, uint64_t bit) {
   for (; lanes; lanes &= lanes - 1) a.u[__builtin_ctz((unsigned)lanes)] |= bit;
   return a;
 }

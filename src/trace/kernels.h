@@ -25,12 +25,12 @@ typedef struct fr_trace_fns {
 } fr_trace_fns;
 
 /* Ray-stream kernels for one ISA and BVH width (bvhn_stream.c). */
-#define FR_STREAM_MAX 32 /* rays in a stream group: one bit each */
+#define FR_STREAM_MAX 64 /* rays in a stream group: one bit each */
 typedef struct fr_stream_fns {
   /* Any hit for rays[idx[0..n)], 1 <= n <= FR_STREAM_MAX, all of one
    * direction octant for speed (any rays give correct answers); returns the
    * bits i of the rays occluded. */
-  uint32_t (*occluded)(const fr_bvhn *b, const fr_ray *rays, const uint32_t *idx, int n);
+  uint64_t (*occluded)(const fr_bvhn *b, const fr_ray *rays, const uint32_t *idx, int n);
 } fr_stream_fns;
 
 /* How the packet kernels run (the switches exist for measurement). */
