@@ -211,8 +211,8 @@ typedef enum fr_trace_mode {
   FR_TRACE_PACKET8,   /* packets of 8 on the BVH4, no single-ray phase */
   FR_TRACE_PACKET16,  /* packets of 16 on the BVH4, no single-ray phase */
   FR_TRACE_HYBRID16,  /* packets of 16 dropping to single rays (hybrid_threshold) */
-  FR_TRACE_RAYSTREAM  /* any hit: sorted by octant, then groups of up to 64 rays traverse
-                         together, each ray tested alone (ray streams); closest hit: as auto */
+  FR_TRACE_RAYSTREAM  /* sorted by octant, then groups of up to 64 rays traverse together,
+                         each ray tested alone (ray streams); any hit and closest hit */
 } fr_trace_mode;
 
 typedef struct fr_trace_options {

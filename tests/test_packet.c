@@ -261,8 +261,10 @@ static void test_leaf_against_scalar(void **st) {
 
 /* Ray streams (FR_TRACE_RAYSTREAM): one call over a long stream of every
  * kind of ray, octants mixed, some invalid, at both BVH widths and every ISA,
- * must give each ray exactly the single-ray kernel's any-hit answer: the
- * stream runs the same box and triangle tests per ray, only in another order. */
+ * must give each ray exactly the single-ray kernel's any-hit answer and its
+ * closest hit (the same t, and the same triangle unless another lies at that
+ * very t): the stream runs the same box and triangle tests per ray, only in
+ * another order. */
 static void test_raystream(void **st) {
   (void)st;
   fr_rng r = fr_rng_seed(31, 5);
@@ -273,16 +275,20 @@ static void test_raystream(void **st) {
   enum { N = 16 * 150 };
   static fr_ray rays[N];
   static uint8_t occ[N];
+  static fr_hit hit[N], expect_hit[2][N];
   int expect[2][N];
   for (int p = 0; p < N / 16; p++) make_packet(&r, p % KIND_COUNT, center, size, &sd, rays + 16 * p);
   rays[17].dir[1] = NAN;
   rays[40].tnear = 5.0f; rays[40].tfar = 1.0f;
-  long occluded = 0;
+  long occluded = 0, hits = 0, ties = 0;
   for (int wi = 0; wi < 2; wi++) {
     int width = wi ? 8 : 4;
     assert_int_equal(fr_scene_set_bvh_width(s, width), FR_OK);
     assert_int_equal(fr_set_isa(FR_ISA_SCALAR), FR_OK);
-    for (int i = 0; i < N; i++) expect[wi][i] = fr_occluded1(s, &rays[i]);
+    for (int i = 0; i < N; i++) {
+      expect[wi][i] = fr_occluded1(s, &rays[i]);
+      fr_intersect1(s, &rays[i], &expect_hit[wi][i]);
+    }
     for (int isa = 0; isa < 3; isa++) {
       if (!fr_isa_supported((fr_isa)isa)) continue;
       assert_int_equal(fr_set_isa((fr_isa)isa), FR_OK);
@@ -295,11 +301,24 @@ static void test_raystream(void **st) {
       for (int i = 0; i < N; i++)
         if (occ[i] != expect[wi][i])
           fail_msg("raystream width %d isa %d ray %d: occluded %d vs single %d", width, isa, i, occ[i], expect[wi][i]);
+      memset(hit, 0x5A, sizeof hit);
+      fr_intersect_stream(s, rays, hit, N);
+      for (int i = 0; i < N; i++) {
+        const fr_hit *e = &expect_hit[wi][i], *h = &hit[i];
+        if (memcmp(&h->t, &e->t, sizeof(float)) || (h->prim == FR_INVALID_ID) != (e->prim == FR_INVALID_ID))
+          fail_msg("raystream width %d isa %d ray %d: t %g prim %u vs single %g prim %u", width, isa, i, h->t, h->prim,
+                   e->t, e->prim);
+        if (h->prim == e->prim && memcmp(h, e, sizeof *h))
+          fail_msg("raystream width %d isa %d ray %d: same triangle, another answer", width, isa, i);
+        ties += h->prim != e->prim;
+      }
     }
   }
-  for (int i = 0; i < N; i++) occluded += expect[1][i];
-  print_message("%d rays, %ld occluded, raystream = single at both widths\n", N, occluded);
+  for (int i = 0; i < N; i++) occluded += expect[1][i], hits += expect_hit[1][i].prim != FR_INVALID_ID;
+  print_message("%d rays, %ld occluded, %ld hit (%ld ties), raystream = single at both widths\n", N, occluded, hits,
+                ties);
   assert_true(occluded > N / 10 && occluded < N - N / 10);
+  assert_true(hits > N / 10 && hits < N - N / 10);
   assert_int_equal(expect[1][17], 0);
   assert_int_equal(expect[1][40], 0);
   fr_scene_release(s);

@@ -225,22 +225,9 @@ static int chunk_order(int sort, const fr_ray *rays, size_t n, uint32_t *order, 
   } while (0)
 
 /* The triangles of a stream; the spheres follow in the public calls. */
-static void triangles_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
-  const fr_bvhn *sb;
-  const fr_trace_fns *single = single_fns(s, &sb);
-  if (s->trace.mode == FR_TRACE_SINGLE) { single->intersect_stream(sb, rays, hits, n); return; }
-  FOR_EACH_GROUP(s, rays, n, {
-    fr_packet_opts po;
-    const fr_bvhn *pb;
-    const fr_packet_fns *pf = packet_fns(s, size, threshold, &po, &pb);
-    pf->intersect_idx(pb, &po, rays + c0, idx, (int)m, hits + c0);
-  }, {
-    for (size_t i = 0; i < m; i++) single->intersect1(sb, &rays[c0 + idx[i]], &hits[c0 + idx[i]]);
-  });
-}
-
-/* Ray streams: each octant run of a chunk in groups of up to FR_STREAM_MAX. */
-static void raystream_occluded(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
+/* Ray streams: each octant run of a chunk in groups of up to FR_STREAM_MAX;
+ * occ (any hit) or hits (closest hit). */
+static void raystream_trace(const fr_scene *s, const fr_ray *rays, uint8_t *occ, fr_hit *hits, size_t n) {
   const fr_kernels *k = fr_kernels_active();
   const fr_bvhn *b = s->single_width == 4 ? &s->bvh4 : &s->bvh8;
   const fr_stream_fns *st = s->single_width == 4 ? k->s4 : k->s8;
@@ -254,11 +241,32 @@ static void raystream_occluded(const fr_scene *s, const fr_ray *rays, uint8_t *o
       for (size_t m; g < run_end[r]; g += m) {
         m = run_end[r] - g < FR_STREAM_MAX ? run_end[r] - g : FR_STREAM_MAX;
         const uint32_t *idx = order + g;
+        if (hits) { st->intersect(b, rays + c0, idx, (int)m, hits + c0); continue; }
         uint64_t o = st->occluded(b, rays + c0, idx, (int)m);
         for (size_t i = 0; i < m; i++) occ[c0 + idx[i]] = (uint8_t)((o >> i) & 1);
       }
   }
 }
+
+static void raystream_occluded(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
+  raystream_trace(s, rays, occ, NULL, n);
+}
+
+static void triangles_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
+  const fr_bvhn *sb;
+  const fr_trace_fns *single = single_fns(s, &sb);
+  if (s->trace.mode == FR_TRACE_SINGLE) { single->intersect_stream(sb, rays, hits, n); return; }
+  if (s->trace.mode == FR_TRACE_RAYSTREAM) { raystream_trace(s, rays, NULL, hits, n); return; }
+  FOR_EACH_GROUP(s, rays, n, {
+    fr_packet_opts po;
+    const fr_bvhn *pb;
+    const fr_packet_fns *pf = packet_fns(s, size, threshold, &po, &pb);
+    pf->intersect_idx(pb, &po, rays + c0, idx, (int)m, hits + c0);
+  }, {
+    for (size_t i = 0; i < m; i++) single->intersect1(sb, &rays[c0 + idx[i]], &hits[c0 + idx[i]]);
+  });
+}
+
 
 static void triangles_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
   const fr_bvhn *sb;

@@ -31,6 +31,9 @@ typedef struct fr_stream_fns {
    * direction octant for speed (any rays give correct answers); returns the
    * bits i of the rays occluded. */
   uint64_t (*occluded)(const fr_bvhn *b, const fr_ray *rays, const uint32_t *idx, int n);
+  /* Closest hit for the same groups, into hits[idx[i]]: per ray the answer
+   * of the single-ray kernel (on exact ties in t, possibly another triangle). */
+  void (*intersect)(const fr_bvhn *b, const fr_ray *rays, const uint32_t *idx, int n, fr_hit *hits);
 } fr_stream_fns;
 
 /* How the packet kernels run (the switches exist for measurement). */
