@@ -21,8 +21,8 @@
 /* single: the default single-ray BVH (8-wide); single4: the MIC paper's BVH4;
  * packet8/packet16: packets alone; hybrid16: packets dropping to single rays;
  * auto: what fr_intersect_stream does by default; mft: camera rays and soft
- * shadows by multi-frusta tracing, the other rays as auto; raystream: any-hit
- * rays in ray streams of up to 32 (closest hits as auto); packetNxN: large
+ * shadows by multi-frusta tracing, the other rays as auto; raystream: every
+ * ray in ray streams of up to 64; packetNxN: large
  * packets of N x N rays on the binary BVH (--traversal, --cull). */
 static const char *frusta_modes[] = {"single", "single4", "packet8", "packet16", "hybrid16", "auto", "mft",
                                      "raystream", "packet2x2", "packet4x4", "packet8x8", "packet16x16", "packet32x32"};
