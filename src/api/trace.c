@@ -267,7 +267,6 @@ static void triangles_intersect_stream(const fr_scene *s, const fr_ray *rays, fr
   });
 }
 
-
 static void triangles_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
   const fr_bvhn *sb;
   const fr_trace_fns *single = single_fns(s, &sb);
