@@ -10,6 +10,7 @@
 #include "geom/tri_watertight.h"
 #include "trace/bvhn_node.h"
 #include "trace/counters.h"
+#include "trace/kernels.h"
 
 /* What a ray precomputes once for all its node and triangle tests. Both
  * tests subtract node or vertex coordinates from the origin rather than the
@@ -152,5 +153,29 @@ FR_INLINE void tri4_test(const fr_tri4 *tr, const ray_pre *r, float tfar, tri4_r
                       vm4_and(vf4_gt(t, vf4(r->tnear)), vf4_lt(t, vf4(tfar))));
   res->t = t; res->e1 = e1; res->e2 = e2; res->inv = inv;
   res->mask = vm4_bits(ok);
+}
+
+static inline float tri4_lane(vfloat4 v, int i) {
+  float f[4] __attribute__((aligned(16)));
+  vf4_store(f, v);
+  return f[i];
+}
+
+/* The nearest of the hit lanes of res (res->mask != 0; the first on ties)
+ * into *best, for block k; returns its t, the ray's new tfar. */
+FR_INLINE float tri4_nearest(const tri4_result *res, uint32_t k, fr_subtree_hit *best) {
+  int m = res->mask, bl = __builtin_ctz((unsigned)m);
+  float bt = tri4_lane(res->t, bl);
+  for (m &= m - 1; m; m &= m - 1) {
+    int i = __builtin_ctz((unsigned)m);
+    float ti = tri4_lane(res->t, i);
+    if (ti < bt) { bt = ti; bl = i; }
+  }
+  float inv = tri4_lane(res->inv, bl);
+  best->t = bt;
+  best->u = tri4_lane(res->e1, bl) * inv;
+  best->v = tri4_lane(res->e2, bl) * inv;
+  best->id = 4 * k + (uint32_t)bl;
+  return bt;
 }
 #endif

@@ -10,12 +10,6 @@
 #include "trace/child_sort8.h"
 #include "trace/kernels.h"
 
-static inline float lane(vfloat4 v, int i) {
-  float f[4] __attribute__((aligned(16)));
-  vf4_store(f, v);
-  return f[i];
-}
-
 typedef struct entry { uint32_t ref; float dist; } entry;
 
 /* Pushes the hit children farthest first and returns the nearest. */
@@ -87,19 +81,7 @@ FR_INLINE int closest(const fr_bvhn *b, const ray_pre *rp, uint32_t root, float 
         tri4_result res;
         tri4_test(&b->tris[k], rp, tfar, &res);
         if (!res.mask) continue;
-        int m = res.mask, bl = __builtin_ctz(m);
-        float bt = lane(res.t, bl);
-        for (m &= m - 1; m; m &= m - 1) {
-          int i = __builtin_ctz(m);
-          float ti = lane(res.t, i);
-          if (ti < bt) { bt = ti; bl = i; }
-        }
-        tfar = bt;
-        float inv = lane(res.inv, bl);
-        best->t = bt;
-        best->u = lane(res.e1, bl) * inv;
-        best->v = lane(res.e2, bl) * inv;
-        best->id = 4 * k + (uint32_t)bl;
+        tfar = tri4_nearest(&res, k, best);
         found = 1;
       }
     }

@@ -126,12 +126,6 @@ static uint64_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint3
   return occ;
 }
 
-static inline float lane4(vfloat4 v, int i) {
-  float f[4] __attribute__((aligned(16)));
-  vf4_store(f, v);
-  return f[i];
-}
-
 /* Closest hits of rays[idx[0..n)] into hits[idx[i]], n <= FR_STREAM_MAX.
  * Children are visited in the order of the least entry distance of any of
  * the group's rays (measured against the order of the group's first ray,
@@ -189,16 +183,7 @@ static void intersect_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t
           tri4_result res;
           tri4_test(&b->tris[k], &pre[i], tfar[i], &res);
           if (!res.mask) continue;
-          int mk = res.mask, bl = __builtin_ctz((unsigned)mk);
-          float bt = lane4(res.t, bl);
-          for (mk &= mk - 1; mk; mk &= mk - 1) {
-            int l = __builtin_ctz((unsigned)mk);
-            float tl = lane4(res.t, l);
-            if (tl < bt) { bt = tl; bl = l; }
-          }
-          tfar[i] = bt;
-          float inv = lane4(res.inv, bl);
-          best[i] = (fr_subtree_hit){bt, lane4(res.e1, bl) * inv, lane4(res.e2, bl) * inv, 4 * k + (uint32_t)bl};
+          tfar[i] = tri4_nearest(&res, k, &best[i]);
           found |= 1ull << i;
         }
       }
