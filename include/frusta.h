@@ -196,17 +196,17 @@ unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays);
 /* ---- streams ------------------------------------------------------------------
  * n independent rays. In FR_TRACE_AUTO mode the rays are sorted by direction
  * octant (in chunks of 1024, keeping their order within an octant) and each
- * group of 16 is traced as a hybrid packet; groups of hybrid_threshold rays or
- * fewer go ray by ray. Order rays so that neighbours are coherent to profit
- * (for example, pixels in 4x4 blocks). The other modes trace consecutive rays
- * together, unsorted. */
+ * group of 16 whose directions are coherent (stream_spread) is traced as a
+ * hybrid packet; the other rays of the octant go as ray streams of up to 64.
+ * Order rays so that neighbours are coherent to profit (for example, pixels
+ * in 4x4 blocks). The other modes trace consecutive rays together, unsorted. */
 void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n);
 void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occluded, size_t n);
 
 /* How the stream and packet calls trace; for measurement and tuning. Set it
  * while no thread traces the scene. */
 typedef enum fr_trace_mode {
-  FR_TRACE_AUTO,      /* sorted by octant, then hybrid packets of 16 */
+  FR_TRACE_AUTO,      /* sorted by octant, then hybrid packets of 16 or ray streams */
   FR_TRACE_SINGLE,    /* every ray alone (BVH of fr_scene_set_bvh_width) */
   FR_TRACE_PACKET8,   /* packets of 8 on the BVH4, no single-ray phase */
   FR_TRACE_PACKET16,  /* packets of 16 on the BVH4, no single-ray phase */
@@ -224,7 +224,11 @@ typedef struct fr_trace_options {
   int ia_cull;            /* interval-arithmetic culling of nodes for whole packets (default on) */
   int prefetch;           /* rays and packets prefetch the children they defer: 1 on, 0 off, -1
                              (default) on when the BVH and triangles exceed 64 MB (see README) */
+  float stream_spread;    /* FR_TRACE_AUTO: a group of 16 whose unit directions spread wider than
+                             this on some axis goes as part of a ray stream, not as a packet;
+                             0..2, 0 streams every group, 2 none (default FR_STREAM_SPREAD_DEFAULT) */
 } fr_trace_options;
+#define FR_STREAM_SPREAD_DEFAULT 0.25f
 
 void fr_trace_options_default(fr_trace_options *o);
 fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o);

@@ -60,17 +60,22 @@ typedef struct config {
   const char *name;
   fr_trace_mode mode;
   int threshold, width, mailbox, axis_aligned, ia, prefetch;
+  float spread; /* auto's stream_spread; 0: the default */
 } config;
 static const config configs[] = {
-    {"packet16", FR_TRACE_PACKET16, 0, 4, 0, 1, 1, 0},  {"packet8", FR_TRACE_PACKET8, 0, 4, 0, 1, 1, 0},
-    {"hybrid16", FR_TRACE_HYBRID16, 7, 4, 0, 1, 1, 0},  {"hybrid16/t3", FR_TRACE_HYBRID16, 3, 4, 0, 1, 1, 0},
-    {"hybrid16/t16", FR_TRACE_HYBRID16, 16, 4, 0, 1, 1, 0}, {"packet16/bvh8", FR_TRACE_PACKET16, 0, 8, 0, 1, 1, 0},
-    {"hybrid16/bvh8", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 0}, {"packet16/mailbox", FR_TRACE_PACKET16, 0, 4, 1, 1, 1, 0},
-    {"packet16/no-aa", FR_TRACE_PACKET16, 0, 4, 0, 0, 1, 0}, {"packet16/no-ia", FR_TRACE_PACKET16, 0, 4, 0, 1, 0, 0},
-    {"auto", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0},
-    {"raystream", FR_TRACE_RAYSTREAM, 7, 4, 0, 1, 1, 0},
+    {"packet16", FR_TRACE_PACKET16, 0, 4, 0, 1, 1, 0, 0.0f},  {"packet8", FR_TRACE_PACKET8, 0, 4, 0, 1, 1, 0, 0.0f},
+    {"hybrid16", FR_TRACE_HYBRID16, 7, 4, 0, 1, 1, 0, 0.0f},  {"hybrid16/t3", FR_TRACE_HYBRID16, 3, 4, 0, 1, 1, 0, 0.0f},
+    {"hybrid16/t16", FR_TRACE_HYBRID16, 16, 4, 0, 1, 1, 0, 0.0f}, {"packet16/bvh8", FR_TRACE_PACKET16, 0, 8, 0, 1, 1, 0, 0.0f},
+    {"hybrid16/bvh8", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 0, 0.0f}, {"packet16/mailbox", FR_TRACE_PACKET16, 0, 4, 1, 1, 1, 0, 0.0f},
+    {"packet16/no-aa", FR_TRACE_PACKET16, 0, 4, 0, 0, 1, 0, 0.0f}, {"packet16/no-ia", FR_TRACE_PACKET16, 0, 4, 0, 1, 0, 0, 0.0f},
+    {"auto", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0, 0.0f},
+    /* auto with every group a packet, and with the packet/stream split
+       inside the camera and shadow packets too */
+    {"auto/packets", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0, 2.0f},
+    {"auto/split", FR_TRACE_AUTO, 7, 8, 0, 1, 1, 0, 0.1f},
+    {"raystream", FR_TRACE_RAYSTREAM, 7, 4, 0, 1, 1, 0, 0.0f},
     /* prefetching, which these small scenes leave off by default */
-    {"hybrid16/bvh8/prefetch", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 1},
+    {"hybrid16/bvh8/prefetch", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 1, 0.0f},
 };
 #define NCONFIGS (sizeof configs / sizeof configs[0])
 
@@ -84,6 +89,7 @@ static void set_config(fr_scene *s, const config *c) {
   o.axis_aligned = c->axis_aligned;
   o.ia_cull = c->ia;
   o.prefetch = c->prefetch ? 1 : -1;
+  if (c->spread > 0.0f) o.stream_spread = c->spread;
   assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
 }
 
@@ -237,7 +243,7 @@ static void test_leaf_against_scalar(void **st) {
       if (!fr_isa_supported((fr_isa)isa)) continue;
       fr_set_isa((fr_isa)isa);
       for (int aa = 0; aa < 2; aa++) {
-        config c = {"leaf", FR_TRACE_PACKET16, 0, 4, 0, aa, 1, 0};
+        config c = {"leaf", FR_TRACE_PACKET16, 0, 4, 0, aa, 1, 0, 0.0f};
         set_config(s, &c);
         fr_tri_shevtsov use = rec;
         if (!aa) use.axis_aligned = 0;
@@ -342,6 +348,14 @@ static void test_options(void **st) {
   assert_int_equal(o.prefetch, -1);
   o.prefetch = 2;
   assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  o.prefetch = -1;
+  assert_true(o.stream_spread == FR_STREAM_SPREAD_DEFAULT);
+  o.stream_spread = NAN;
+  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  o.stream_spread = 2.5f;
+  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  o.stream_spread = 0.0f;
+  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
   /* an uncommitted scene: misses, nothing occluded */
   fr_ray16 r16;
   memset(&r16, 0, sizeof r16);

@@ -1,5 +1,6 @@
 /* The public tracing calls: single rays, packets of 16, streams, and the
  * choice between the kernels (trace/kernels.h) they make. */
+#include <math.h>
 #include <stddef.h>
 #include <string.h>
 #if defined(__SSE__)
@@ -18,6 +19,7 @@ void fr_trace_options_default(fr_trace_options *o) {
   o->axis_aligned = 1;
   o->ia_cull = 1;
   o->prefetch = -1;
+  o->stream_spread = FR_STREAM_SPREAD_DEFAULT;
 }
 
 fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o) {
@@ -28,6 +30,8 @@ fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o) {
   if (o->packet_bvh_width != 4 && o->packet_bvh_width != 8)
     return fr_fail(FR_ERR_ARG, "packet BVH width %d (4 or 8)", o->packet_bvh_width);
   if (o->prefetch < -1 || o->prefetch > 1) return fr_fail(FR_ERR_ARG, "prefetch %d (-1, 0 or 1)", o->prefetch);
+  if (!(o->stream_spread >= 0.0f && o->stream_spread <= 2.0f))
+    return fr_fail(FR_ERR_ARG, "stream spread %g (0..2)", (double)o->stream_spread);
   s->trace = *o;
   fr_scene_apply_prefetch(s);
   return FR_OK;
@@ -132,31 +136,12 @@ unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays) 
 
 /* ---- streams ----
  * The explicit packet modes trace consecutive rays together, as the papers
- * measure them. FR_TRACE_AUTO first sorts each chunk of the stream by
- * direction octant (keeping stream order within an octant), as Embree's
- * stream mode does: rays of neighbouring pixels that leave in the same
- * octant then share a packet, which traverses with one set of near planes
- * and culls by interval arithmetic. */
+ * measure them. FR_TRACE_AUTO and FR_TRACE_RAYSTREAM first sort each chunk of
+ * the stream by direction octant (keeping stream order within an octant), as
+ * Embree's stream mode does: rays of neighbouring pixels that leave in the
+ * same octant then share a packet or a ray stream, which traverse with one
+ * set of near planes. */
 #define STREAM_CHUNK 1024
-
-/* How a group is traced: 0 single rays, else the packet size. */
-static int group_plan(const fr_scene *s, size_t n, int *threshold) {
-  switch (s->trace.mode) {
-  case FR_TRACE_SINGLE: return 0;
-  case FR_TRACE_PACKET8: *threshold = 0; return 8;
-  case FR_TRACE_PACKET16: *threshold = 0; return 16;
-  case FR_TRACE_HYBRID16: *threshold = s->trace.hybrid_threshold; return 16;
-  case FR_TRACE_AUTO: default:
-    /* a group too small ever to run as a packet goes ray by ray at once */
-    *threshold = s->trace.hybrid_threshold;
-    return n > (size_t)s->trace.hybrid_threshold ? 16 : 0;
-  }
-}
-
-/* Auto mode, and ray streams (whose closest hits go as auto), sort. */
-static inline int sorts_by_octant(const fr_scene *s) {
-  return s->trace.mode == FR_TRACE_AUTO || s->trace.mode == FR_TRACE_RAYSTREAM;
-}
 
 /* A ray's direction octant: bit a is dir[a]'s sign bit. dir and tfar are one
  * 16-byte row of fr_ray, so SSE reads the three bits with one move mask (a
@@ -171,15 +156,9 @@ static inline unsigned ray_octant(const fr_ray *r) {
 #endif
 }
 
-/* The order in which a chunk's rays are grouped into packets; run_end[r] ends
- * the r-th run of rays that may share packets (one run per octant in auto
- * mode). Returns the number of runs. */
-static int chunk_order(int sort, const fr_ray *rays, size_t n, uint32_t *order, size_t *run_end) {
-  if (!sort) {
-    for (size_t i = 0; i < n; i++) order[i] = (uint32_t)i;
-    run_end[0] = n;
-    return 1;
-  }
+/* The order in which a chunk's rays are grouped: run_end[r] ends the r-th
+ * run, the rays of one octant. Returns the number of runs. */
+static int chunk_order(const fr_ray *rays, size_t n, uint32_t *order, size_t *run_end) {
   size_t start[9] = {0};
   uint8_t oct[STREAM_CHUNK];
   unsigned some = 0, every = 7;
@@ -203,83 +182,140 @@ static int chunk_order(int sort, const fr_ray *rays, size_t n, uint32_t *order, 
   return runs;
 }
 
-/* For each packet-sized group of each chunk (its rays rays[c0 + idx[0..m)]),
- * runs BODY_PACKET, or BODY_SINGLE where the group is traced ray by ray. */
-#define FOR_EACH_GROUP(s, rays, n, BODY_PACKET, BODY_SINGLE)                                     \
-  do {                                                                                            \
-    uint32_t order[STREAM_CHUNK];                                                                 \
-    size_t run_end[8];                                                                            \
-    size_t group = (s)->trace.mode == FR_TRACE_PACKET8 ? 8 : 16;                                  \
-    for (size_t c0 = 0; c0 < (n); c0 += STREAM_CHUNK) {                                           \
-      size_t cn = (n) - c0 < STREAM_CHUNK ? (n) - c0 : STREAM_CHUNK;                              \
-      int runs = chunk_order(sorts_by_octant(s), (rays) + c0, cn, order, run_end);               \
-      size_t g = 0;                                                                               \
-      for (int r = 0; r < runs; r++)                                                              \
-        for (size_t m; g < run_end[r]; g += m) {                                                  \
-          m = run_end[r] - g < group ? run_end[r] - g : group;                                    \
-          const uint32_t *idx = order + g;                                                        \
-          int threshold = 0, size = group_plan((s), m, &threshold);                               \
-          if (size) { BODY_PACKET; } else { BODY_SINGLE; }                                        \
-        }                                                                                         \
-    }                                                                                             \
-  } while (0)
+/* Whether a packet of these rays pays: their unit directions span less than
+ * spread on every axis. A packet's rays then visit nearly the same nodes;
+ * past that, lanes die early and a ray stream, which tests each ray alone
+ * but shares the node fetches, does better (README, "auto"). */
+static int group_coherent(const fr_ray *rays, const uint32_t *idx, size_t m, float spread) {
+  float lo[3] = {2.0f, 2.0f, 2.0f}, hi[3] = {-2.0f, -2.0f, -2.0f};
+  for (size_t i = 0; i < m; i++) {
+    const float *d = rays[idx[i]].dir;
+    float inv = 1.0f / sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    for (int a = 0; a < 3; a++) {
+      float u = d[a] * inv;
+      lo[a] = u < lo[a] ? u : lo[a];
+      hi[a] = u > hi[a] ? u : hi[a];
+    }
+  }
+  /* written so that a NaN direction counts as incoherent */
+  return hi[0] - lo[0] < spread && hi[1] - lo[1] < spread && hi[2] - lo[2] < spread;
+}
 
-/* The triangles of a stream; the spheres follow in the public calls. */
-/* Ray streams: each octant run of a chunk in groups of up to FR_STREAM_MAX;
- * occ (any hit) or hits (closest hit). */
-static void raystream_trace(const fr_scene *s, const fr_ray *rays, uint8_t *occ, fr_hit *hits, size_t n) {
+typedef struct stream_ctx {
+  const fr_stream_fns *st;
+  const fr_bvhn *sb;           /* the single-ray BVH the streams traverse */
+  const fr_packet_fns *pf;     /* packets of 16, for coherent groups */
+  const fr_bvhn *pb;
+  fr_packet_opts po;
+  float spread;                /* < 0: streams only */
+} stream_ctx;
+
+/* One ray stream of rays[idx[0..m)]: occ (any hit) or hits (closest hit). */
+static inline void stream_group(const stream_ctx *c, const fr_ray *rays, const uint32_t *idx, int m,
+                                uint8_t *occ, fr_hit *hits) {
+  if (hits) { c->st->intersect(c->sb, rays, idx, m, hits); return; }
+  uint64_t o = c->st->occluded(c->sb, rays, idx, m);
+  for (int i = 0; i < m; i++) occ[idx[i]] = (uint8_t)((o >> i) & 1);
+}
+
+/* FR_TRACE_AUTO and FR_TRACE_RAYSTREAM: per octant run of a chunk, each
+ * coherent group of 16 goes as a hybrid packet; the other rays gather into
+ * ray streams of up to FR_STREAM_MAX, the last one flushed at the run's end
+ * (a stream stays within one octant). */
+static void octant_trace(const fr_scene *s, const fr_ray *rays, uint8_t *occ, fr_hit *hits, size_t n, float spread) {
   const fr_kernels *k = fr_kernels_active();
-  const fr_bvhn *b = s->single_width == 4 ? &s->bvh4 : &s->bvh8;
-  const fr_stream_fns *st = s->single_width == 4 ? k->s4 : k->s8;
-  uint32_t order[STREAM_CHUNK];
+  stream_ctx c;
+  c.st = s->single_width == 4 ? k->s4 : k->s8;
+  c.sb = s->single_width == 4 ? &s->bvh4 : &s->bvh8;
+  c.pf = packet_fns(s, 16, s->trace.hybrid_threshold, &c.po, &c.pb);
+  c.spread = spread;
+  uint32_t order[STREAM_CHUNK], pend[FR_STREAM_MAX];
   size_t run_end[8];
   for (size_t c0 = 0; c0 < n; c0 += STREAM_CHUNK) {
     size_t cn = n - c0 < STREAM_CHUNK ? n - c0 : STREAM_CHUNK;
-    int runs = chunk_order(1, rays + c0, cn, order, run_end);
+    const fr_ray *cr = rays + c0;
+    uint8_t *co = occ ? occ + c0 : NULL;
+    fr_hit *ch = hits ? hits + c0 : NULL;
+    int runs = chunk_order(cr, cn, order, run_end);
     size_t g = 0;
-    for (int r = 0; r < runs; r++)
+    for (int r = 0; r < runs; r++) {
+      int np = 0;
       for (size_t m; g < run_end[r]; g += m) {
-        m = run_end[r] - g < FR_STREAM_MAX ? run_end[r] - g : FR_STREAM_MAX;
+        m = run_end[r] - g < 16 ? run_end[r] - g : 16;
         const uint32_t *idx = order + g;
-        if (hits) { st->intersect(b, rays + c0, idx, (int)m, hits + c0); continue; }
-        uint64_t o = st->occluded(b, rays + c0, idx, (int)m);
-        for (size_t i = 0; i < m; i++) occ[c0 + idx[i]] = (uint8_t)((o >> i) & 1);
+        if (m > (size_t)s->trace.hybrid_threshold && spread > 0.0f && group_coherent(cr, idx, m, spread)) {
+          if (ch) c.pf->intersect_idx(c.pb, &c.po, cr, idx, (int)m, ch);
+          else {
+            unsigned o = c.pf->occluded_idx(c.pb, &c.po, cr, idx, (int)m);
+            for (size_t i = 0; i < m; i++) co[idx[i]] = (uint8_t)((o >> i) & 1);
+          }
+          continue;
+        }
+        for (size_t i = 0; i < m; i++) {
+          pend[np++] = idx[i];
+          if (np == FR_STREAM_MAX) { stream_group(&c, cr, pend, np, co, ch); np = 0; }
+        }
       }
+      if (np) stream_group(&c, cr, pend, np, co, ch);
+    }
   }
 }
 
-static void raystream_occluded(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
-  raystream_trace(s, rays, occ, NULL, n);
+/* How the explicit packet modes trace a group: 0 single rays, else the packet size. */
+static int group_plan(const fr_scene *s, int *threshold) {
+  switch (s->trace.mode) {
+  case FR_TRACE_PACKET8: *threshold = 0; return 8;
+  case FR_TRACE_PACKET16: *threshold = 0; return 16;
+  case FR_TRACE_HYBRID16: *threshold = s->trace.hybrid_threshold; return 16;
+  default: return 0;
+  }
 }
+
+static const uint32_t identity_idx[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
+
+/* For each packet-sized group of consecutive rays (rays[g..g+m)), runs
+ * BODY_PACKET with the packet size in size and the threshold in threshold. */
+#define FOR_EACH_PACKET(s, rays, n, BODY_PACKET)                                                 \
+  do {                                                                                            \
+    int threshold = 0, size = group_plan((s), &threshold);                                        \
+    for (size_t g = 0, m; g < (n); g += m) {                                                      \
+      m = (n) - g < (size_t)size ? (n) - g : (size_t)size;                                        \
+      BODY_PACKET;                                                                                \
+    }                                                                                             \
+  } while (0)
 
 static void triangles_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
   const fr_bvhn *sb;
   const fr_trace_fns *single = single_fns(s, &sb);
-  if (s->trace.mode == FR_TRACE_SINGLE) { single->intersect_stream(sb, rays, hits, n); return; }
-  if (s->trace.mode == FR_TRACE_RAYSTREAM) { raystream_trace(s, rays, NULL, hits, n); return; }
-  FOR_EACH_GROUP(s, rays, n, {
-    fr_packet_opts po;
-    const fr_bvhn *pb;
+  switch (s->trace.mode) {
+  case FR_TRACE_SINGLE: single->intersect_stream(sb, rays, hits, n); return;
+  case FR_TRACE_AUTO: octant_trace(s, rays, NULL, hits, n, s->trace.stream_spread); return;
+  case FR_TRACE_RAYSTREAM: octant_trace(s, rays, NULL, hits, n, -1.0f); return;
+  default: break;
+  }
+  fr_packet_opts po;
+  const fr_bvhn *pb;
+  FOR_EACH_PACKET(s, rays, n, {
     const fr_packet_fns *pf = packet_fns(s, size, threshold, &po, &pb);
-    pf->intersect_idx(pb, &po, rays + c0, idx, (int)m, hits + c0);
-  }, {
-    for (size_t i = 0; i < m; i++) single->intersect1(sb, &rays[c0 + idx[i]], &hits[c0 + idx[i]]);
+    pf->intersect_idx(pb, &po, rays + g, identity_idx, (int)m, hits + g);
   });
 }
 
 static void triangles_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
   const fr_bvhn *sb;
   const fr_trace_fns *single = single_fns(s, &sb);
-  if (s->trace.mode == FR_TRACE_SINGLE) { single->occluded_stream(sb, rays, occ, n); return; }
-  if (s->trace.mode == FR_TRACE_RAYSTREAM) { raystream_occluded(s, rays, occ, n); return; }
-  FOR_EACH_GROUP(s, rays, n, {
-    fr_packet_opts po;
-    const fr_bvhn *pb;
+  switch (s->trace.mode) {
+  case FR_TRACE_SINGLE: single->occluded_stream(sb, rays, occ, n); return;
+  case FR_TRACE_AUTO: octant_trace(s, rays, occ, NULL, n, s->trace.stream_spread); return;
+  case FR_TRACE_RAYSTREAM: octant_trace(s, rays, occ, NULL, n, -1.0f); return;
+  default: break;
+  }
+  fr_packet_opts po;
+  const fr_bvhn *pb;
+  FOR_EACH_PACKET(s, rays, n, {
     const fr_packet_fns *pf = packet_fns(s, size, threshold, &po, &pb);
-    unsigned o = pf->occluded_idx(pb, &po, rays + c0, idx, (int)m);
-    for (size_t i = 0; i < m; i++) occ[c0 + idx[i]] = (uint8_t)((o >> i) & 1);
-  }, {
-    for (size_t i = 0; i < m; i++) occ[c0 + idx[i]] = (uint8_t)single->occluded1(sb, &rays[c0 + idx[i]]);
+    unsigned o = pf->occluded_idx(pb, &po, rays + g, identity_idx, (int)m);
+    for (size_t i = 0; i < m; i++) occ[g + i] = (uint8_t)((o >> i) & 1);
   });
 }
 
@@ -291,7 +327,7 @@ void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, si
 
 void fr_occluded_raystream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
   if (!s->committed) { memset(occ, 0, n); return; }
-  raystream_occluded(s, rays, occ, n);
+  octant_trace(s, rays, occ, NULL, n, -1.0f);
   if (has_spheres(s)) spheres_occluded_stream(s, rays, occ, n);
 }
 

@@ -169,7 +169,7 @@ int cmd_bench(int argc, char **argv) {
     if (!strcmp(a, "--threshold") || !strcmp(a, "--mailbox") || !strcmp(a, "--axis-aligned") || !strcmp(a, "--ia") ||
         !strcmp(a, "--packet-width") || !strcmp(a, "--corner-rays") || !strcmp(a, "--shrink") || !strcmp(a, "--mft-leaf") ||
         !strcmp(a, "--corner-cost") || !strcmp(a, "--mft-fallback") ||
-        !strcmp(a, "--light-sets") || !strcmp(a, "--prefetch")) {
+        !strcmp(a, "--light-sets") || !strcmp(a, "--prefetch") || !strcmp(a, "--stream-spread")) {
       if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
       const char *val = argv[++i];
       if (!strcmp(a, "--light-sets")) {
@@ -199,6 +199,9 @@ int cmd_bench(int argc, char **argv) {
         if (!strcmp(val, "auto")) topt.prefetch = -1;
         else if (!strcmp(val, "on") || !strcmp(val, "off")) topt.prefetch = !strcmp(val, "on");
         else return cli_error(CLI_USAGE_ERROR, "--prefetch is on, off or auto, not '%s'", val);
+      } else if (!strcmp(a, "--stream-spread")) {
+        if (!cli_parse_float(val, &topt.stream_spread) || !(topt.stream_spread >= 0.0f && topt.stream_spread <= 2.0f))
+          return cli_error(CLI_USAGE_ERROR, "--stream-spread wants 0..2, got '%s'", val);
       } else if (!strcmp(a, "--threshold")) {
         if (!cli_parse_int(val, 0, 16, &topt.hybrid_threshold)) return cli_error(CLI_USAGE_ERROR, "--threshold wants 0..16, got '%s'", val);
       } else if (!strcmp(a, "--packet-width")) {
