@@ -224,11 +224,12 @@ typedef struct fr_trace_options {
   int ia_cull;            /* interval-arithmetic culling of nodes for whole packets (default on) */
   int prefetch;           /* rays and packets prefetch the children they defer: 1 on, 0 off, -1
                              (default) on when the BVH and triangles exceed 64 MB (see README) */
-  float stream_spread;    /* FR_TRACE_AUTO: a group of 16 whose unit directions spread wider than
-                             this on some axis goes as part of a ray stream, not as a packet;
-                             0..2, 0 streams every group, 2 none (default FR_STREAM_SPREAD_DEFAULT) */
+  float stream_spread;    /* FR_TRACE_AUTO: a group of 16 goes as a packet when its unit directions
+                             lie within this distance of its first ray's (probed at 3 rays), else
+                             in a ray stream; 0..2: 0 streams every group, 2 none (default
+                             FR_STREAM_SPREAD_DEFAULT) */
 } fr_trace_options;
-#define FR_STREAM_SPREAD_DEFAULT 0.25f
+#define FR_STREAM_SPREAD_DEFAULT 0.1f
 
 void fr_trace_options_default(fr_trace_options *o);
 fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o);
