@@ -211,7 +211,6 @@ typedef struct stream_ctx {
   const fr_packet_fns *pf;     /* packets of 16, for coherent groups */
   const fr_bvhn *pb;
   fr_packet_opts po;
-  float spread;                /* < 0: streams only */
 } stream_ctx;
 
 /* One ray stream of rays[idx[0..m)]: occ (any hit) or hits (closest hit). */
@@ -225,14 +224,13 @@ static inline void stream_group(const stream_ctx *c, const fr_ray *rays, const u
 /* FR_TRACE_AUTO and FR_TRACE_RAYSTREAM: per octant run of a chunk, each
  * coherent group of 16 goes as a hybrid packet; the other rays gather into
  * ray streams of up to FR_STREAM_MAX, the last one flushed at the run's end
- * (a stream stays within one octant). */
+ * (a stream stays within one octant). spread <= 0: streams only. */
 static void octant_trace(const fr_scene *s, const fr_ray *rays, uint8_t *occ, fr_hit *hits, size_t n, float spread) {
   const fr_kernels *k = fr_kernels_active();
   stream_ctx c;
   c.st = s->single_width == 4 ? k->s4 : k->s8;
   c.sb = s->single_width == 4 ? &s->bvh4 : &s->bvh8;
   c.pf = packet_fns(s, 16, s->trace.hybrid_threshold, &c.po, &c.pb);
-  c.spread = spread;
   uint32_t order[STREAM_CHUNK], pend[FR_STREAM_MAX];
   size_t run_end[8];
   for (size_t c0 = 0; c0 < n; c0 += STREAM_CHUNK) {
@@ -265,67 +263,44 @@ static void octant_trace(const fr_scene *s, const fr_ray *rays, uint8_t *occ, fr
   }
 }
 
-/* How the explicit packet modes trace a group: 0 single rays, else the packet size. */
-static int group_plan(const fr_scene *s, int *threshold) {
-  switch (s->trace.mode) {
-  case FR_TRACE_PACKET8: *threshold = 0; return 8;
-  case FR_TRACE_PACKET16: *threshold = 0; return 16;
-  case FR_TRACE_HYBRID16: *threshold = s->trace.hybrid_threshold; return 16;
-  default: return 0;
-  }
+/* The explicit packet modes: the packet size, and the hybrid threshold. */
+static int packet_size(const fr_scene *s, int *threshold) {
+  *threshold = s->trace.mode == FR_TRACE_HYBRID16 ? s->trace.hybrid_threshold : 0;
+  return s->trace.mode == FR_TRACE_PACKET8 ? 8 : 16;
 }
 
 static const uint32_t identity_idx[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
 
-/* For each packet-sized group of consecutive rays (rays[g..g+m)), runs
- * BODY_PACKET with the packet size in size and the threshold in threshold. */
-#define FOR_EACH_PACKET(s, rays, n, BODY_PACKET)                                                 \
-  do {                                                                                            \
-    int threshold = 0, size = group_plan((s), &threshold);                                        \
-    for (size_t g = 0, m; g < (n); g += m) {                                                      \
-      m = (n) - g < (size_t)size ? (n) - g : (size_t)size;                                        \
-      BODY_PACKET;                                                                                \
-    }                                                                                             \
-  } while (0)
-
-static void triangles_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
-  const fr_bvhn *sb;
-  const fr_trace_fns *single = single_fns(s, &sb);
+/* The triangles of a stream: any hit into occ, or closest hits into hits;
+ * the spheres follow in the public calls. */
+static void triangles_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, fr_hit *hits, size_t n) {
   switch (s->trace.mode) {
-  case FR_TRACE_SINGLE: single->intersect_stream(sb, rays, hits, n); return;
-  case FR_TRACE_AUTO: octant_trace(s, rays, NULL, hits, n, s->trace.stream_spread); return;
-  case FR_TRACE_RAYSTREAM: octant_trace(s, rays, NULL, hits, n, -1.0f); return;
+  case FR_TRACE_SINGLE: {
+    const fr_bvhn *sb;
+    const fr_trace_fns *single = single_fns(s, &sb);
+    if (hits) single->intersect_stream(sb, rays, hits, n);
+    else single->occluded_stream(sb, rays, occ, n);
+    return;
+  }
+  case FR_TRACE_AUTO: octant_trace(s, rays, occ, hits, n, s->trace.stream_spread); return;
+  case FR_TRACE_RAYSTREAM: octant_trace(s, rays, occ, hits, n, -1.0f); return;
   default: break;
   }
+  int threshold, size = packet_size(s, &threshold);
   fr_packet_opts po;
   const fr_bvhn *pb;
-  FOR_EACH_PACKET(s, rays, n, {
-    const fr_packet_fns *pf = packet_fns(s, size, threshold, &po, &pb);
-    pf->intersect_idx(pb, &po, rays + g, identity_idx, (int)m, hits + g);
-  });
-}
-
-static void triangles_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
-  const fr_bvhn *sb;
-  const fr_trace_fns *single = single_fns(s, &sb);
-  switch (s->trace.mode) {
-  case FR_TRACE_SINGLE: single->occluded_stream(sb, rays, occ, n); return;
-  case FR_TRACE_AUTO: octant_trace(s, rays, occ, NULL, n, s->trace.stream_spread); return;
-  case FR_TRACE_RAYSTREAM: octant_trace(s, rays, occ, NULL, n, -1.0f); return;
-  default: break;
-  }
-  fr_packet_opts po;
-  const fr_bvhn *pb;
-  FOR_EACH_PACKET(s, rays, n, {
-    const fr_packet_fns *pf = packet_fns(s, size, threshold, &po, &pb);
+  const fr_packet_fns *pf = packet_fns(s, size, threshold, &po, &pb);
+  for (size_t g = 0, m; g < n; g += m) {
+    m = n - g < (size_t)size ? n - g : (size_t)size;
+    if (hits) { pf->intersect_idx(pb, &po, rays + g, identity_idx, (int)m, hits + g); continue; }
     unsigned o = pf->occluded_idx(pb, &po, rays + g, identity_idx, (int)m);
     for (size_t i = 0; i < m; i++) occ[g + i] = (uint8_t)((o >> i) & 1);
-  });
+  }
 }
 
 void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
   if (!s->committed) { for (size_t i = 0; i < n; i++) fr_hit_miss(&hits[i]); return; }
-  triangles_intersect_stream(s, rays, hits, n);
+  triangles_stream(s, rays, NULL, hits, n);
   if (has_spheres(s)) spheres_stream(s, rays, hits, n);
 }
 
@@ -337,6 +312,6 @@ void fr_occluded_raystream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, 
 
 void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
   if (!s->committed) { memset(occ, 0, n); return; }
-  triangles_occluded_stream(s, rays, occ, n);
+  triangles_stream(s, rays, occ, NULL, n);
   if (has_spheres(s)) spheres_occluded_stream(s, rays, occ, n);
 }
