@@ -26,7 +26,7 @@ static void usage(FILE *f) {
           "         single rays:  [--prefetch on|off|auto]\n"
           "         multi-frusta: [--light-sets spread|cells] [--corner-rays on|off] [--corner-cost C]\n"
           "                       [--shrink on|corners|off] [--mft-leaf N] [--mft-fallback on|off]\n"
-          "         large packets: [--traversal masked|ranged|partition] [--cull off|ia|planes|corners]\n"
+          "         NxN packets:  [--traversal masked|ranged|partition] [--cull off|ia|planes|corners]\n"
           "         whitted:      [--mirror NAME,..|all] [--glass NAME,..] [--depth N]\n"
           "  trace  SCENE RAYS --query closest|any --out FILE [--tracer frusta|embree]\n"
           "         [--mode single|packet8|packet16|hybrid16|auto|raystream]\n"
