@@ -187,8 +187,9 @@ static int chunk_order(const fr_ray *rays, size_t n, uint32_t *order, size_t *ru
  * each ray alone but shares the node fetches, does better (README, "auto").
  * Three rays spread over the group stand for it: a primary ray takes only
  * ~36 ns of a core here (55 Mrays/s on 2 threads), and normalizing all 16
- * directions cost 6% of conference primary (1024x1024, two pairs). No square root: with c = 1 -
- * spread^2 / 2 the cosine test dot >= c |d0| |di| is squared. */
+ * directions cost 6% of conference primary (1024x1024, two pairs). No
+ * square root: with c = 1 - spread^2 / 2 the cosine test
+ * dot >= c |d0| |di| is squared. */
 static int group_coherent(const fr_ray *rays, const uint32_t *idx, size_t m, float spread) {
   const float *d0 = rays[idx[0]].dir;
   const float n0 = d0[0] * d0[0] + d0[1] * d0[1] + d0[2] * d0[2];
