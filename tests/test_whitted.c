@@ -215,7 +215,7 @@ static float ref_max3(vec3 a) { return fr_maxf(a.x, fr_maxf(a.y, a.z)); }
 
 typedef struct ref_lane {
   vec3 add, p, l, lw, rd, rw, td, tw;
-  float ltfar;
+  float ldist;
   int shadow, refl, refr;
 } ref_lane;
 
@@ -245,7 +245,7 @@ static ref_lane ref_shade(const fr_wshade_in *in, const fr_whitted_mats *mats, i
       float rv = -v3_dot(r, d);
       if (rv > 0.0f) lit = v3_add(lit, v3_scale(ks, powf(rv, m->ns)));
     }
-    o.shadow = 1; o.l = l; o.ltfar = dist * (1.0f - 1e-4f); o.lw = v3_mul(w, lit);
+    o.shadow = 1; o.l = l; o.ldist = dist; o.lw = v3_mul(w, lit);
   }
   if (!in->bounce || m->kind == FR_SURF_DIFFUSE) return o;
   float cosi = -v3_dot(d, nf);
@@ -329,7 +329,7 @@ static void test_shade_kernel(void **state) {
         if (r.shadow || r.refl || r.refr) assert_true(same3(r.p, out.p, l));
         if (r.shadow) {
           assert_true(same3(r.l, out.l, l) && same3(r.lw, out.lw, l));
-          assert_memory_equal(&r.ltfar, &out.ltfar[l], sizeof(float));
+          assert_memory_equal(&r.ldist, &out.ldist[l], sizeof(float));
         }
         if (r.refl) assert_true(same3(r.rd, out.rd, l) && same3(r.rw, out.rw, l));
         if (r.refr) assert_true(same3(r.td, out.td, l) && same3(r.tw, out.tw, l));

@@ -100,7 +100,7 @@ void FR_ISA_FN(fr_whitted_shade16)(const fr_wshade_in *in, fr_wshade_out *out) {
       lit = v3p_select(ph, v3p_add(lit, v3p_scale(ks, vp_load(hl))), lit);
     }
     v3p_store(out->l, l);
-    vp_store(out->ltfar, vp_mul(dist, vp(1.0f - 1e-4f)));
+    vp_store(out->ldist, dist);
     v3p_store(out->lw, v3p_mul(w, lit));
   }
   if (!in->bounce) return;

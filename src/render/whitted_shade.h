@@ -54,8 +54,8 @@ typedef struct fr_wshade_in {
 typedef struct fr_wshade_out {
   float add[3][FR_WS_LANES] __attribute__((aligned(64))); /* colour added to the pixel */
   float p[3][FR_WS_LANES] __attribute__((aligned(64)));   /* hit point: the new rays' origin */
-  float l[3][FR_WS_LANES] __attribute__((aligned(64))), ltfar[FR_WS_LANES] __attribute__((aligned(64)));
-  float lw[3][FR_WS_LANES] __attribute__((aligned(64)));  /* shadow ray: direction, tfar, weight if unoccluded */
+  float l[3][FR_WS_LANES] __attribute__((aligned(64))), ldist[FR_WS_LANES] __attribute__((aligned(64)));
+  float lw[3][FR_WS_LANES] __attribute__((aligned(64)));  /* shadow ray: direction to the light, distance, weight if unoccluded */
   float rd[3][FR_WS_LANES] __attribute__((aligned(64))), rw[3][FR_WS_LANES] __attribute__((aligned(64)));
   float td[3][FR_WS_LANES] __attribute__((aligned(64))), tw[3][FR_WS_LANES] __attribute__((aligned(64)));
   unsigned shadow, refl, refr; /* lanes that spawn a shadow, reflection, refraction ray */
