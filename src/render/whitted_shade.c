@@ -33,9 +33,13 @@ FR_INLINE v3p v3p_norm(v3p a) {
   vpf l = vp_sqrt(v3p_dot(a, a));
   return v3p_select(vp_gt(l, vp(0.0f)), v3p_scale(a, vp_div(vp(1.0f), l)), a);
 }
-/* field f of each lane's material */
-typedef struct mat_lanes { const float *soa; size_t count; const int32_t *idx; } mat_lanes;
-FR_INLINE vpf mat_field(const mat_lanes *m, int f) { return vp_gather(m->soa + (size_t)f * m->count, m->idx); }
+/* field f of each lane's material; when all lanes share one material (the
+ * common case for 16 neighbouring rays) a broadcast rather than a gather */
+typedef struct mat_lanes { const float *soa; size_t count; const int32_t *idx; int same; } mat_lanes;
+FR_INLINE vpf mat_field(const mat_lanes *m, int f) {
+  const float *field = m->soa + (size_t)f * m->count;
+  return m->same ? vp(field[m->idx[0]]) : vp_gather(field, m->idx);
+}
 FR_INLINE v3p mat_field3(const mat_lanes *m, int f) {
   v3p r = {mat_field(m, f), mat_field(m, f + 1), mat_field(m, f + 2)};
   return r;
@@ -48,11 +52,13 @@ void FR_ISA_FN(fr_whitted_shade16)(const fr_wshade_in *in, fr_wshade_out *out) {
   int32_t ni[FR_WS_LANES] __attribute__((aligned(64)));
   int32_t mi[FR_WS_LANES] __attribute__((aligned(64))); /* the gathers want aligned indices */
   int first = __builtin_ctz(in->valid);
+  int same = 1;
   for (int l = 0; l < FR_WS_LANES; l++) { /* absent lanes read a present one */
     int s = (in->valid >> l) & 1 ? l : first;
     ri[l] = s * RAY; hi[l] = s * HIT; ni[l] = 3 * s; mi[l] = in->mat[s];
+    same &= mi[l] == mi[0];
   }
-  const mat_lanes M = {in->mats, in->mat_count, mi};
+  const mat_lanes M = {in->mats, in->mat_count, mi, same};
   const float *rf = (const float *)in->ray, *hf = (const float *)in->hit;
   v3p o = v3p_gather(rf + offsetof(fr_wray, r.org) / sizeof(float), ri);
   v3p d = v3p_gather(rf + offsetof(fr_wray, r.dir) / sizeof(float), ri);
