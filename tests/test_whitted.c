@@ -302,6 +302,8 @@ static void test_shade_kernel(void **state) {
     int n = 1 + (int)(fr_rng_u32(&rng) % FR_WS_LANES);
     fr_wshade_in in = {rays, hits, ng, mi, (1u << n) - 1u, 0, mats.soa, mats.count, {0, 0, 0}, trial % 4 != 0};
     for (int a = 0; a < 3; a++) in.light[a] = 4.0f * fr_rng_float(&rng) - 2.0f;
+    /* every third group shares one material (the kernel's broadcast path) */
+    const int32_t shared_mat = trial % 3 == 0 ? (int32_t)(fr_rng_u32(&rng) % mats.count) : -1;
     for (int l = 0; l < n; l++) {
       vec3 d = v3_norm(v3(2 * fr_rng_float(&rng) - 1, 2 * fr_rng_float(&rng) - 1, 2 * fr_rng_float(&rng) - 1));
       rays[l] = (fr_wray){{{fr_rng_float(&rng), fr_rng_float(&rng), fr_rng_float(&rng)}, 0, {d.x, d.y, d.z}, INFINITY},
@@ -309,7 +311,7 @@ static void test_shade_kernel(void **state) {
       hits[l].t = 3.0f * fr_rng_float(&rng);
       hits[l].prim = fr_rng_u32(&rng) % 5 ? (uint32_t)l : FR_INVALID_ID;
       in.hits |= (unsigned)(hits[l].prim != FR_INVALID_ID) << l;
-      mi[l] = (int32_t)(fr_rng_u32(&rng) % mats.count);
+      mi[l] = shared_mat >= 0 ? shared_mat : (int32_t)(fr_rng_u32(&rng) % mats.count);
       for (int a = 0; a < 3; a++) ng[3 * l + a] = 2 * fr_rng_float(&rng) - 1;
       if (fr_rng_u32(&rng) % 50 == 0) ng[3 * l] = ng[3 * l + 1] = ng[3 * l + 2] = 0.0f;
     }
