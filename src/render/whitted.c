@@ -322,7 +322,8 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
           const float dist = out.ldist[l];
           const fr_ray from_light = {{w->view.light.x, w->view.light.y, w->view.light.z}, dist * 1e-4f,
                                      {-out.l[0][l], -out.l[1][l], -out.l[2][l]}, dist - w->eps};
-          S->shadow[ns++] = (wray){from_light, {out.lw[0][l], out.lw[1][l], out.lw[2][l]}, g->pix, (uint16_t)(g->key / 2)};
+          S->shadow[ns++] =
+              (wray){from_light, {out.lw[0][l], out.lw[1][l], out.lw[2][l]}, g->pix, (uint16_t)(g->key / 2)};
         }
         if ((out.refl >> l) & 1) {
           wray *r = &S->next[nn++];
