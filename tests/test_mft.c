@@ -81,7 +81,9 @@ static void check_shadows_vs(const fr_scene *s, const fr_mft_batch *b, const fr_
         fr_mft_opts o = {corner != 0, shrink, corner == 2 ? fr_mft_opts_default().corner_cost : 0.0f};
         uint16_t occ[16];
         memset(occ, 0xAB, sizeof occ); /* poison: every frustum must be written */
-        isa_fns[i]->occluded(&s->bvh2_mft, &o, b, T, occ);
+        unsigned nodes = ~0u;
+        isa_fns[i]->occluded(&s->bvh2_mft, &o, b, T, occ, &nodes);
+        assert_true(nodes != ~0u);
         if (first) {
           memcpy(ref, occ, sizeof ref);
           first = 0;
@@ -227,6 +229,111 @@ static void random_scenes(void **state) {
     free_scene(&sd);
   }
   print_message("random scenes: %ld rays, %ld disagreements (all at edges or range ends)\n", tl.rays, tl.disagree);
+  assert_true(tl.disagree * 1000 < tl.rays);
+}
+
+/* Frusta around given rays (fr_mft_fns.from_rays), as Whitted's shadow rays
+ * from a point light make them: groups of 16 rays from one origin to
+ * points on the scene, each unit direction with [eps, dist - eps]. Every
+ * ISA makes the same batch; the rays it makes are the given ones scaled to
+ * end at t = 1; groups that break a rule make no frustum; and the frusta
+ * traced (corner-ray culls for every triangle, every shrinking) agree with
+ * the single-ray kernel ray by ray, which checks that the corner rays bound
+ * the rays. A node budget stops a batch short with a subset of the answers. */
+static void rays_batch(fr_rng *r, const mesh_ref *m, vec3 light, float eps, fr_ray rays[256], int bad_group) {
+  for (int i = 0; i < 256; i++) {
+    uint32_t t = fr_rng_u32(r) % (uint32_t)m->nt;
+    vec3 a = v3_load(m->pos + 3 * m->idx[3 * t]), b = v3_load(m->pos + 3 * m->idx[3 * t + 1]),
+         c = v3_load(m->pos + 3 * m->idx[3 * t + 2]);
+    float u = fr_rng_float(r) * 0.5f, v = fr_rng_float(r) * 0.5f;
+    vec3 p = v3_add(a, v3_add(v3_scale(v3_sub(b, a), u), v3_scale(v3_sub(c, a), v)));
+    vec3 d = v3_sub(p, light);
+    float dist = v3_len(d);
+    d = v3_scale(d, 1.0f / dist);
+    rays[i] = (fr_ray){{light.x, light.y, light.z}, dist * 1e-4f, {d.x, d.y, d.z}, dist - eps};
+  }
+  fr_ray *g = rays + 16 * bad_group;
+  switch (bad_group % 4) {
+  case 0: g[5].org[1] += 1.0f; break;                   /* two origins */
+  case 1: g[3].dir[0] = NAN; break;                     /* NaN */
+  case 2: g[9].tfar = INFINITY; break;                  /* unbounded */
+  default: /* a ray against the others */
+    for (int a = 0; a < 3; a++) g[7].dir[a] = -g[6].dir[a];
+  }
+}
+
+static void rays_frusta(void **state) {
+  (void)state;
+  fr_rng r = fr_rng_seed(29, 5);
+  tally tl = {0};
+  long made = 0, stopped = 0;
+  for (int round = 0; round < 4; round++) {
+    vec3 center = round == 3 ? v3(1e4f, -3e3f, 2e3f) : v3(0, 0, 0);
+    float size = round % 2 ? 1.0f : 30.0f;
+    scene_data sd = make_scene(&r, 800 + 400 * (size_t)round, center, size);
+    fr_scene *s = commit_scene(&sd);
+    mesh_ref m = scene_mesh(s);
+    for (int n = 0; n < 24; n++) {
+      /* a light above the scene, so that the rays fan out within 75 degrees */
+      vec3 light = v3_add(center, v3(urand(&r, -0.3f, 0.3f) * size, 4.0f * size, urand(&r, -0.3f, 0.3f) * size));
+      static fr_ray rays[256];
+      const int bad = n % 16;
+      rays_batch(&r, &m, light, 1e-4f * size, rays, bad);
+      const size_t count = n % 3 ? 256 : 256 - 5; /* a partial last frustum (11 rays) */
+      fr_mft_batch b, bi;
+      static fr_mft_sets T, Ti;
+      unsigned valid = 0;
+      for (int i = 0; i < 3; i++) {
+        if (!fr_isa_supported(isas[i])) continue;
+        memset(&bi, 0x5A, sizeof bi);
+        memset(&Ti, 0x5A, sizeof Ti);
+        unsigned v = isa_fns[i]->from_rays(&bi, &Ti, rays, count);
+        assert_int_equal(v, bi.valid);
+        if (i == 0) {
+          valid = v;
+          b = bi;
+          T = Ti;
+        } else { /* every ISA makes the same frusta */
+          assert_int_equal(v, valid);
+          assert_memory_equal(&bi, &b, sizeof b);
+          assert_memory_equal(&Ti, &T, sizeof T);
+        }
+      }
+      /* the broken group, and no other, makes no frustum */
+      assert_int_equal(valid, 0xFFFFu & ~(1u << bad));
+      made += __builtin_popcount(valid);
+      for (unsigned l = valid; l; l &= l - 1) {
+        int f = __builtin_ctz(l);
+        assert_true(b.tfar[f] == 1.0f);
+        for (int k = 0; k < 16; k++) {
+          const fr_ray *g = &rays[16 * f + (16 * (size_t)f + (size_t)k < count ? k : (int)(count - 1 - 16 * (size_t)f))];
+          float org[3], dir[3];
+          fr_mft_ray(&b, &T, f, k, org, dir);
+          assert_memory_equal(org, g->org, sizeof org);
+          for (int a = 0; a < 3; a++) assert_true(fabsf(dir[a] - g->dir[a] * g->tfar) <= 1e-5f * g->tfar);
+          assert_true(b.tnear[f] <= g->tnear / g->tfar);
+        }
+      }
+      check_shadows(s, &b, &T, &tl);
+      /* a budget of 3 nodes stops the batch: what it says occluded is */
+      uint16_t full[16], part[16];
+      unsigned nodes = 0;
+      const fr_mft_opts o = fr_mft_opts_default();
+      fr_mft_active()->occluded(&s->bvh2, &o, &b, &T, full, &nodes);
+      if (nodes > 3) {
+        unsigned budget = 3;
+        fr_mft_active()->occluded(&s->bvh2, &o, &b, &T, part, &budget);
+        assert_int_equal(budget, 4);
+        for (int f = 0; f < 16; f++) assert_int_equal(part[f] & ~full[f], 0);
+        stopped++;
+      }
+    }
+    fr_scene_release(s);
+    free_scene(&sd);
+  }
+  print_message("rays as frusta: %ld frusta, %ld rays, %ld disagreements (all at edges or range ends), %ld stopped by a budget\n",
+                made, tl.rays, tl.disagree, stopped);
+  assert_true(made > 0 && stopped > 0);
   assert_true(tl.disagree * 1000 < tl.rays);
 }
 
@@ -454,10 +561,11 @@ static unsigned counted_intersect_frusta(void *ctx, const fr_mft_batch *b, const
   return c->inner.intersect_frusta(c->inner.ctx, b, t, h);
 }
 
-static unsigned counted_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[16]) {
+static unsigned counted_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[16],
+                                        unsigned *nodes) {
   ray_counter *c = ctx;
   c->batches++;
-  return c->inner.occluded_frusta(c->inner.ctx, b, t, occ);
+  return c->inner.occluded_frusta(c->inner.ctx, b, t, occ, nodes);
 }
 
 static void soft_fallback(void **state) {
@@ -503,6 +611,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(light_sets_are_nets),
       cmocka_unit_test(random_scenes),
+      cmocka_unit_test(rays_frusta),
       cmocka_unit_test(builtin_scene),
       cmocka_unit_test(fine_far_sphere),
       cmocka_unit_test(shared_scenes),

@@ -24,7 +24,7 @@
 typedef struct checker {
   fr_tracer inner;
   const fr_scene *s;
-  long rays, occluded_rays, disagree, frusta_rays;
+  long rays, occluded_rays, disagree, frusta_rays, shadow_frusta_rays;
 } checker;
 
 /* the tracer may overwrite its rays: keep a copy to re-trace */
@@ -73,6 +73,30 @@ static unsigned check_intersect_frusta(void *ctx, const fr_mft_batch *b, const f
   return fetched;
 }
 
+/* shadow frusta from the light: each ray as fr_mft_ray makes it; a batch
+ * stopped by its node budget answers only for the rays it found occluded */
+static unsigned check_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[16],
+                                      unsigned *nodes) {
+  checker *c = ctx;
+  const unsigned budget = nodes ? *nodes : 0;
+  unsigned fetched = c->inner.occluded_frusta(c->inner.ctx, b, t, occ, nodes);
+  const int stopped = budget && nodes && *nodes > budget;
+  mesh_ref m = scene_mesh(c->s);
+  for (int f = 0; f < FR_MFT_FRUSTA; f++) {
+    if (!((b->valid >> f) & 1)) continue;
+    for (int k = 0; k < FR_MFT_RAYS; k++) {
+      fr_ray r = {{0, 0, 0}, b->tnear[f], {0, 0, 0}, b->tfar[f]};
+      fr_mft_ray(b, t, f, k, r.org, r.dir);
+      int got = (occ[f] >> k) & 1, single = fr_occluded1(c->s, &r);
+      c->shadow_frusta_rays++;
+      if (got == single || (stopped && !got)) continue;
+      c->disagree++;
+      if (!ambiguous(&m, &r)) fail_msg("shadow frustum %d ray %d: frusta %d, single %d", f, k, got, single);
+    }
+  }
+  return fetched;
+}
+
 static void check_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
   checker *c = ctx;
   fr_ray *copy = copy_rays(rays, n);
@@ -104,28 +128,37 @@ static void whitted_setup(fr_workload *w, fr_scene *s, const char *name, const f
 }
 
 /* The multi-frusta tracer: camera rays as frusta where a 16x16 block fits
- * (200x150 leaves partial blocks on two sides, traced as rays), the rest
- * as streams; everything checked ray by ray. */
+ * (200x150 leaves partial blocks on two sides, traced as rays), the first
+ * shadow rays as frusta from the light (with their node budget, and with
+ * none: every batch), the rest as streams; everything checked ray by ray. */
 static void check_whitted_mft(fr_scene *s, const char *name, const fr_whitted_mats *mats) {
-  fr_workload w;
-  whitted_setup(&w, s, name, mats, 200, 150);
-  fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
-  checker c = {fr_tracer_mft(&mctx), s, 0, 0, 0, 0};
-  fr_tracer t = {&c, check_intersect, check_occluded, check_intersect_frusta, NULL, 0};
-  fr_workload_result r = fr_workload_run(&w, &t);
-  assert_int_equal(r.rays, (uint64_t)(c.rays + c.occluded_rays + c.frusta_rays));
-  /* 12 x 9 blocks of 16x16 as frusta; the partial ones' camera rays, and the secondaries, as rays */
-  assert_int_equal(c.frusta_rays, 12 * 9 * 256);
-  /* the stage times: every stage ran, and (one thread) they add up to the tiles' time, within the run's */
-  double staged = 0.0;
-  for (int i = 0; i < FR_STAGES; i++) {
-    assert_true(r.stage[i] > 0.0);
-    staged += r.stage[i];
+  for (int no_budget = 0; no_budget < 2; no_budget++) {
+    fr_workload w;
+    whitted_setup(&w, s, name, mats, 200, 150);
+    w.mft_no_fallback = no_budget;
+    fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
+    checker c = {fr_tracer_mft(&mctx), s, 0, 0, 0, 0, 0};
+    fr_tracer t = {&c, check_intersect, check_occluded, check_intersect_frusta, check_occluded_frusta, 0};
+    fr_workload_result r = fr_workload_run(&w, &t);
+    /* shadow frusta repeat a partial frustum's last ray, and a batch over budget goes again as rays */
+    const long traced = c.rays + c.occluded_rays + c.frusta_rays;
+    assert_true((long)r.rays >= traced && (long)r.rays <= traced + c.shadow_frusta_rays);
+    assert_true(c.shadow_frusta_rays > 0);
+    if (no_budget) assert_true((long)r.rays > traced);
+    /* 12 x 9 blocks of 16x16 as frusta; the partial ones' camera rays, and the secondaries, as rays */
+    assert_int_equal(c.frusta_rays, 12 * 9 * 256);
+    /* the stage times: every stage ran, and (one thread) they add up to the tiles' time, within the run's */
+    double staged = 0.0;
+    for (int i = 0; i < FR_STAGES; i++) {
+      assert_true(r.stage[i] > 0.0);
+      staged += r.stage[i];
+    }
+    assert_true(staged <= r.seconds * 1.0001 + 1e-6 && staged >= 0.5 * r.seconds);
+    assert_true(c.rays > 200 * 150 - 12 * 9 * 256 && c.occluded_rays > 0);
+    print_message("%s mft%s: %ld camera rays in frusta, %ld closest-hit rays, %ld shadow rays, %ld shadow rays in "
+                  "frusta, %ld disagreements (all at edges or range ends)\n", name, no_budget ? " (no budget)" : "",
+                  c.frusta_rays, c.rays, c.occluded_rays, c.shadow_frusta_rays, c.disagree);
   }
-  assert_true(staged <= r.seconds * 1.0001 + 1e-6 && staged >= 0.5 * r.seconds);
-  assert_true(c.rays > 200 * 150 - 12 * 9 * 256 && c.occluded_rays > 0);
-  print_message("%s mft: %ld camera rays in frusta, %ld closest-hit rays, %ld shadow rays, %ld disagreements (all at "
-                "edges or range ends)\n", name, c.frusta_rays, c.rays, c.occluded_rays, c.disagree);
 }
 
 /* Whitted on scene s (view of name) with its materials as mirror and glass
@@ -143,7 +176,7 @@ static void check_whitted(fr_scene *s, const char *name, const char *mirror, con
       {16, FR_LP_RANGED, FR_CULL_OFF},    {16, FR_LP_PARTITION, FR_CULL_CORNERS}, {32, FR_LP_MASKED, FR_CULL_CORNERS}};
   for (size_t k = 0; k < sizeof configs / sizeof configs[0]; k++) {
     fr_lp_tracer lpc = {s, {&s->bvh2, &s->sphere_bvh, fr_scene_sphere_base(s)}, {configs[k].t, configs[k].c}, configs[k].side};
-    checker c = {fr_tracer_lp(&lpc), s, 0, 0, 0, 0};
+    checker c = {fr_tracer_lp(&lpc), s, 0, 0, 0, 0, 0};
     fr_tracer t = {&c, check_intersect, check_occluded, NULL, NULL, configs[k].side};
     fr_workload_result r = fr_workload_run(&w, &t);
     assert_int_equal(r.rays, (uint64_t)(c.rays + c.occluded_rays));

@@ -136,7 +136,7 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
     rays += 16u * (uint64_t)__builtin_popcount(b.valid);
     if (!as_rays) {
       uint16_t occ[FR_MFT_FRUSTA];
-      unsigned fetched = t->occluded_frusta(t->ctx, &b, T, occ);
+      unsigned fetched = t->occluded_frusta(t->ctx, &b, T, occ, NULL);
       for (unsigned v = b.valid; v; v &= v - 1) {
         int f = __builtin_ctz(v);
         lit[16 * j + f] = (float)(16 - __builtin_popcount(occ[f])) / 16.0f;
@@ -400,9 +400,9 @@ static unsigned mft_intersect_frusta(void *ctx, const fr_mft_batch *b, const fr_
 }
 
 static unsigned mft_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t,
-                                    uint16_t occ[FR_MFT_FRUSTA]) {
+                                    uint16_t occ[FR_MFT_FRUSTA], unsigned *nodes) {
   const fr_mft_tracer *m = ctx;
-  return fr_mft_active()->occluded(m->shadow_bvh ? m->shadow_bvh : m->bvh, &m->opts, b, t, occ);
+  return fr_mft_active()->occluded(m->shadow_bvh ? m->shadow_bvh : m->bvh, &m->opts, b, t, occ, nodes);
 }
 
 fr_mft_tracer fr_mft_tracer_of(const fr_scene *s, fr_mft_opts opts) {

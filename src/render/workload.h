@@ -45,7 +45,8 @@ typedef struct fr_tracer {
   void (*occluded)(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent);
   unsigned (*intersect_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *hits);
   /* both return the triangles the batch fetched (see soft_shadows in workload.c) */
-  unsigned (*occluded_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[FR_MFT_FRUSTA]);
+  unsigned (*occluded_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[FR_MFT_FRUSTA],
+                              unsigned *nodes);
   int packet_side;
 } fr_tracer;
 

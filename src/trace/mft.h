@@ -21,6 +21,7 @@
  */
 #ifndef FR_TRACE_MFT_H
 #define FR_TRACE_MFT_H
+#include <stddef.h>
 #include <stdint.h>
 #include "accel/bvh2.h"
 #include "frusta.h"
@@ -92,9 +93,13 @@ fr_mft_opts fr_mft_opts_default(void);
 
 typedef struct fr_mft_fns {
   /* occ[f]: bit k set when ray k of frustum f is occluded; returns the
-   * triangles the batch's leaves fetched (what it cost) */
+   * triangles the batch's leaves fetched, what it cost. nodes, when not
+   * NULL: in, a budget of inner-node visits (0: none); out, the visits. A
+   * batch that would go over its budget stops there (*nodes = budget + 1),
+   * and then only the set bits of occ are answers: the other rays are
+   * still to be traced. */
   unsigned (*occluded)(const fr_bvh2 *b, const fr_mft_opts *o, const fr_mft_batch *batch, const fr_mft_sets *sets,
-                   uint16_t occ[FR_MFT_FRUSTA]);
+                       uint16_t occ[FR_MFT_FRUSTA], unsigned *nodes);
   /* returns the triangles fetched, as occluded does */
   unsigned (*intersect)(const fr_bvh2 *b, const fr_mft_opts *o, const fr_mft_batch *batch, const fr_mft_sets *sets,
                         fr_mft_hits *hits);
@@ -103,12 +108,26 @@ typedef struct fr_mft_fns {
    * all 16 frusta (src/trace/mft_expand.c) */
   void (*expand)(const fr_mft_batch *batch, const fr_mft_sets *sets, const fr_mft_hits *hits, fr_ray *rays_out,
                  fr_hit *hits_out);
+  /* 16 frusta around up to n <= 256 given rays, ray k of frustum f being
+   * rays[16 f + k] (a last, partial frustum repeats its last ray), one set
+   * per frustum in sets (src/trace/mft_from_rays.c). A frustum is made where
+   * its rays share an origin, have finite ranges with 0 <= tnear <= tfar,
+   * and lie within about 75 degrees of the batch's mean direction. Its rays,
+   * as fr_mft_ray makes them, are the given directions times tfar, to within
+   * rounding, over t in (the least tnear / tfar, 1). Returns the frusta made
+   * (batch->valid); the rest are for the caller to trace as rays. */
+  unsigned (*from_rays)(fr_mft_batch *batch, fr_mft_sets *sets, const fr_ray *rays, size_t n);
 } fr_mft_fns;
 
 extern const fr_mft_fns fr_mft_avx512, fr_mft_avx2, fr_mft_scalar;
 #define FR_MFT_EXPAND_DECL(isa)                                                                            \
   void fr_mft_expand_##isa(const fr_mft_batch *batch, const fr_mft_sets *sets, const fr_mft_hits *hits, fr_ray *rays_out, \
                            fr_hit *hits_out);
+#define FR_MFT_FROM_RAYS_DECL(isa) \
+  unsigned fr_mft_from_rays_##isa(fr_mft_batch *batch, fr_mft_sets *sets, const fr_ray *rays, size_t n);
+FR_MFT_FROM_RAYS_DECL(avx512)
+FR_MFT_FROM_RAYS_DECL(avx2)
+FR_MFT_FROM_RAYS_DECL(scalar)
 FR_MFT_EXPAND_DECL(avx512)
 FR_MFT_EXPAND_DECL(avx2)
 FR_MFT_EXPAND_DECL(scalar)

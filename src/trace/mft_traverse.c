@@ -363,11 +363,14 @@ FR_INLINE int visit_node(const frusta *F, const fr_bvh2 *b, uint32_t ref, unsign
 }
 
 static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B, const fr_mft_sets *T,
-                         uint16_t occ[16]) {
+                             uint16_t occ[16], unsigned *nodes) {
   frusta F;
   tri_frusta X;
   unsigned valid = B->valid & 0xFFFFu;
+  unsigned visited = 0;
+  const unsigned budget = nodes && *nodes ? *nodes : ~0u;
   for (int f = 0; f < 16; f++) occ[f] = 0;
+  if (nodes) *nodes = 0;
   FR_COUNT(mft_batches, 1);
   FR_COUNT(rays, 16 * __builtin_popcount(valid));
   if (!valid || !b->nodes) return 0;
@@ -384,6 +387,7 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
     e.mask &= alive;
     while (e.mask) {
       if (!(e.ref & FR_BVH2_LEAF)) {
+        if (visited++ == budget) goto out;
         if (!visit_node(&F, b, e.ref, e.mask, stack, &sp, &e)) break;
         continue;
       }
@@ -422,6 +426,8 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
       break;
     }
   }
+out:
+  if (nodes) *nodes = visited;
   return fetched;
 }
 
@@ -487,4 +493,4 @@ static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr
   return fetched;
 }
 
-const fr_mft_fns FR_ISA_FN(fr_mft) = {occluded_mft, intersect_mft, FR_ISA_FN(fr_mft_expand)};
+const fr_mft_fns FR_ISA_FN(fr_mft) = {occluded_mft, intersect_mft, FR_ISA_FN(fr_mft_expand), FR_ISA_FN(fr_mft_from_rays)};

@@ -10,6 +10,7 @@
 #include "cli.h"
 #include "commands.h"
 #include "embree_tracer.h"
+#include "render/whitted.h"
 #include "render/workload.h"
 #include "trace/counters.h"
 
@@ -26,6 +27,14 @@ static int table5(const char *path, const cli_view *v, int threads, const char *
   if (rc) return rc;
   w.kind = k;
   w.seed = 7;
+  /* Whitted needs its materials (without, the renderer had none to read: a crash) */
+  fr_whitted_mats mats = {0};
+  cli_whitted wo;
+  cli_whitted_default(&wo);
+  if (k == FR_WL_WHITTED && (rc = cli_whitted_setup(s, &wo, &mats, &w))) {
+    fr_scene_release(s);
+    return rc;
+  }
   fr_trace_options o;
   fr_trace_options_default(&o);
   o.mode = FR_TRACE_HYBRID16;
@@ -50,6 +59,7 @@ static int table5(const char *path, const cli_view *v, int threads, const char *
          c.switches ? (double)c.switch_rays / c.switches : 0.0, c.pk_box_tests ? (double)c.pk_box_lanes / c.pk_box_tests : 0.0,
          c.pk_tri_tests ? (double)c.pk_tri_lanes / c.pk_tri_tests : 0.0, c.packets ? (double)c.ia_culled / c.packets : 0.0,
          c.packets ? (double)c.mailbox_hits / c.packets : 0.0);
+  fr_whitted_mats_free(&mats);
   fr_scene_release(s);
   return 0;
 }
