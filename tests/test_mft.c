@@ -25,14 +25,19 @@ static const fr_mft_fns *isa_fns[] = {&fr_mft_scalar, &fr_mft_avx2, &fr_mft_avx5
 static const fr_isa isas[] = {FR_ISA_SCALAR, FR_ISA_AVX2, FR_ISA_AVX512};
 
 /* Soft-shadow frusta from random points of the scene to a quad light. */
+/* A random point of a random triangle of m. */
+static vec3 random_surface_point(fr_rng *r, const mesh_ref *m) {
+  uint32_t t = fr_rng_u32(r) % (uint32_t)m->nt;
+  vec3 a = v3_load(m->pos + 3 * m->idx[3 * t]), b = v3_load(m->pos + 3 * m->idx[3 * t + 1]),
+       c = v3_load(m->pos + 3 * m->idx[3 * t + 2]);
+  float u = fr_rng_float(r) * 0.5f, v = fr_rng_float(r) * 0.5f;
+  return v3_add(a, v3_add(v3_scale(v3_sub(b, a), u), v3_scale(v3_sub(c, a), v)));
+}
+
 static void make_shadow_batch(fr_rng *r, const mesh_ref *m, vec3 lc, float eps, fr_mft_batch *b) {
   memset(b, 0, sizeof *b);
   for (int f = 0; f < 16; f++) {
-    uint32_t t = fr_rng_u32(r) % (uint32_t)m->nt;
-    vec3 a = v3_load(m->pos + 3 * m->idx[3 * t]), bb = v3_load(m->pos + 3 * m->idx[3 * t + 1]),
-         c = v3_load(m->pos + 3 * m->idx[3 * t + 2]);
-    float u = fr_rng_float(r) * 0.5f, v = fr_rng_float(r) * 0.5f;
-    vec3 p = v3_add(a, v3_add(v3_scale(v3_sub(bb, a), u), v3_scale(v3_sub(c, a), v)));
+    vec3 p = random_surface_point(r, m);
     vec3 s = v3_sub(lc, p);
     b->org[0][f] = p.x; b->org[1][f] = p.y; b->org[2][f] = p.z;
     b->start[0][f] = s.x; b->start[1][f] = s.y; b->start[2][f] = s.z;
@@ -242,12 +247,7 @@ static void random_scenes(void **state) {
  * the rays. A node budget stops a batch short with a subset of the answers. */
 static void rays_batch(fr_rng *r, const mesh_ref *m, vec3 light, float eps, fr_ray rays[256], int bad_group) {
   for (int i = 0; i < 256; i++) {
-    uint32_t t = fr_rng_u32(r) % (uint32_t)m->nt;
-    vec3 a = v3_load(m->pos + 3 * m->idx[3 * t]), b = v3_load(m->pos + 3 * m->idx[3 * t + 1]),
-         c = v3_load(m->pos + 3 * m->idx[3 * t + 2]);
-    float u = fr_rng_float(r) * 0.5f, v = fr_rng_float(r) * 0.5f;
-    vec3 p = v3_add(a, v3_add(v3_scale(v3_sub(b, a), u), v3_scale(v3_sub(c, a), v)));
-    vec3 d = v3_sub(p, light);
+    vec3 d = v3_sub(random_surface_point(r, m), light);
     float dist = v3_len(d);
     d = v3_scale(d, 1.0f / dist);
     rays[i] = (fr_ray){{light.x, light.y, light.z}, dist * 1e-4f, {d.x, d.y, d.z}, dist - eps};
