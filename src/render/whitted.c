@@ -232,9 +232,9 @@ static void trace_runs(const fr_tracer *t, const wray *g, fr_ray *rays, fr_hit *
  * over a frame for a few probe tiles to tell (3x3 of them read conference
  * 3.7, sibenik 7.1), so each batch gets a budget of this many visits per
  * frustum, and a batch over it sends the rest of its tile's shadow rays to
- * the packets. With it, against packets, 2 pairs: museum 0.81x, sibenik
- * 0.79x, conference 0.84x, kitchen 0.88x of the time, but dragon 1.13x,
- * spd_balls 1.08x, spd_tree 1.03x (budget 4: museum, kitchen and sibenik
+ * the packets. With it, against packets, 2 pairs: museum 0.79x, sibenik
+ * 0.79x, conference 0.83x, kitchen 0.88x of the time, but dragon 1.11-1.14x,
+ * spd_balls 1.08-1.10x, spd_tree 1.03x (budget 4: museum, kitchen and sibenik
  * 4-9% slower than 6; 8 and 10 no better than 6, and hairball worse; adding
  * the triangles fetched to the count, or a bound on them as the soft
  * shadows have, helped none). */

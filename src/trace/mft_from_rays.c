@@ -97,6 +97,12 @@ static int frustum_of(fr_mft_batch *b, fr_mft_set *S, int f, const fr_ray *r, co
   return 1;
 }
 
+static void cross_d(const double a[3], const double b[3], double out[3]) {
+  out[0] = a[1] * b[2] - a[2] * b[1];
+  out[1] = a[2] * b[0] - a[0] * b[2];
+  out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
 unsigned FR_ISA_FN(fr_mft_from_rays)(fr_mft_batch *b, fr_mft_sets *t, const fr_ray *rays, size_t n) {
   memset(b, 0, sizeof *b);
   if (n > FR_MFT_FRUSTA * FR_MFT_RAYS) n = FR_MFT_FRUSTA * FR_MFT_RAYS;
@@ -113,17 +119,19 @@ unsigned FR_ISA_FN(fr_mft_from_rays)(fr_mft_batch *b, fr_mft_sets *t, const fr_r
   if (ok_axis) {
     for (int a = 0; a < 3; a++) m[a] /= ml;
     /* e1, e2 across it, orthonormal in double and rounded once */
-    double h[3] = {fabs(m[0]) < 0.6 ? 1.0 : 0.0, fabs(m[0]) < 0.6 ? 0.0 : 1.0, 0.0};
-    double u[3] = {m[1] * h[2] - m[2] * h[1], m[2] * h[0] - m[0] * h[2], m[0] * h[1] - m[1] * h[0]};
+    const double h[3] = {fabs(m[0]) < 0.6 ? 1.0 : 0.0, fabs(m[0]) < 0.6 ? 0.0 : 1.0, 0.0};
+    double u[3], v[3], e1[3], e2[3], N[3];
+    cross_d(m, h, u);
     double ul = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
     for (int a = 0; a < 3; a++) u[a] /= ul;
-    double v[3] = {m[1] * u[2] - m[2] * u[1], m[2] * u[0] - m[0] * u[2], m[0] * u[1] - m[1] * u[0]};
+    cross_d(m, u, v);
     for (int a = 0; a < 3; a++) {
       F.e1[a] = t->e1[a] = (float)u[a];
       F.e2[a] = t->e2[a] = (float)v[a];
+      e1[a] = F.e1[a];
+      e2[a] = F.e2[a];
     }
-    double N[3] = {(double)F.e1[1] * F.e2[2] - (double)F.e1[2] * F.e2[1], (double)F.e1[2] * F.e2[0] - (double)F.e1[0] * F.e2[2],
-                   (double)F.e1[0] * F.e2[1] - (double)F.e1[1] * F.e2[0]};
+    cross_d(e1, e2, N); /* of e1 and e2 as rounded */
     for (int a = 0; a < 3; a++) F.N[a] = (float)N[a];
     F.nn = F.N[0] * F.N[0] + F.N[1] * F.N[1] + F.N[2] * F.N[2];
   }
