@@ -4,9 +4,12 @@
  * arbitrary origins and directions), no cull of any mode rejects a box,
  * triangle or sphere that one of the packet's rays hits. Hits are decided
  * in double precision, boundaries included. The test also counts how often
- * each mode culls, so it cannot pass by never culling.
+ * each mode culls, so it cannot pass by never culling. The bounds are
+ * checked both as fr_pbounds_build makes them (in double) and as the large
+ * packets make them (in float, 16 lanes at a time) on every ISA.
  */
 #include "test_util.h"
+#include "trace/lpacket.h"
 #include "trace/packet_bounds.h"
 
 #define MAXR 256
@@ -177,15 +180,52 @@ static void near_point(fr_rng *g, const packet *p, float c[3], float *size) {
   for (int a = 0; a < 3; a++) c[a] = p->o[a][i] + t * p->d[a][i] + urand(g, -0.6f, 0.6f);
 }
 
+/* Bounds of packet p for each maker: [0] fr_pbounds_build, then per ISA
+ * the large packets' own, [1 + 2 isa] for the IA cull and [2 + 2 isa] for
+ * planes and corners. */
+#define MAKERS 7
+static const fr_lp_fns *lp_isa_fns[] = {&fr_lp_scalar, &fr_lp_avx2, &fr_lp_avx512};
+static const fr_isa lp_isas[] = {FR_ISA_SCALAR, FR_ISA_AVX2, FR_ISA_AVX512};
+
+static int make_bounds(const packet *p, fr_pbounds b[MAKERS]) {
+  static fr_lpacket lp;
+  static fr_ray rays[MAXR];
+  fr_ray_soa soa = {{p->o[0], p->o[1], p->o[2]}, {p->d[0], p->d[1], p->d[2]}, p->tnear, p->tfar, NULL, p->n};
+  fr_pbounds_build(&b[0], &soa);
+  for (int i = 0; i < p->n; i++) {
+    for (int a = 0; a < 3; a++) { rays[i].org[a] = p->o[a][i]; rays[i].dir[a] = p->d[a][i]; }
+    rays[i].tnear = p->tnear[i];
+    rays[i].tfar = p->tfar[i];
+  }
+  int made = 1;
+  for (int i = 0; i < 3; i++) {
+    if (!fr_isa_supported(lp_isas[i])) continue;
+    for (int j = 0; j < 2; j++) {
+      fr_lp_opts o = {FR_LP_RANGED, j ? FR_CULL_PLANES : FR_CULL_IA};
+      fr_lpacket_load(&lp, rays, p->n);
+      lp_isa_fns[i]->bounds(&o, &lp);
+      b[1 + 2 * i + j] = lp.bounds;
+    }
+    made = 3 + 2 * i;
+  }
+  return made;
+}
+
+static const char *maker_name(int j) {
+  static const char *names[MAKERS] = {"double", "scalar ia", "scalar planes", "avx2 ia", "avx2 planes", "avx512 ia", "avx512 planes"};
+  return names[j];
+}
+
 static void check_packets(int npackets, uint64_t seed) {
   fr_rng g = fr_rng_seed(seed, 0);
   static packet p;
-  long tests = 0, culled[3][FR_CULL_COUNT] = {{0}}, hit_objects = 0;
+  long tests = 0, culled[3][FR_CULL_COUNT] = {{0}}, hit_objects = 0, lp_culled[MAKERS] = {0}, planes[MAKERS] = {0};
   for (int k = 0; k < npackets; k++) {
     make_packet(&g, &p, k % 5);
-    fr_ray_soa soa = {{p.o[0], p.o[1], p.o[2]}, {p.d[0], p.d[1], p.d[2]}, p.tnear, p.tfar, NULL, p.n};
-    fr_pbounds b;
-    fr_pbounds_build(&b, &soa);
+    fr_pbounds bs[MAKERS];
+    const int makers = make_bounds(&p, bs);
+    const fr_pbounds b = bs[0];
+    for (int j = 0; j < makers; j++) planes[j] += bs[j].has_planes;
     for (int obj = 0; obj < 6; obj++) {
       float c[3], s;
       near_point(&g, &p, c, &s);
@@ -212,6 +252,17 @@ static void check_packets(int npackets, uint64_t seed) {
         culled[1][m] += ct;
         culled[2][m] += cs;
         tests += 3;
+        for (int j = 1; j < makers; j++) {
+          /* the IA bounds serve the IA cull, the plane bounds all three */
+          if (j % 2 == 1 && m != FR_CULL_IA) continue;
+          cb = fr_pbounds_cull_box(&bs[j], (fr_cull)m, lo, hi);
+          ct = fr_pbounds_cull_tri(&bs[j], (fr_cull)m, v[0], v[1], v[2]);
+          cs = fr_pbounds_cull_sphere(&bs[j], (fr_cull)m, c, radius);
+          if ((cb && hb) || (ct && ht) || (cs && hs))
+            fail_msg("%s packet %d (%d rays), %s bounds: cull %s rejects a %s one of its rays hits", p.kind, k, p.n,
+                     maker_name(j), fr_cull_name((fr_cull)m), cb && hb ? "box" : ct && ht ? "triangle" : "sphere");
+          lp_culled[j] += cb + ct + cs;
+        }
       }
     }
   }
@@ -219,6 +270,15 @@ static void check_packets(int npackets, uint64_t seed) {
                 "triangles %ld/%ld/%ld, spheres %ld/%ld/%ld\n",
                 tests, hit_objects, culled[0][1], culled[0][2], culled[0][3], culled[1][1], culled[1][2], culled[1][3],
                 culled[2][1], culled[2][2], culled[2][3]);
+  for (int j = 1; j < MAKERS; j++)
+    print_message("%s bounds: %ld culls, planes in %ld of %ld packets (double: %ld)\n", maker_name(j), lp_culled[j],
+                  planes[j], (long)npackets, planes[0]);
+  /* the large packets' bounds cull, and find planes where the double build does */
+  for (int j = 1; j < MAKERS; j++) {
+    if (!fr_isa_supported(lp_isas[(j - 1) / 2])) continue;
+    assert_true(lp_culled[j] > tests / 100);
+    if (j % 2 == 0) assert_true(planes[j] >= planes[0] - planes[0] / 1000);
+  }
   /* the culls must do something, and corners (exact for boxes) at least as much as planes */
   for (int o = 0; o < 3; o++)
     for (int m = FR_CULL_IA; m < FR_CULL_COUNT; m++) assert_true(culled[o][m] > tests / 200);

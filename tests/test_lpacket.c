@@ -49,6 +49,8 @@ static int self_hit(const fr_scene *s, const fr_ray *r) {
   return fminf(h.t, h1.t) < 10.0f * r->tnear;
 }
 
+static const char *config = ""; /* traversal/cull of the packet being checked, for messages */
+
 static void check_against_single(const fr_scene *s, const fr_ray *rays, int n, const fr_hit *hits, const uint8_t *occ,
                                  tally *tl) {
   mesh_ref m = scene_mesh(s);
@@ -63,8 +65,8 @@ static void check_against_single(const fr_scene *s, const fr_ray *rays, int n, c
       if (!ambiguous(&m, &rays[i]) && !self_hit(s, &rays[i])) {
         uint32_t bp;
         double margin, bt = brute_force(m.pos, m.idx, m.nt, &rays[i], &bp, &margin, 1);
-        fail_msg("ray %d: packet occluded %d, single %d (org %g %g %g dir %g %g %g range %g %g; double t %g prim %u)", i,
-                 occ[i], single, rays[i].org[0], rays[i].org[1], rays[i].org[2], rays[i].dir[0], rays[i].dir[1],
+        fail_msg("%s ray %d: packet occluded %d, single %d (org %g %g %g dir %g %g %g range %g %g; double t %g prim %u)",
+                 config, i, occ[i], single, rays[i].org[0], rays[i].org[1], rays[i].org[2], rays[i].dir[0], rays[i].dir[1],
                  rays[i].dir[2], rays[i].tnear, rays[i].tfar, bt, bp);
       }
       continue;
@@ -82,7 +84,9 @@ static void check_against_single(const fr_scene *s, const fr_ray *rays, int n, c
       continue; /* the same distance on two triangles: either answer */
     tl->disagree++;
     if (!ambiguous(&m, &rays[i]) && !self_hit(s, &rays[i]))
-      fail_msg("ray %d of %d: packet prim %u t %g, single prim %u t %g", i, n, hits[i].prim, hits[i].t, h.prim, h.t);
+      fail_msg("%s ray %d of %d: packet prim %u t %g, single prim %u t %g (org %a %a %a dir %a %a %a range %a %a)", config, i,
+               n, hits[i].prim, hits[i].t, h.prim, h.t, rays[i].org[0], rays[i].org[1], rays[i].org[2], rays[i].dir[0],
+               rays[i].dir[1], rays[i].dir[2], rays[i].tnear, rays[i].tfar);
   }
 }
 
@@ -123,6 +127,9 @@ static void check_packet(const fr_scene *s, const fr_ray *rays, int n, int occlu
         }
         first = 0;
       }
+      char name[64];
+      snprintf(name, sizeof name, "%s/%s", fr_lp_traversal_name((fr_lp_traversal)t), fr_cull_name((fr_cull)c));
+      config = name;
       check_against_single(s, rays, n, occluded ? NULL : ref, occluded ? ref_occ : NULL, t == 0 && c == 0 ? tl : NULL);
     }
 }

@@ -77,6 +77,7 @@ void fr_lpacket_hits(const fr_lpacket *p, const fr_lp_scene *g, fr_hit *hits);
 typedef struct fr_lp_fns {
   void (*intersect)(const fr_lp_scene *g, const fr_lp_opts *o, fr_lpacket *p);
   void (*occluded)(const fr_lp_scene *g, const fr_lp_opts *o, fr_lpacket *p);
+  void (*bounds)(const fr_lp_opts *o, fr_lpacket *p); /* p->bounds as traversal makes them for o->cull */
 } fr_lp_fns;
 
 extern const fr_lp_fns fr_lp_avx512, fr_lp_avx2, fr_lp_scalar;

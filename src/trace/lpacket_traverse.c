@@ -24,6 +24,9 @@
 
 #define ROUND_UP (1.0f + 0x1p-20f)
 #define TINY 1e-18f
+#ifndef TRI_CULL_MIN_CHUNKS
+#define TRI_CULL_MIN_CHUNKS 2
+#endif
 #define STACK 256
 
 typedef struct entry {
@@ -170,6 +173,92 @@ static void ia_bounds(fr_lpacket *p) {
   b->shared_origin = shared;
 }
 
+/* Float error allowance of the plane bounds: each bound below is off by at
+ * most about 2^-21 of the magnitudes it is made of, and is pushed outward
+ * by twice that. */
+#define PLANE_ERR 0x1p-20f
+
+/* Bounding planes along the major axis k (packet_bounds.h), in float, 16
+ * lanes at a time, each bound pushed outward by a bound on its own rounding
+ * error. The double build (fr_pbounds_build: three scalar passes) cost more
+ * than the planes and corner rays saved. Non-finite bounds (a direction
+ * nearly perpendicular to every axis of one sign) leave the IA bounds. */
+static void plane_bounds(fr_lpacket *p) {
+  ia_bounds(p);
+  fr_pbounds *b = &p->bounds;
+  if (b->empty || !b->uniform) return;
+  const vpf inf = vp(INFINITY), ninf = vp(-INFINITY), zero = vp(0.0f), E = vp(PLANE_ERR);
+  /* the major axis: the one of uniform sign whose directions stay farthest
+   * from 0 relative to their length, so the slopes stay small */
+  vpf frac[3] = {inf, inf, inf};
+  for (int c = 0; c < p->nchunks; c++) {
+    if (!p->valid[c]) continue;
+    const int i = 16 * c;
+    const vpm m = vpm_bits_to(p->valid[c]);
+    vpf ad[3] = {vp_abs(vp_load(p->d[0] + i)), vp_abs(vp_load(p->d[1] + i)), vp_abs(vp_load(p->d[2] + i))};
+    vpf inv = vp_div(vp(1.0f), vp_add(vp_add(ad[0], ad[1]), ad[2]));
+    for (int a = 0; a < 3; a++) frac[a] = vp_min(frac[a], vp_select(m, vp_mul(ad[a], inv), inf));
+  }
+  int k = -1;
+  float best = -1.0f;
+  for (int a = 0; a < 3; a++) {
+    float f = vp_reduce_min(frac[a]);
+    if (((b->uniform >> a) & 1) && f > best) best = f, k = a;
+  }
+  const int u = (k + 1) % 3, v = (k + 2) % 3;
+  const float sk = b->dlo[k] > 0.0f ? 1.0f : -1.0f;
+  /* K = sk x_k grows along every ray: knear and kfar bound the rays' K */
+  vpf kn = inf, kf = ninf;
+  for (int c = 0; c < p->nchunks; c++) {
+    if (!p->valid[c]) continue;
+    const int i = 16 * c;
+    const vpm m = vpm_bits_to(p->valid[c]);
+    vpf K = vp_mul(vp(sk), vp_load(p->o[k] + i)), dk = vp_abs(vp_load(p->d[k] + i));
+    vpf an = vp_mul(vp_load(p->tnear + i), dk), af = vp_mul(vp_load(p->tfar + i), dk);
+    /* K + 0 is exact: no allowance, so camera rays keep a point at knear */
+    vpf en = vp_select(vp_eq(an, zero), zero, vp_mul(vp_add(vp_abs(K), vp_abs(an)), E));
+    vpf ef = vp_mul(vp_add(vp_abs(K), vp_abs(af)), E);
+    kn = vp_min(kn, vp_select(m, vp_sub(vp_add(K, an), en), inf));
+    kf = vp_max(kf, vp_select(m, vp_add(vp_add(K, af), ef), ninf)); /* tfar = inf: +inf */
+  }
+  /* A shared origin's K bounds every start when no tnear is negative; then
+   * every ray crosses knear at the origin itself, the single point the
+   * corner-ray edge test (fr_pbounds_cull_tri) takes it for. */
+  const float knear = b->shared_origin && b->tmin >= 0.0f ? sk * b->olo[k] : vp_reduce_min(kn);
+  const float kfar = vp_reduce_max(kf);
+  /* each ray's u, v where it crosses K = knear, and its slopes dK/du, dK/dv */
+  vpf ulo = inf, vlo = inf, sulo = inf, svlo = inf, uhi = ninf, vhi = ninf, suhi = ninf, svhi = ninf;
+  for (int c = 0; c < p->nchunks; c++) {
+    if (!p->valid[c]) continue;
+    const int i = 16 * c;
+    const vpm m = vpm_bits_to(p->valid[c]);
+    vpf rk = vp_div(vp(1.0f), vp_abs(vp_load(p->d[k] + i)));
+    vpf back = vp_sub(vp(knear), vp_mul(vp(sk), vp_load(p->o[k] + i)));
+    vpf su = vp_mul(vp_load(p->d[u] + i), rk), sv = vp_mul(vp_load(p->d[v] + i), rk);
+    vpf ou = vp_load(p->o[u] + i), ov = vp_load(p->o[v] + i), bu = vp_mul(back, su), bv = vp_mul(back, sv);
+    vpf pu = vp_add(ou, bu), pv = vp_add(ov, bv);
+    vpf eu = vp_select(vp_eq(bu, zero), zero, vp_mul(vp_add(vp_abs(ou), vp_abs(bu)), E));
+    vpf ev = vp_select(vp_eq(bv, zero), zero, vp_mul(vp_add(vp_abs(ov), vp_abs(bv)), E));
+    vpf esu = vp_mul(vp_abs(su), E), esv = vp_mul(vp_abs(sv), E);
+    ulo = vp_min(ulo, vp_select(m, vp_sub(pu, eu), inf)); uhi = vp_max(uhi, vp_select(m, vp_add(pu, eu), ninf));
+    vlo = vp_min(vlo, vp_select(m, vp_sub(pv, ev), inf)); vhi = vp_max(vhi, vp_select(m, vp_add(pv, ev), ninf));
+    sulo = vp_min(sulo, vp_select(m, vp_sub(su, esu), inf)); suhi = vp_max(suhi, vp_select(m, vp_add(su, esu), ninf));
+    svlo = vp_min(svlo, vp_select(m, vp_sub(sv, esv), inf)); svhi = vp_max(svhi, vp_select(m, vp_add(sv, esv), ninf));
+  }
+  const float f[8] = {vp_reduce_min(ulo), vp_reduce_max(uhi), vp_reduce_min(vlo), vp_reduce_max(vhi),
+                      vp_reduce_min(sulo), vp_reduce_max(suhi), vp_reduce_min(svlo), vp_reduce_max(svhi)};
+  if (!isfinite(knear) || isnan(kfar)) return;
+  for (int j = 0; j < 8; j++)
+    if (!isfinite(f[j])) return;
+  b->has_planes = 1;
+  b->k = k; b->u = u; b->v = v;
+  b->sk = sk;
+  b->knear = knear; b->kfar = kfar;
+  b->ulo = f[0]; b->uhi = f[1]; b->vlo = f[2]; b->vhi = f[3];
+  b->sulo = f[4]; b->suhi = f[5]; b->svlo = f[6]; b->svhi = f[7];
+  b->scale = fr_pb_max(b->scale, fabsf(knear));
+}
+
 static void setup(state *S, fr_lpacket *p, const fr_lp_opts *opt) {
   S->p = p;
   S->opt = opt;
@@ -206,12 +295,8 @@ static void setup(state *S, fr_lpacket *p, const fr_lp_opts *opt) {
     }
   }
   for (int a = 0; a < 3; a++) S->dmean[a] = (float)sum[a];
-  if (opt->cull == FR_CULL_IA) {
-    ia_bounds(p);
-  } else if (opt->cull != FR_CULL_OFF) {
-    fr_ray_soa soa = {{p->o[0], p->o[1], p->o[2]}, {p->d[0], p->d[1], p->d[2]}, p->tnear, p->tfar, p->valid, p->n};
-    fr_pbounds_build(&p->bounds, &soa);
-  }
+  if (opt->cull == FR_CULL_IA) ia_bounds(p);
+  else if (opt->cull != FR_CULL_OFF) plane_bounds(p);
 }
 
 /* Whether the whole packet misses box k of node n by its bounds. */
@@ -226,7 +311,8 @@ static int cull_box(const state *S, const fr_bvh2_node *n, int k) {
  * box; fills the child set in *out. 0 when no chunk is left. The packet's
  * bounds are tried only once the first chunk tested has missed (Overbeck's
  * order): where a ray of it hits, which is most boxes a coherent packet
- * visits, the cull could not have helped and costs nothing. */
+ * visits, the cull could not have helped and costs nothing. Nor is it
+ * tried when no chunk is left to test after the one that missed. */
 FR_INLINE int narrow(state *S, const entry *e, entry *out) {
   fr_lpacket *p = S->p;
   const fr_bvh2_node *n = e->parent;
@@ -246,7 +332,7 @@ FR_INLINE int narrow(state *S, const entry *e, entry *out) {
       unsigned m = in[c] & p->alive[c];
       if (m) {
         m &= box16(p, c, n, k);
-        if (!tested++ && !m && cull && cull_box(S, n, k)) return 0;
+        if (!tested++ && !m && cull && c + 1 < p->nchunks && cull_box(S, n, k)) return 0;
       }
       mo[c] = (uint16_t)m;
       any |= m;
@@ -259,7 +345,7 @@ FR_INLINE int narrow(state *S, const entry *e, entry *out) {
     for (int c = e->a; c <= e->b; c++) {
       if (!p->alive[c]) continue;
       if (box16(p, c, n, k) & p->alive[c]) { first = c; break; }
-      if (!tested++ && cull && cull_box(S, n, k)) return 0;
+      if (!tested++ && cull && c < e->b && cull_box(S, n, k)) return 0;
     }
     if (first < 0) return 0;
     for (int c = e->b; c > first; c--)
@@ -277,7 +363,7 @@ FR_INLINE int narrow(state *S, const entry *e, entry *out) {
       if (box16(p, c, n, k) & p->alive[c]) {
         l[j] = l[hit];
         l[hit++] = (uint8_t)c;
-      } else if (!tested++ && !hit && cull && cull_box(S, n, k)) return 0;
+      } else if (!tested++ && !hit && cull && j + 1 < e->a && cull_box(S, n, k)) return 0;
     }
     out->a = hit;
     return hit > 0;
@@ -296,14 +382,15 @@ static void leaf(state *S, const entry *e, int closest) {
     const fr_bvh2_tri *r = b->spheres ? NULL : &b->tris[first + j];
     const fr_sphere *sp = b->spheres ? &b->spheres[first + j] : NULL;
     FR_COUNT(lp_tris, 1);
-    if (S->opt->cull != FR_CULL_OFF &&
+    int nc = S->opt->traversal == FR_LP_RANGED ? e->b - e->a + 1 : S->opt->traversal == FR_LP_PARTITION ? e->a : p->nchunks;
+    /* the cull pays only where it may save more than one chunk's test */
+    if (S->opt->cull != FR_CULL_OFF && nc >= TRI_CULL_MIN_CHUNKS &&
         (sp ? fr_pbounds_cull_sphere(&p->bounds, S->opt->cull, sp->c, sp->r)
             : fr_pbounds_cull_tri(&p->bounds, S->opt->cull, r->v0, r->v1, r->v2))) {
       if (sp) FR_COUNT(lp_sph_culled, 1);
       else FR_COUNT(lp_tri_culled, 1);
       continue;
     }
-    int nc = S->opt->traversal == FR_LP_RANGED ? e->b - e->a + 1 : S->opt->traversal == FR_LP_PARTITION ? e->a : p->nchunks;
     edges16 ed;
     int have_edges = 0;
     for (int jc = 0; jc < nc; jc++) {
@@ -398,4 +485,10 @@ static void traverse(const fr_lp_scene *g, const fr_lp_opts *opt, fr_lpacket *p,
 static void lp_intersect(const fr_lp_scene *g, const fr_lp_opts *opt, fr_lpacket *p) { traverse(g, opt, p, 1); }
 static void lp_occluded(const fr_lp_scene *g, const fr_lp_opts *opt, fr_lpacket *p) { traverse(g, opt, p, 0); }
 
-const fr_lp_fns FR_ISA_FN(fr_lp) = {lp_intersect, lp_occluded};
+/* The packet's bounds as the traversal makes them for opt->cull (tests). */
+static void lp_bounds(const fr_lp_opts *opt, fr_lpacket *p) {
+  state S;
+  setup(&S, p, opt);
+}
+
+const fr_lp_fns FR_ISA_FN(fr_lp) = {lp_intersect, lp_occluded, lp_bounds};

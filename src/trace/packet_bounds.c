@@ -137,19 +137,29 @@ static void from_kuv(const fr_pbounds *b, double K, double u, double v, double p
   p[b->v] = v;
 }
 
-/* all points outside one of the six planes of the packet volume */
-static int points_outside_planes(const fr_pbounds *b, const kuv *p, int n, double tol) {
-  int out[6] = {1, 1, 1, 1, 1, 1};
-  for (int i = 0; i < n; i++) {
-    double dK = p[i].K - b->knear;
-    out[0] &= dK < -tol;
-    out[1] &= p[i].K > b->kfar + tol;
-    out[2] &= p[i].u > b->uhi + b->suhi * dK + tol;
-    out[3] &= p[i].u < b->ulo + b->sulo * dK - tol;
-    out[4] &= p[i].v > b->vhi + b->svhi * dK + tol;
-    out[5] &= p[i].v < b->vlo + b->svlo * dK - tol;
+static float absf_max4(float a, float b, float c, float d) {
+  return fr_pb_max(fr_pb_max(fabsf(a), fabsf(b)), fr_pb_max(fabsf(c), fabsf(d)));
+}
+
+/* All three corners outside one of the six planes of the packet volume,
+ * in float: the test runs once per triangle a packet reaches, where double
+ * conversions cost more than it saved. Each side's float rounding is below 2^-20 of the magnitudes it is
+ * made of (the coordinates, the slopes times them, the plane offsets),
+ * which is added to the slack. */
+static int tri_outside_planes(const fr_pbounds *b, const float *const v[3]) {
+  float mag = 0.0f;
+  for (int i = 0; i < 3; i++)
+    for (int a = 0; a < 3; a++) mag = fr_pb_max(mag, fabsf(v[i][a]));
+  const float reach = b->scale + mag, slope = 1.0f + absf_max4(b->sulo, b->suhi, b->svlo, b->svhi);
+  const float tol = FR_PBOUNDS_SLACK * reach + 0x1p-20f * (slope * reach + absf_max4(b->ulo, b->uhi, b->vlo, b->vhi));
+  unsigned out = 0x3f;
+  for (int i = 0; i < 3; i++) {
+    const float K = b->sk * v[i][b->k], dK = K - b->knear, u = v[i][b->u], w = v[i][b->v];
+    out &= (unsigned)(dK < -tol) | (unsigned)(K > b->kfar + tol) << 1 | (unsigned)(u > b->uhi + b->suhi * dK + tol) << 2 |
+           (unsigned)(u < b->ulo + b->sulo * dK - tol) << 3 | (unsigned)(w > b->vhi + b->svhi * dK + tol) << 4 |
+           (unsigned)(w < b->vlo + b->svlo * dK - tol) << 5;
   }
-  return out[0] | out[1] | out[2] | out[3] | out[4] | out[5];
+  return out != 0;
 }
 
 static double dot3d(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -244,19 +254,16 @@ int fr_pbounds_cull_tri(const fr_pbounds *b, fr_cull c, const float v0[3], const
     }
     return fr_pbounds_cull_box(b, FR_CULL_IA, lo, hi);
   }
-  double V[3][3], lo[3], hi[3], mag = 0.0;
-  const float *src[3] = {v0, v1, v2};
-  for (int i = 0; i < 3; i++)
-    for (int a = 0; a < 3; a++) V[i][a] = src[i][a];
-  for (int a = 0; a < 3; a++) {
-    lo[a] = dmin(V[0][a], dmin(V[1][a], V[2][a]));
-    hi[a] = dmax(V[0][a], dmax(V[1][a], V[2][a]));
-    mag = dmax(mag, dmax(fabs(lo[a]), fabs(hi[a])));
-  }
-  double tol = SLACK * (b->scale + mag);
-  kuv p[3] = {to_kuv(b, V[0]), to_kuv(b, V[1]), to_kuv(b, V[2])};
-  if (points_outside_planes(b, p, 3, tol)) return 1;
+  const float *const src[3] = {v0, v1, v2};
+  if (tri_outside_planes(b, src)) return 1;
   if (c != FR_CULL_CORNERS) return 0;
+  double V[3][3], mag = 0.0;
+  for (int i = 0; i < 3; i++)
+    for (int a = 0; a < 3; a++) {
+      V[i][a] = src[i][a];
+      mag = dmax(mag, fabs(V[i][a]));
+    }
+  double tol = SLACK * (b->scale + mag);
   double e1[3], e2[3], n[3];
   for (int a = 0; a < 3; a++) { e1[a] = V[1][a] - V[0][a]; e2[a] = V[2][a] - V[0][a]; }
   cross3d(e1, e2, n);
