@@ -229,7 +229,7 @@ static void plane_bounds(fr_lpacket *p) {
    * corner-ray edge test (fr_pbounds_cull_tri) takes it for. */
   const float knear = b->shared_origin && b->tmin >= 0.0f ? sk * b->olo[k] : vp_reduce_min(kn);
   const float kfar = vp_reduce_max(kf);
-  /* each ray's u, v where it crosses K = knear, and its slopes dK/du, dK/dv */
+  /* each ray's u, v where it crosses K = knear, and its slopes du/dK, dv/dK */
   vpf ulo = inf, vlo = inf, sulo = inf, svlo = inf, uhi = ninf, vhi = ninf, suhi = ninf, svhi = ninf;
   for (int c = 0; c < p->nchunks; c++) {
     if (!p->valid[c]) continue;

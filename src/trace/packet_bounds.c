@@ -143,9 +143,9 @@ static float absf_max4(float a, float b, float c, float d) {
 
 /* All three corners outside one of the six planes of the packet volume,
  * in float: the test runs once per triangle a packet reaches, where double
- * conversions cost more than it saved. Each side's float rounding is below 2^-20 of the magnitudes it is
- * made of (the coordinates, the slopes times them, the plane offsets),
- * which is added to the slack. */
+ * conversions cost more than it saved. Each side's float rounding is below
+ * 2^-20 of the magnitudes it is made of (the coordinates, the slopes times
+ * them, the plane offsets), which is added to the slack. */
 static int tri_outside_planes(const fr_pbounds *b, const float *const v[3]) {
   float mag = 0.0f;
   for (int i = 0; i < 3; i++)
