@@ -22,11 +22,12 @@
  *
  * The tests are conservative: a cull never rejects what one of the rays
  * hits, with slack for the rays' own float rounding (tests/test_cull.c
- * checks this on millions of random packets). The bounds are made in
- * double, once per packet, and each test is a few dozen flops; the large
- * packets make their interval-arithmetic bounds themselves, in float from
- * the rays' own values (trace/lpacket_traverse.c), and the IA triangle cull
- * needs no double either.
+ * checks this on millions of random packets). fr_pbounds_build makes the
+ * bounds in double, once per packet; the large packets make theirs
+ * themselves, 16 lanes at a time in float, each bound pushed outward by its
+ * own rounding error (trace/lpacket_traverse.c; test_cull checks both).
+ * The box tests and the triangle plane test run in float, with that
+ * rounding inside their slack; the corner-ray triangle tests in double.
  */
 #ifndef FR_TRACE_PACKET_BOUNDS_H
 #define FR_TRACE_PACKET_BOUNDS_H
@@ -44,7 +45,7 @@ const char *fr_cull_name(fr_cull c);
 int fr_cull_parse(const char *name, fr_cull *out);
 
 /* Stored in float, every bound rounded outward, so the box test is a few
- * float operations inline in the traversal (made in double first). */
+ * float operations inline in the traversal.
 typedef struct fr_pbounds {
   int empty;                  /* no valid rays */
   /* interval arithmetic */
