@@ -45,7 +45,7 @@ const char *fr_cull_name(fr_cull c);
 int fr_cull_parse(const char *name, fr_cull *out);
 
 /* Stored in float, every bound rounded outward, so the box test is a few
- * float operations inline in the traversal.
+ * float operations inline in the traversal. */
 typedef struct fr_pbounds {
   int empty;                  /* no valid rays */
   /* interval arithmetic */
