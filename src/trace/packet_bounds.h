@@ -73,8 +73,8 @@ typedef struct fr_ray_soa {
   int n;
 } fr_ray_soa;
 
-/* The bounds in double, rounded outward: the reference test_cull checks
- * the large packets' own float bounds beside (they make theirs themselves). */
+/* The bounds in double, rounded outward. The large packets make their own
+ * in float (trace/lpacket_traverse.c); test_cull checks both. */
 void fr_pbounds_build(fr_pbounds *b, const fr_ray_soa *r);
 
 /* 1 when no ray of the packet can hit the box, triangle or sphere. */
