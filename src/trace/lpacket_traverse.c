@@ -386,13 +386,14 @@ static void leaf(state *S, const entry *e, int closest) {
   const fr_bvh2 *b = S->b;
   uint32_t ref = e->ref, first = ref & FR_BVH2_FIRST_MASK, count = (ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
   FR_COUNT(lp_leaves, 1);
+  const int nc = S->opt->traversal == FR_LP_RANGED ? e->b - e->a + 1 : S->opt->traversal == FR_LP_PARTITION ? e->a : p->nchunks;
+  /* the cull pays only where it may save more than one chunk's test */
+  const int cull = S->opt->cull != FR_CULL_OFF && nc >= TRI_CULL_MIN_CHUNKS;
   for (uint32_t j = 0; j < count; j++) {
     const fr_bvh2_tri *r = b->spheres ? NULL : &b->tris[first + j];
     const fr_sphere *sp = b->spheres ? &b->spheres[first + j] : NULL;
     FR_COUNT(lp_tris, 1);
-    int nc = S->opt->traversal == FR_LP_RANGED ? e->b - e->a + 1 : S->opt->traversal == FR_LP_PARTITION ? e->a : p->nchunks;
-    /* the cull pays only where it may save more than one chunk's test */
-    if (S->opt->cull != FR_CULL_OFF && nc >= TRI_CULL_MIN_CHUNKS &&
+    if (cull &&
         (sp ? fr_pbounds_cull_sphere(&p->bounds, S->opt->cull, sp->c, sp->r)
             : fr_pbounds_cull_tri(&p->bounds, S->opt->cull, r->v0, r->v1, r->v2))) {
       if (sp) FR_COUNT(lp_sph_culled, 1);
