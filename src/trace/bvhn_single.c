@@ -6,89 +6,8 @@
  * (FR_WIDTH) through base/simd.h.
  */
 #include "base/simd.h"
-#include "trace/bvhn_ray.h"
-#include "trace/child_sort8.h"
+#include "trace/bvhn_single.h"
 #include "trace/kernels.h"
-
-typedef struct entry { uint32_t ref; float dist; } entry;
-
-/* Pushes the hit children farthest first and returns the nearest. */
-#if defined(FR_HAVE_CHILD_SORT8) && FR_WIDTH == 8
-#define STACK_SLACK W /* the network stores all eight entries */
-FR_INLINE uint32_t order_children(const node_t *n, int mask, vnode tn, entry *stack, int *spp) {
-  if (!(mask & (mask - 1))) return n->child[__builtin_ctz((unsigned)mask)];
-  uint32_t nearest = fr_child_sort8(n->child, mask, tn.v, stack + *spp);
-  *spp += __builtin_popcount((unsigned)mask) - 1;
-  return nearest;
-}
-#else
-/* Three or more are insertion-sorted straight into the stack (building a
- * local array and copying it over cost ~15% of a diffuse ray's
- * instructions). */
-#define STACK_SLACK 0
-FR_INLINE uint32_t order_children(const node_t *n, int mask, vnode tn, entry *stack, int *spp) {
-  float dist[W] __attribute__((aligned(32)));
-  VN_STORE(dist, tn);
-  int i0 = __builtin_ctz(mask);
-  int rest = mask & (mask - 1);
-  if (!rest) return n->child[i0];
-  int i1 = __builtin_ctz(rest);
-  int sp = *spp;
-  if (!(rest & (rest - 1))) {
-    if (dist[i1] < dist[i0]) { int t = i0; i0 = i1; i1 = t; }
-    stack[sp] = (entry){n->child[i1], dist[i1]};
-    *spp = sp + 1;
-    return n->child[i0];
-  }
-  entry *e = stack + sp;
-  int k = 0;
-  for (; mask; mask &= mask - 1) { /* in slot order; ties keep it */
-    int i = __builtin_ctz(mask);
-    entry x = {n->child[i], dist[i]};
-    int j = k++ - 1;
-    while (j >= 0 && e[j].dist < x.dist) { e[j + 1] = e[j]; j--; }
-    e[j + 1] = x;
-  }
-  *spp = sp + k - 1; /* the nearest, last, is not pushed but returned */
-  return e[k - 1].ref;
-}
-#endif
-
-/* Closest hit in the subtree at root before *tfar; fills *best on a hit. */
-FR_INLINE int closest(const fr_bvhn *b, const ray_pre *rp, uint32_t root, float tfar, fr_subtree_hit *best) {
-  entry stack[STACK_SIZE + STACK_SLACK];
-  int sp = 0, found = 0;
-  stack[sp++] = (entry){root, -INFINITY};
-  while (sp) {
-    entry top = stack[--sp];
-    if (top.dist > tfar * ROUND_UP) continue;
-    uint32_t ref = top.ref;
-    while (!(ref & FR_BVHN_LEAF)) {
-      const node_t *n = (const node_t *)b->nodes + ref;
-      int mask;
-      vnode tn = visit_node(n, rp, tfar, &mask);
-      if (!mask) goto next;
-      int sp0 = sp;
-      ref = order_children(n, mask, tn, stack, &sp);
-      if (b->prefetch)
-        for (int i = sp0; i < sp; i++) prefetch_ref(b, stack[i].ref);
-    }
-    {
-      const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
-      FR_COUNT(leaves, 1);
-      FR_COUNT(tri_tests, 4 * nb);
-      for (uint32_t k = first; k < first + nb; k++) {
-        tri4_result res;
-        tri4_test(&b->tris[k], rp, tfar, &res);
-        if (!res.mask) continue;
-        tfar = tri4_nearest(&res, k, best);
-        found = 1;
-      }
-    }
-  next:;
-  }
-  return found;
-}
 
 static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
   fr_hit_miss(hit);
@@ -105,47 +24,6 @@ static int intersect_subtree(const fr_bvhn *b, uint32_t ref, const fr_ray *ray, 
   ray_pre r;
   ray_setup(&r, ray);
   return closest(b, &r, ref, ray->tfar, best);
-}
-
-FR_INLINE int any_hit(const fr_bvhn *b, const ray_pre *rp, uint32_t root, const float tfar) {
-  entry stack[STACK_SIZE];
-  int sp = 0;
-  stack[sp++] = (entry){root, -INFINITY};
-  while (sp) {
-    uint32_t ref = stack[--sp].ref;
-    while (!(ref & FR_BVHN_LEAF)) {
-      const node_t *n = (const node_t *)b->nodes + ref;
-      int mask;
-      (void)visit_node(n, rp, tfar, &mask);
-      if (!mask) goto next;
-      /* Any hit ends the search, so no sorting: descend into the last hit
-       * slot, push the others. Last-first is not arbitrary: the collapse puts
-       * the left child of the original split in slot 0, and going there first
-       * measured up to 2x slower for hemisphere rays leaving a surface
-       * (kitchen ao16: 7.9 -> 13.0 Mrays/s); nearest-first was no faster. */
-      {
-        int last = 31 - __builtin_clz((unsigned)mask);
-        ref = n->child[last];
-        for (int m = mask & ~(1 << last); m; m &= m - 1) {
-          uint32_t c = n->child[__builtin_ctz(m)];
-          if (b->prefetch) prefetch_ref(b, c);
-          stack[sp++] = (entry){c, 0.0f};
-        }
-      }
-    }
-    {
-      const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
-      FR_COUNT(leaves, 1);
-      for (uint32_t k = first; k < first + nb; k++) {
-        FR_COUNT(tri_tests, 4);
-        tri4_result res;
-        tri4_test(&b->tris[k], rp, tfar, &res);
-        if (res.mask) return 1;
-      }
-    }
-  next:;
-  }
-  return 0;
 }
 
 static int occluded1(const fr_bvhn *b, const fr_ray *ray) {
