@@ -106,13 +106,32 @@ static void cross_d(const double a[3], const double b[3], double out[3]) {
 unsigned FR_ISA_FN(fr_mft_from_rays)(fr_mft_batch *b, fr_mft_sets *t, const fr_ray *rays, size_t n) {
   memset(b, 0, sizeof *b);
   if (n > FR_MFT_FRUSTA * FR_MFT_RAYS) n = FR_MFT_FRUSTA * FR_MFT_RAYS;
-  /* the axis: the mean direction, in double (unit directions, for the renderers' rays) */
-  double m[3] = {0.0, 0.0, 0.0};
-  for (size_t i = 0; i < n; i++) {
-    const float *d = rays[i].dir;
-    if (fabsf(d[0]) < INFINITY && fabsf(d[1]) < INFINITY && fabsf(d[2]) < INFINITY) /* one NaN spoils no batch */
-      for (int a = 0; a < 3; a++) m[a] += d[a];
+  /* The axis: the mean direction (unit directions, for the renderers' rays).
+   * Sixteen running sums, ray i in sum i % 16, then those in double in lane
+   * order: the same additions on every ISA, so the same frusta, at a tenth
+   * of the time of a scalar sum in double (which was 2% of museum's Whitted
+   * frame). A non-finite direction is left out: one NaN spoils no batch. */
+  float sum[3][FR_MFT_RAYS] __attribute__((aligned(64)));
+  {
+    vpf acc[3] = {vp(0.0f), vp(0.0f), vp(0.0f)};
+    size_t i = 0;
+    for (; i + FR_MFT_RAYS <= n; i += FR_MFT_RAYS) {
+      vpf x[8];
+      vp_load_records8((const float *)(rays + i), x);
+      const vpf inf = vp(INFINITY);
+      vpm fin = vpm_and(vp_lt(vp_abs(x[4]), inf), vpm_and(vp_lt(vp_abs(x[5]), inf), vp_lt(vp_abs(x[6]), inf)));
+      for (int a = 0; a < 3; a++) acc[a] = vp_add(acc[a], vp_select(fin, x[4 + a], vp(0.0f)));
+    }
+    for (int a = 0; a < 3; a++) vp_store(sum[a], acc[a]);
+    for (; i < n; i++) {
+      const float *d = rays[i].dir;
+      if (fabsf(d[0]) < INFINITY && fabsf(d[1]) < INFINITY && fabsf(d[2]) < INFINITY)
+        for (int a = 0; a < 3; a++) sum[a][i % FR_MFT_RAYS] += d[a];
+    }
   }
+  double m[3] = {0.0, 0.0, 0.0};
+  for (int a = 0; a < 3; a++)
+    for (int k = 0; k < FR_MFT_RAYS; k++) m[a] += sum[a][k];
   double ml = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
   int ok_axis = ml > 0.0 && ml < INFINITY;
   frame F;
