@@ -59,12 +59,20 @@ FR_INLINE vmask4 vm4_and(vmask4 a, vmask4 b) { vmask4 r = {(__mmask8)(a.m & b.m)
 FR_INLINE vmask4 vm4_or(vmask4 a, vmask4 b) { vmask4 r = {(__mmask8)(a.m | b.m)}; return r; }
 FR_INLINE int vm4_bits(vmask4 a) { return a.m & 0xF; }
 FR_INLINE vfloat4 vf4_select(vmask4 m, vfloat4 t, vfloat4 f) { vfloat4 r = {_mm_mask_blend_ps(m.m, f.v, t.v)}; return r; }
+/* a + b in the lanes set in `lanes` (bit i: lane i), a in the others */
+FR_INLINE vfloat4 vf4_add_where(vfloat4 a, int lanes, vfloat4 b) { vfloat4 r = {_mm_mask_add_ps(a.v, (__mmask8)lanes, a.v, b.v)}; return r; }
 #else
 #define FR_CMP4(a, b, op) { _mm_cmp_ps((a).v, (b).v, op) }
 FR_INLINE vmask4 vm4_and(vmask4 a, vmask4 b) { vmask4 r = {_mm_and_ps(a.m, b.m)}; return r; }
 FR_INLINE vmask4 vm4_or(vmask4 a, vmask4 b) { vmask4 r = {_mm_or_ps(a.m, b.m)}; return r; }
 FR_INLINE int vm4_bits(vmask4 a) { return _mm_movemask_ps(a.m); }
 FR_INLINE vfloat4 vf4_select(vmask4 m, vfloat4 t, vfloat4 f) { vfloat4 r = {_mm_blendv_ps(f.v, t.v, m.m)}; return r; }
+FR_INLINE vfloat4 vf4_add_where(vfloat4 a, int lanes, vfloat4 b) {
+  const __m128i bit = _mm_setr_epi32(1, 2, 4, 8);
+  __m128 sel = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(lanes), bit), bit));
+  vfloat4 r = {_mm_add_ps(a.v, _mm_and_ps(sel, b.v))}; /* b's other lanes may be inf or NaN: and them away */
+  return r;
+}
 #endif
 FR_INLINE vmask4 vf4_lt(vfloat4 a, vfloat4 b) { vmask4 r = FR_CMP4(a, b, _CMP_LT_OQ); return r; }
 FR_INLINE vmask4 vf4_le(vfloat4 a, vfloat4 b) { vmask4 r = FR_CMP4(a, b, _CMP_LE_OQ); return r; }
@@ -83,10 +91,18 @@ FR_INLINE vfloat8 vf8_sub(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_sub_ps(a.v
 FR_INLINE vfloat8 vf8_mul(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_mul_ps(a.v, b.v)}; return r; }
 FR_INLINE vfloat8 vf8_min(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_min_ps(a.v, b.v)}; return r; }
 FR_INLINE vfloat8 vf8_max(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_max_ps(a.v, b.v)}; return r; }
+FR_INLINE vfloat8 vf8_div(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_div_ps(a.v, b.v)}; return r; }
 #if defined(FR_BUILD_ISA_AVX512)
 FR_INLINE int vf8_le_bits(vfloat8 a, vfloat8 b) { return _mm256_cmp_ps_mask(a.v, b.v, _CMP_LE_OQ); }
+FR_INLINE vfloat8 vf8_add_where(vfloat8 a, int lanes, vfloat8 b) { vfloat8 r = {_mm256_mask_add_ps(a.v, (__mmask8)lanes, a.v, b.v)}; return r; }
 #else
 FR_INLINE int vf8_le_bits(vfloat8 a, vfloat8 b) { return _mm256_movemask_ps(_mm256_cmp_ps(a.v, b.v, _CMP_LE_OQ)); }
+FR_INLINE vfloat8 vf8_add_where(vfloat8 a, int lanes, vfloat8 b) {
+  const __m256i bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+  __m256 sel = _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(lanes), bit), bit));
+  vfloat8 r = {_mm256_add_ps(a.v, _mm256_and_ps(sel, b.v))};
+  return r;
+}
 #endif
 
 /* eight 64-bit sets, one per child of a node: which rays of a stream hit it */
@@ -144,6 +160,7 @@ FR_INLINE vmask4 vm4_and(vmask4 a, vmask4 b) { vmask4 r = {a.m & b.m}; return r;
 FR_INLINE vmask4 vm4_or(vmask4 a, vmask4 b) { vmask4 r = {a.m | b.m}; return r; }
 FR_INLINE int vm4_bits(vmask4 a) { return (int)a.m; }
 FR_INLINE vfloat4 vf4_select(vmask4 m, vfloat4 t, vfloat4 f) FR_LANES4(((m.m >> i) & 1) ? t.f[i] : f.f[i])
+FR_INLINE vfloat4 vf4_add_where(vfloat4 a, int lanes, vfloat4 b) FR_LANES4(((lanes >> i) & 1) ? a.f[i] + b.f[i] : a.f[i])
 
 typedef struct vfloat8 { float f[8]; } vfloat8;
 #define FR_LANES8(expr) { vfloat8 r; for (int i = 0; i < 8; i++) r.f[i] = (expr); return r; }
@@ -155,6 +172,8 @@ FR_INLINE vfloat8 vf8_mul(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] * b.f[i])
 FR_INLINE vfloat8 vf8_min(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] < b.f[i] ? a.f[i] : b.f[i])
 FR_INLINE vfloat8 vf8_max(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] > b.f[i] ? a.f[i] : b.f[i])
 FR_INLINE int vf8_le_bits(vfloat8 a, vfloat8 b) { int m = 0; for (int i = 0; i < 8; i++) m |= (a.f[i] <= b.f[i]) << i; return m; }
+FR_INLINE vfloat8 vf8_div(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] / b.f[i])
+FR_INLINE vfloat8 vf8_add_where(vfloat8 a, int lanes, vfloat8 b) FR_LANES8(((lanes >> i) & 1) ? a.f[i] + b.f[i] : a.f[i])
 
 typedef struct vbits8 { uint64_t u[8]; } vbits8;
 FR_INLINE vbits8 vb8_zero(void) { vbits8 r = {{0}}; return r; }

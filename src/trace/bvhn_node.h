@@ -32,6 +32,8 @@ typedef vfloat8 vnode;
 #define VN_MIN vf8_min
 #define VN_MAX vf8_max
 #define VN_LE_BITS vf8_le_bits
+#define VN_DIV vf8_div
+#define VN_ADD_WHERE vf8_add_where
 #else
 typedef fr_bvh4_node node_t;
 typedef vfloat4 vnode;
@@ -43,6 +45,8 @@ typedef vfloat4 vnode;
 #define VN_MIN vf4_min
 #define VN_MAX vf4_max
 #define VN_LE_BITS(a, b) vm4_bits(vf4_le(a, b))
+#define VN_DIV vf4_div
+#define VN_ADD_WHERE vf4_add_where
 #endif
 #define W FR_WIDTH
 
