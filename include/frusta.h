@@ -197,7 +197,7 @@ unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays);
  * n independent rays. In FR_TRACE_AUTO mode the rays are sorted by direction
  * octant (in chunks of 1024, keeping their order within an octant) and each
  * group of 16 whose directions are coherent (stream_spread) is traced as a
- * hybrid packet; the other rays of the octant go as ray streams of up to 64.
+ * hybrid packet (coherent_threshold); the other rays of the octant go as ray streams of up to 64.
  * Order rays so that neighbours are coherent to profit (for example, pixels
  * in 4x4 blocks). The other modes trace consecutive rays together, unsorted. */
 void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n);
@@ -228,6 +228,9 @@ typedef struct fr_trace_options {
                              lie within this distance of its first ray's (probed at 3 rays), else
                              in a ray stream; 0..2: 0 streams every group, 2 none (default
                              FR_STREAM_SPREAD_DEFAULT) */
+  int coherent_threshold; /* FR_TRACE_AUTO: its coherent groups are hybrid packets that drop to
+                             single rays at this many active rays, 0..16 (default 2, as Embree's
+                             coherent packets; hybrid_threshold is FR_TRACE_HYBRID16's) */
 } fr_trace_options;
 #define FR_STREAM_SPREAD_DEFAULT 0.1f
 

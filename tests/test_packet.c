@@ -356,6 +356,12 @@ static void test_options(void **st) {
   assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
   o.stream_spread = 0.0f;
   assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+  assert_int_equal(o.coherent_threshold, 2);
+  o.coherent_threshold = -1;
+  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  o.coherent_threshold = 17;
+  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  o.coherent_threshold = 2;
   /* an uncommitted scene: misses, nothing occluded */
   fr_ray16 r16;
   memset(&r16, 0, sizeof r16);

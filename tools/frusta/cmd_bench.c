@@ -169,7 +169,8 @@ int cmd_bench(int argc, char **argv) {
     if (!strcmp(a, "--threshold") || !strcmp(a, "--mailbox") || !strcmp(a, "--axis-aligned") || !strcmp(a, "--ia") ||
         !strcmp(a, "--packet-width") || !strcmp(a, "--corner-rays") || !strcmp(a, "--shrink") || !strcmp(a, "--mft-leaf") ||
         !strcmp(a, "--corner-cost") || !strcmp(a, "--mft-fallback") ||
-        !strcmp(a, "--light-sets") || !strcmp(a, "--prefetch") || !strcmp(a, "--stream-spread")) {
+        !strcmp(a, "--light-sets") || !strcmp(a, "--prefetch") || !strcmp(a, "--stream-spread") ||
+        !strcmp(a, "--coherent-threshold")) {
       if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
       const char *val = argv[++i];
       if (!strcmp(a, "--light-sets")) {
@@ -204,6 +205,9 @@ int cmd_bench(int argc, char **argv) {
           return cli_error(CLI_USAGE_ERROR, "--stream-spread wants 0..2, got '%s'", val);
       } else if (!strcmp(a, "--threshold")) {
         if (!cli_parse_int(val, 0, 16, &topt.hybrid_threshold)) return cli_error(CLI_USAGE_ERROR, "--threshold wants 0..16, got '%s'", val);
+      } else if (!strcmp(a, "--coherent-threshold")) {
+        if (!cli_parse_int(val, 0, 16, &topt.coherent_threshold))
+          return cli_error(CLI_USAGE_ERROR, "--coherent-threshold wants 0..16, got '%s'", val);
       } else if (!strcmp(a, "--packet-width")) {
         if (!cli_parse_int(val, 4, 8, &topt.packet_bvh_width) || (topt.packet_bvh_width != 4 && topt.packet_bvh_width != 8))
           return cli_error(CLI_USAGE_ERROR, "--packet-width is 4 or 8, not '%s'", val);

@@ -22,7 +22,7 @@ static void usage(FILE *f) {
           "         embree modes: single packet4 packet8 packet16 stream\n"
           "         packets:      [--threshold N] [--packet-width 4|8] [--mailbox on|off] [--axis-aligned on|off]\n"
           "                       [--ia on|off]\n"
-          "         auto:         [--stream-spread S]\n"
+          "         auto:         [--stream-spread S] [--coherent-threshold N]\n"
           "         single rays:  [--prefetch on|off|auto]\n"
           "         multi-frusta: [--light-sets spread|cells] [--corner-rays on|off] [--corner-cost C]\n"
           "                       [--shrink on|corners|off] [--mft-leaf N] [--mft-fallback on|off]\n"
