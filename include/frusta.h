@@ -197,7 +197,8 @@ unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays);
  * n independent rays. In FR_TRACE_AUTO mode the rays are sorted by direction
  * octant (in chunks of 1024, keeping their order within an octant) and each
  * group of 16 whose directions are coherent (stream_spread) is traced as a
- * hybrid packet (coherent_threshold); the other rays of the octant go as ray streams of up to 64.
+ * hybrid packet (coherent_threshold); the other rays of the octant go as
+ * ray streams of up to 64.
  * Order rays so that neighbours are coherent to profit (for example, pixels
  * in 4x4 blocks). The other modes trace consecutive rays together, unsorted. */
 void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n);

@@ -2,8 +2,9 @@
  * The single-ray traversal loops over an N-wide BVH: closest hit (nearest
  * child first) and any hit (early exit) in one subtree, for a ray already
  * set up (ray_pre). The single-ray kernels (bvhn_single.c) run them from the
- * root; the ray streams (bvhn_stream.c) hand them a subtree once only one of
- * their rays is left in it. Include after base/simd.h with FR_WIDTH defined.
+ * root; the closest-hit ray streams (bvhn_stream.c) hand `closest` a subtree
+ * once only one of their rays is left in it. Include after base/simd.h with
+ * FR_WIDTH defined.
  */
 #ifndef FR_TRACE_BVHN_SINGLE_H
 #define FR_TRACE_BVHN_SINGLE_H
@@ -105,7 +106,9 @@ FR_INLINE int any_hit(const fr_bvhn *b, const ray_pre *rp, uint32_t root, const 
        * slot, push the others. Last-first is not arbitrary: the collapse puts
        * the left child of the original split in slot 0, and going there first
        * measured up to 2x slower for hemisphere rays leaving a surface
-       * (kitchen ao16: 7.9 -> 13.0 Mrays/s); nearest-first was no faster. */
+       * (kitchen ao16: 7.9 -> 13.0 Mrays/s). Nearest-first measured +21% on
+       * hairball soft16 but -30% on kitchen ao16, -18% on dragon soft16 and
+       * -9% on hairball shadow (README, Performance, session 37). */
       {
         int last = 31 - __builtin_clz((unsigned)mask);
         ref = n->child[last];
