@@ -31,6 +31,15 @@ typedef struct stream_entry { uint64_t rays; uint32_t ref; } stream_entry;
 /* ... and, for closest hits, a distance no ray enters it before */
 typedef struct dist_entry { uint64_t rays; uint32_t ref; float dist; } dist_entry;
 
+/* Closest hits: per child, the least entry distance of the rays tested and
+ * the sum and count of the entry distances of those that hit it. */
+typedef struct child_dists { vnode lo, sum, cnt; } child_dists;
+FR_INLINE void child_dists_add(child_dists *d, vnode tn, int bits) {
+  d->lo = VN_MIN(d->lo, tn);
+  d->sum = VN_ADD_WHERE(d->sum, bits, tn);
+  d->cnt = VN_ADD_WHERE(d->cnt, bits, VN(1.0f));
+}
+
 /* Tests the rays m against node n's boxes; *child_rays[c] gets those that
  * hit child c, the result the children some ray hit. With `uniform` every ray
  * has the first ray's direction signs, so the node's near and far planes are
@@ -44,18 +53,14 @@ FR_INLINE int stream_node(const node_t *n, const ray_pre *pre, const float *tfar
   FR_COUNT(nodes, (uint64_t)__builtin_popcountll(m));
   FR_COUNT(box_tests, (uint64_t)n->nchildren * (uint64_t)__builtin_popcountll(m));
   vbits8 acc = vb8_zero();
-  vnode lo = VN(INFINITY), sum = VN(0.0f), cnt = VN(0.0f);
+  child_dists dists = {VN(INFINITY), VN(0.0f), VN(0.0f)};
   int hit = 0;
   if (uniform) {
     const node_planes p = load_planes(n, &pre[__builtin_ctzll(m)]);
     for (; m; m &= m - 1) {
       int i = __builtin_ctzll(m), bits;
       vnode tn = planes_test(&p, &pre[i], tfar[i], &bits);
-      if (min_tn) {
-        lo = VN_MIN(lo, tn);
-        sum = VN_ADD_WHERE(sum, bits, tn);
-        cnt = VN_ADD_WHERE(cnt, bits, VN(1.0f));
-      }
+      if (min_tn) child_dists_add(&dists, tn, bits);
       hit |= bits;
       acc = vb8_or_where(acc, bits, 1ull << i);
     }
@@ -63,18 +68,14 @@ FR_INLINE int stream_node(const node_t *n, const ray_pre *pre, const float *tfar
     for (; m; m &= m - 1) {
       int i = __builtin_ctzll(m), bits;
       vnode tn = box_test(n, &pre[i], tfar[i], &bits);
-      if (min_tn) {
-        lo = VN_MIN(lo, tn);
-        sum = VN_ADD_WHERE(sum, bits, tn);
-        cnt = VN_ADD_WHERE(cnt, bits, VN(1.0f));
-      }
+      if (min_tn) child_dists_add(&dists, tn, bits);
       hit |= bits;
       acc = vb8_or_where(acc, bits, 1ull << i);
     }
   }
   if (min_tn) {
-    VN_STORE(min_tn, lo);
-    VN_STORE(mean_tn, VN_DIV(sum, cnt)); /* 0 / 0 in the children no ray hit: never read */
+    VN_STORE(min_tn, dists.lo);
+    VN_STORE(mean_tn, VN_DIV(dists.sum, dists.cnt)); /* 0 / 0 in the children no ray hit: never read */
   }
   vb8_store(child_rays, acc);
   return hit;
