@@ -194,9 +194,42 @@ static void test_add_where(void **st) {
   print_message("masked adds: %d lane sets\n", tested);
 }
 
+typedef void (*load_records_fn)(const float *, size_t, float (*)[16], float (*)[16]);
+void fr_test_load_records_scalar(const float *src, size_t stride, float (*out8)[16], float (*out4)[16]);
+void fr_test_load_records_avx2(const float *src, size_t stride, float (*out8)[16], float (*out4)[16]);
+void fr_test_load_records_avx512(const float *src, size_t stride, float (*out8)[16], float (*out4)[16]);
+
+/* The transposing record loads on every level move bits: field k of record
+ * i lands in lane i of output k, NaNs and all, at the strides the Whitted
+ * shading (12) and the packets (8) use. */
+static void test_load_records(void **st) {
+  (void)st;
+  const struct { fr_isa isa; load_records_fn fn; } levels[] = {{FR_ISA_SCALAR, fr_test_load_records_scalar},
+                                                               {FR_ISA_AVX2, fr_test_load_records_avx2},
+                                                               {FR_ISA_AVX512, fr_test_load_records_avx512}};
+  uint32_t src[12 * 16];
+  for (size_t i = 0; i < sizeof src / sizeof src[0]; i++) src[i] = 0x7FC00000u + (uint32_t)i; /* distinct NaNs */
+  int tested = 0;
+  for (size_t l = 0; l < sizeof levels / sizeof levels[0]; l++) {
+    if (!fr_isa_supported(levels[l].isa)) continue;
+    for (size_t stride = 8; stride <= 12; stride += 4) {
+      float out8[8][16], out4[4][16];
+      levels[l].fn((const float *)src, stride, out8, out4);
+      for (int i = 0; i < 16; i++) {
+        for (int k = 0; k < 8; k++) assert_memory_equal(&out8[k][i], &src[stride * (size_t)i + (size_t)k], 4);
+        for (int k = 0; k < 4; k++) assert_memory_equal(&out4[k][i], &src[4 * i + k], 4);
+      }
+      tested++;
+    }
+  }
+  assert_true(tested >= 2);
+  print_message("record loads: %d level/stride pairs\n", tested);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_add_where),
+      cmocka_unit_test(test_load_records),
       cmocka_unit_test(test_agreement),
       cmocka_unit_test(test_child_sort8),
       cmocka_unit_test(test_axis_aligned_fast_path),

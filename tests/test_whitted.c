@@ -259,9 +259,9 @@ static ref_lane ref_shade(const fr_wshade_in *in, const fr_whitted_mats *mats, i
   const fr_wray *g = &in->ray[lane];
   vec3 w = v3_load(g->w);
   if (!((in->hits >> lane) & 1)) { o.add = v3_scale(w, FR_WHITTED_BACKGROUND); return o; }
-  const fr_whitted_mat *m = &mats->mat[in->mat[lane]];
+  const fr_whitted_mat *m = &mats->mat[in->surf[lane].mat];
   vec3 d = v3_load(g->r.dir), p = v3_add(v3_load(g->r.org), v3_scale(d, in->hit[lane].t));
-  vec3 ng = v3_norm(v3_load(in->ng + 3 * lane));
+  vec3 ng = v3_norm(v3_load(in->surf[lane].ng));
   int entering = v3_dot(ng, d) < 0.0f;
   vec3 nf = entering ? ng : v3_scale(ng, -1.0f);
   vec3 kd = v3_load(m->kd), ks = v3_load(m->ks);
@@ -330,10 +330,12 @@ static void test_shade_kernel(void **state) {
   for (int trial = 0; trial < 4000; trial++) {
     fr_wray rays[FR_WS_LANES];
     fr_hit hits[FR_WS_LANES];
-    float ng[3 * FR_WS_LANES];
-    int32_t mi[FR_WS_LANES];
+    fr_whitted_tri surf[FR_WS_LANES];
     int n = 1 + (int)(fr_rng_u32(&rng) % FR_WS_LANES);
-    fr_wshade_in in = {rays, hits, ng, mi, (1u << n) - 1u, 0, mats.soa, mats.count, {0, 0, 0}, trial % 4 != 0};
+    /* lanes past n hold NaNs: the kernel must not let them in */
+    memset(rays, 0xFF, sizeof rays);
+    memset(surf, 0xFF, sizeof surf);
+    fr_wshade_in in = {rays, hits, surf, (1u << n) - 1u, 0, mats.soa, mats.count, {0, 0, 0}, trial % 4 != 0};
     for (int a = 0; a < 3; a++) in.light[a] = 4.0f * fr_rng_float(&rng) - 2.0f;
     /* every third group shares one material (the kernel's broadcast path) */
     const int32_t shared_mat = trial % 3 == 0 ? (int32_t)(fr_rng_u32(&rng) % mats.count) : -1;
@@ -344,9 +346,9 @@ static void test_shade_kernel(void **state) {
       hits[l].t = 3.0f * fr_rng_float(&rng);
       hits[l].prim = fr_rng_u32(&rng) % 5 ? (uint32_t)l : FR_INVALID_ID;
       in.hits |= (unsigned)(hits[l].prim != FR_INVALID_ID) << l;
-      mi[l] = shared_mat >= 0 ? shared_mat : (int32_t)(fr_rng_u32(&rng) % mats.count);
-      for (int a = 0; a < 3; a++) ng[3 * l + a] = 2 * fr_rng_float(&rng) - 1;
-      if (fr_rng_u32(&rng) % 50 == 0) ng[3 * l] = ng[3 * l + 1] = ng[3 * l + 2] = 0.0f;
+      surf[l].mat = shared_mat >= 0 ? shared_mat : (int32_t)(fr_rng_u32(&rng) % mats.count);
+      for (int a = 0; a < 3; a++) surf[l].ng[a] = 2 * fr_rng_float(&rng) - 1;
+      if (fr_rng_u32(&rng) % 50 == 0) surf[l].ng[0] = surf[l].ng[1] = surf[l].ng[2] = 0.0f;
     }
     for (int isa = 0; isa < 3; isa++) {
       if (!fr_isa_supported((fr_isa)isa)) continue;

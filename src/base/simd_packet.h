@@ -200,9 +200,13 @@ FR_INLINE void vp_store_records(float *dst, const vpf *f, int nf) {
   for (int i = 0; i < P; i++)
     for (int k = 0; k < nf; k++) memcpy(dst + nf * i + k, &f[k].f[i], sizeof(float));
 }
-FR_INLINE void vp_load_records8(const float *src, vpf f[8]) {
+FR_INLINE void vp_load_records8_at(const float *src, size_t stride, vpf f[8]) {
   for (int i = 0; i < P; i++)
-    for (int k = 0; k < 8; k++) memcpy(&f[k].f[i], src + 8 * i + k, sizeof(float));
+    for (int k = 0; k < 8; k++) memcpy(&f[k].f[i], src + stride * (size_t)i + k, sizeof(float));
+}
+FR_INLINE void vp_load_records4(const float *src, vpf f[4]) {
+  for (int i = 0; i < P; i++)
+    for (int k = 0; k < 4; k++) memcpy(&f[k].f[i], src + 4 * i + k, sizeof(float));
 }
 #else
 /* rows r[0..8) of 8 lanes to records 0..7 (8 floats each), in place */
@@ -233,24 +237,49 @@ FR_INLINE __m256 fr_vp_half(vpf a, int h) {
   return a.v[h];
 #endif
 }
-/* The inverse for records of 8 floats: f[k] gets field k of records
- * src[0..P). Eight rows are loaded and transposed at a time, where a
- * gather per field loads each float on its own. */
-FR_INLINE void vp_load_records8(const float *src, vpf f[8]) {
-  __m256 r[P / 8][8];
-  for (int h = 0; h < P / 8; h++) {
-    for (int i = 0; i < 8; i++) r[h][i] = _mm256_loadu_ps(src + 8 * (8 * h + i));
-    fr_transpose8(r[h]);
-  }
-  for (int k = 0; k < 8; k++) {
+/* lane k of f gets halves[0][k] | halves[1][k] | ... (8 lanes each) */
+FR_INLINE vpf fr_vp_from_halves(const __m256 *halves) {
+  vpf f;
 #if defined(FR_BUILD_ISA_AVX512) && P == 16
-    f[k].v = _mm512_insertf32x8(_mm512_castps256_ps512(r[0][k]), r[1][k], 1);
+  f.v = _mm512_insertf32x8(_mm512_castps256_ps512(halves[0]), halves[1], 1);
 #elif defined(FR_BUILD_ISA_AVX512)
-    f[k].v = r[0][k];
+  f.v = halves[0];
 #else
-    for (int h = 0; h < P / 8; h++) f[k].v[h] = r[h][k];
+  for (int h = 0; h < P / 8; h++) f.v[h] = halves[h];
 #endif
+  return f;
+}
+/* The inverse for the first 8 floats of records `stride` floats apart:
+ * f[k] gets field k of records 0..P. Eight rows are loaded and transposed
+ * at a time, where a gather per field loads each float on its own. */
+FR_INLINE void vp_load_records8_at(const float *src, size_t stride, vpf f[8]) {
+  __m256 r[8][P / 8];
+  for (int h = 0; h < P / 8; h++) {
+    __m256 row[8];
+    for (int i = 0; i < 8; i++) row[i] = _mm256_loadu_ps(src + stride * (size_t)(8 * h + i));
+    fr_transpose8(row);
+    for (int k = 0; k < 8; k++) r[k][h] = row[k];
   }
+  for (int k = 0; k < 8; k++) f[k] = fr_vp_from_halves(r[k]);
+}
+/* The same for records of 4 floats: rows i and i + 4 share a register, so
+ * one in-lane 4x4 transpose serves 8 records. */
+FR_INLINE void vp_load_records4(const float *src, vpf f[4]) {
+  __m256 r[4][P / 8];
+  for (int h = 0; h < P / 8; h++) {
+    const float *s = src + 32 * h;
+    __m256 row[4], t[4];
+    for (int i = 0; i < 4; i++) row[i] = _mm256_set_m128(_mm_loadu_ps(s + 4 * (i + 4)), _mm_loadu_ps(s + 4 * i));
+    t[0] = _mm256_unpacklo_ps(row[0], row[1]); /* x0 x1 y0 y1 | x4 x5 y4 y5 */
+    t[1] = _mm256_unpackhi_ps(row[0], row[1]); /* z0 z1 w0 w1 | ... */
+    t[2] = _mm256_unpacklo_ps(row[2], row[3]);
+    t[3] = _mm256_unpackhi_ps(row[2], row[3]);
+    r[0][h] = _mm256_shuffle_ps(t[0], t[2], 0x44);
+    r[1][h] = _mm256_shuffle_ps(t[0], t[2], 0xEE);
+    r[2][h] = _mm256_shuffle_ps(t[1], t[3], 0x44);
+    r[3][h] = _mm256_shuffle_ps(t[1], t[3], 0xEE);
+  }
+  for (int k = 0; k < 4; k++) f[k] = fr_vp_from_halves(r[k]);
 }
 FR_INLINE void vp_store_records(float *dst, const vpf *f, int nf) {
   const __m256i seven = _mm256_setr_epi32(-1, -1, -1, -1, -1, -1, -1, 0);
@@ -266,6 +295,8 @@ FR_INLINE void vp_store_records(float *dst, const vpf *f, int nf) {
   }
 }
 #endif
+
+FR_INLINE void vp_load_records8(const float *src, vpf f[8]) { vp_load_records8_at(src, 8, f); }
 
 #if !(defined(FR_BUILD_ISA_AVX512) && P == 16) && !defined(FR_BUILD_ISA_SCALAR)
 /* horizontal min/max of 8 lanes: halves, quarters, pairs */

@@ -166,8 +166,7 @@ typedef struct fr_whitted_scratch {
   fr_ray *rays;
   fr_hit *hits;
   uint8_t *occ;
-  float *ng;                  /* a generation's geometric normals (3 per ray), not unit */
-  int32_t *mat;               /* ... and material indices */
+  fr_whitted_tri *surf;       /* a generation's geometric normals (not unit) and materials */
   vec3 colour[WT_PIX];
   double stage[FR_STAGES];    /* seconds, over this thread's tiles */
 } fr_whitted_scratch;
@@ -187,7 +186,7 @@ static int reserve(fr_whitted_scratch *S, size_t n) {
   if (!grow((void **)&S->cur, cap * sizeof *S->cur) || !grow((void **)&S->next, cap * sizeof *S->next) ||
       !grow((void **)&S->shadow, cap * sizeof *S->shadow) || !grow((void **)&S->rays, cap * sizeof *S->rays) ||
       !grow((void **)&S->hits, cap * sizeof *S->hits) || !grow((void **)&S->occ, cap) ||
-      !grow((void **)&S->ng, 3 * cap * sizeof *S->ng) || !grow((void **)&S->mat, cap * sizeof *S->mat))
+      !grow((void **)&S->surf, cap * sizeof *S->surf))
     return 0;
   S->cap = cap;
   return 1;
@@ -203,7 +202,7 @@ void fr_whitted_scratch_stages(const fr_whitted_scratch *S, double stage[FR_STAG
 void fr_whitted_scratch_free(fr_whitted_scratch *S) {
   if (!S) return;
   free(S->cur); free(S->next); free(S->shadow); free(S->rays); free(S->hits); free(S->occ);
-  free(S->ng); free(S->mat);
+  free(S->surf);
   free(S);
 }
 
@@ -335,20 +334,17 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
      * arithmetic 16 hits at a time; then the new rays, in ray order. */
     for (size_t i = 0; i < n; i++) {
       const fr_hit *h = &S->hits[i];
-      float *ng = S->ng + 3 * i;
-      S->mat[i] = 0;
-      ng[0] = ng[1] = ng[2] = 0.0f;
-      if (h->prim == FR_INVALID_ID) continue;
+      fr_whitted_tri *sf = &S->surf[i];
       if (h->prim < w->mats->ntris) {
-        const fr_whitted_tri *r = &w->mats->tri[h->prim];
-        ng[0] = r->ng[0]; ng[1] = r->ng[1]; ng[2] = r->ng[2];
-        S->mat[i] = r->mat;
+        *sf = w->mats->tri[h->prim];
         continue;
       }
+      *sf = (fr_whitted_tri){{0.0f, 0.0f, 0.0f}, 0};
+      if (h->prim == FR_INVALID_ID) continue;
       const float *o = S->cur[i].r.org, *d = S->cur[i].r.dir; /* a sphere: the normal is p - c */
       float pp[3] = {o[0] + d[0] * h->t, o[1] + d[1] * h->t, o[2] + d[2] * h->t};
-      fr_scene_geometric_normal(sc, h->prim, pp, ng);
-      S->mat[i] = (int32_t)mat_index(sc, w->mats, h->prim);
+      fr_scene_geometric_normal(sc, h->prim, pp, sf->ng);
+      sf->mat = (int32_t)mat_index(sc, w->mats, h->prim);
     }
     fr_wshade_in in = {.mats = w->mats->soa, .mat_count = w->mats->count, .bounce = depth < max_depth};
     memcpy(in.light, &w->view.light, sizeof in.light);
@@ -356,8 +352,7 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
       const size_t lanes = n - i0 < FR_WS_LANES ? n - i0 : FR_WS_LANES;
       in.ray = S->cur + i0;
       in.hit = S->hits + i0;
-      in.ng = S->ng + 3 * i0;
-      in.mat = S->mat + i0;
+      in.surf = S->surf + i0;
       in.valid = (unsigned)((1u << lanes) - 1u);
       in.hits = 0;
       for (size_t l = 0; l < lanes; l++) in.hits |= (unsigned)(S->hits[i0 + l].prim != FR_INVALID_ID) << l;

@@ -11,10 +11,6 @@
 
 typedef struct v3p { vpf x, y, z; } v3p;
 
-FR_INLINE v3p v3p_gather(const float *base, const int32_t *idx) {
-  v3p r = {vp_gather(base, idx), vp_gather(base + 1, idx), vp_gather(base + 2, idx)};
-  return r;
-}
 FR_INLINE v3p v3p_splat(const float *a) { v3p r = {vp(a[0]), vp(a[1]), vp(a[2])}; return r; }
 FR_INLINE vpf vp_neg(vpf a) { return vp_xor(a, vp(-0.0f)); }
 FR_INLINE v3p v3p_add(v3p a, v3p b) { v3p r = {vp_add(a.x, b.x), vp_add(a.y, b.y), vp_add(a.z, b.z)}; return r; }
@@ -48,21 +44,39 @@ FR_INLINE v3p mat_field3(const mat_lanes *m, int f) {
 void FR_ISA_FN(fr_whitted_shade16)(const fr_wshade_in *in, fr_wshade_out *out) {
   enum { RAY = sizeof(fr_wray) / sizeof(float), HIT = sizeof(fr_hit) / sizeof(float) };
   _Static_assert(sizeof(fr_wray) % sizeof(float) == 0 && sizeof(fr_hit) % sizeof(float) == 0, "whole floats");
-  int32_t ri[FR_WS_LANES] __attribute__((aligned(64))), hi[FR_WS_LANES] __attribute__((aligned(64)));
-  int32_t ni[FR_WS_LANES] __attribute__((aligned(64)));
+  _Static_assert(sizeof(fr_whitted_tri) == 4 * sizeof(float), "a surface record is 4 floats");
+  _Static_assert(offsetof(fr_wray, r.org) == 0 && offsetof(fr_wray, r.dir) == 4 * sizeof(float) &&
+                     offsetof(fr_wray, w) == 8 * sizeof(float), "a ray record: org, tnear, dir, tfar, w");
+  int32_t hi[FR_WS_LANES] __attribute__((aligned(64)));
   int32_t mi[FR_WS_LANES] __attribute__((aligned(64))); /* the gathers want aligned indices */
+  const fr_wray *ray = in->ray;
+  const fr_whitted_tri *surf = in->surf;
+  fr_wray ray_pad[FR_WS_LANES];
+  fr_whitted_tri surf_pad[FR_WS_LANES];
   int first = __builtin_ctz(in->valid);
+  if (in->valid != (1u << FR_WS_LANES) - 1u) { /* absent lanes copy a present one: whole records load below */
+    for (int l = 0; l < FR_WS_LANES; l++) {
+      int s = (in->valid >> l) & 1 ? l : first;
+      ray_pad[l] = ray[s];
+      surf_pad[l] = surf[s];
+    }
+    ray = ray_pad;
+    surf = surf_pad;
+  }
   int same = 1;
-  for (int l = 0; l < FR_WS_LANES; l++) { /* absent lanes read a present one */
+  for (int l = 0; l < FR_WS_LANES; l++) {
     int s = (in->valid >> l) & 1 ? l : first;
-    ri[l] = s * RAY; hi[l] = s * HIT; ni[l] = 3 * s; mi[l] = in->mat[s];
+    hi[l] = s * HIT; mi[l] = surf[l].mat;
     same &= mi[l] == mi[0];
   }
   const mat_lanes M = {in->mats, in->mat_count, mi, same};
-  const float *rf = (const float *)in->ray, *hf = (const float *)in->hit;
-  v3p o = v3p_gather(rf + offsetof(fr_wray, r.org) / sizeof(float), ri);
-  v3p d = v3p_gather(rf + offsetof(fr_wray, r.dir) / sizeof(float), ri);
-  v3p w = v3p_gather(rf + offsetof(fr_wray, w) / sizeof(float), ri);
+  const float *hf = (const float *)in->hit;
+  /* whole records, transposed: floats 0-7 (org, tnear, dir, tfar) and 4-11 (dir, tfar, w, pix and key) */
+  vpf r0[8], r4[8], sf[4];
+  vp_load_records8_at((const float *)ray, RAY, r0);
+  vp_load_records8_at((const float *)ray + 4, RAY, r4);
+  vp_load_records4((const float *)surf, sf);
+  v3p o = {r0[0], r0[1], r0[2]}, d = {r0[4], r0[5], r0[6]}, w = {r4[4], r4[5], r4[6]};
   vpf t = vp_gather(hf + offsetof(fr_hit, t) / sizeof(float), hi);
   vpm hit = vpm_bits_to(in->hits);
 
@@ -75,7 +89,7 @@ void FR_ISA_FN(fr_whitted_shade16)(const fr_wshade_in *in, fr_wshade_out *out) {
 
   v3p p = v3p_add(o, v3p_scale(d, t));
   v3p_store(out->p, p);
-  v3p ng = v3p_norm(v3p_gather(in->ng, ni));
+  v3p ng = v3p_norm((v3p){sf[0], sf[1], sf[2]});
   vpm entering = vp_lt(v3p_dot(ng, d), vp(0.0f));
   v3p nf = v3p_select(entering, ng, v3p_scale(ng, vp(-1.0f)));
 

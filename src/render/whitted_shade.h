@@ -13,6 +13,7 @@
 #define FR_RENDER_WHITTED_SHADE_H
 #include <stdint.h>
 #include "frusta.h"
+#include "render/whitted.h"
 
 #define FR_WS_LANES 16
 
@@ -42,8 +43,8 @@ enum {
 typedef struct fr_wshade_in {
   const fr_wray *ray;   /* 16 rays (lanes past `valid` are not read) */
   const fr_hit *hit;    /* their hits */
-  const float *ng;      /* 3 per ray: geometric normal, not unit */
-  const int32_t *mat;   /* per ray: material index (any valid index for a miss) */
+  const fr_whitted_tri *surf; /* per ray: geometric normal (not unit) and material index
+                                 (any valid index for a miss) */
   unsigned valid, hits; /* lanes present; lanes that hit */
   const float *mats;    /* the material table, FR_WM_FIELDS x mat_count */
   size_t mat_count;
