@@ -544,14 +544,14 @@ static void light_sets_are_nets(void **state) {
  * rays grazing an edge. */
 typedef struct ray_counter { fr_tracer inner; size_t rays, batches, stream_rays; } ray_counter;
 
-static void counted_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
+static void counted_occluded(void *ctx, const fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
   ray_counter *c = ctx;
   c->rays += n;
   if (coherent == FR_RAYS_DIVERGENT) c->stream_rays += n;
   c->inner.occluded(c->inner.ctx, rays, occ, n, coherent);
 }
 
-static void counted_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
+static void counted_intersect(void *ctx, const fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
   ray_counter *c = ctx;
   c->inner.intersect(c->inner.ctx, rays, hits, n, coherent);
 }

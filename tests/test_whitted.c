@@ -46,7 +46,7 @@ static void check_hit(checker *c, const mesh_ref *m, const fr_ray *ray, const fr
     fail_msg("ray %zu of a packet of %zu: packet prim %u t %g, single prim %u t %g", i, n, got->prim, got->t, h.prim, h.t);
 }
 
-static void check_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
+static void check_intersect(void *ctx, const fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
   checker *c = ctx;
   fr_ray *copy = copy_rays(rays, n);
   c->inner.intersect(c->inner.ctx, rays, hits, n, coherent);
@@ -97,7 +97,7 @@ static unsigned check_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr
   return fetched;
 }
 
-static void check_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
+static void check_occluded(void *ctx, const fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
   checker *c = ctx;
   fr_ray *copy = copy_rays(rays, n);
   c->inner.occluded(c->inner.ctx, rays, occ, n, coherent);
@@ -256,11 +256,11 @@ typedef struct ref_lane {
 static ref_lane ref_shade(const fr_wshade_in *in, const fr_whitted_mats *mats, int lane) {
   ref_lane o;
   memset(&o, 0, sizeof o);
-  const fr_wray *g = &in->ray[lane];
-  vec3 w = v3_load(g->w);
+  const fr_ray *g = &in->ray[lane];
+  vec3 w = v3_load(in->path[lane].w);
   if (!((in->hits >> lane) & 1)) { o.add = v3_scale(w, FR_WHITTED_BACKGROUND); return o; }
   const fr_whitted_mat *m = &mats->mat[in->surf[lane].mat];
-  vec3 d = v3_load(g->r.dir), p = v3_add(v3_load(g->r.org), v3_scale(d, in->hit[lane].t));
+  vec3 d = v3_load(g->dir), p = v3_add(v3_load(g->org), v3_scale(d, in->hit[lane].t));
   vec3 ng = v3_norm(v3_load(in->surf[lane].ng));
   int entering = v3_dot(ng, d) < 0.0f;
   vec3 nf = entering ? ng : v3_scale(ng, -1.0f);
@@ -328,21 +328,23 @@ static void test_shade_kernel(void **state) {
   fr_rng rng = fr_rng_seed(7, 11);
   long lanes_checked = 0, counts[3] = {0, 0, 0};
   for (int trial = 0; trial < 4000; trial++) {
-    fr_wray rays[FR_WS_LANES];
+    fr_ray rays[FR_WS_LANES];
+    fr_wpath path[FR_WS_LANES];
     fr_hit hits[FR_WS_LANES];
     fr_whitted_tri surf[FR_WS_LANES];
     int n = 1 + (int)(fr_rng_u32(&rng) % FR_WS_LANES);
     /* lanes past n hold NaNs: the kernel must not let them in */
     memset(rays, 0xFF, sizeof rays);
+    memset(path, 0xFF, sizeof path);
     memset(surf, 0xFF, sizeof surf);
-    fr_wshade_in in = {rays, hits, surf, (1u << n) - 1u, 0, mats.soa, mats.count, {0, 0, 0}, trial % 4 != 0};
+    fr_wshade_in in = {rays, path, hits, surf, (1u << n) - 1u, 0, mats.soa, mats.count, {0, 0, 0}, trial % 4 != 0};
     for (int a = 0; a < 3; a++) in.light[a] = 4.0f * fr_rng_float(&rng) - 2.0f;
     /* every third group shares one material (the kernel's broadcast path) */
     const int32_t shared_mat = trial % 3 == 0 ? (int32_t)(fr_rng_u32(&rng) % mats.count) : -1;
     for (int l = 0; l < n; l++) {
       vec3 d = v3_norm(v3(2 * fr_rng_float(&rng) - 1, 2 * fr_rng_float(&rng) - 1, 2 * fr_rng_float(&rng) - 1));
-      rays[l] = (fr_wray){{{fr_rng_float(&rng), fr_rng_float(&rng), fr_rng_float(&rng)}, 0, {d.x, d.y, d.z}, INFINITY},
-                          {fr_rng_float(&rng), fr_rng_float(&rng), fr_rng_float(&rng)}, (uint16_t)l, 0};
+      rays[l] = (fr_ray){{fr_rng_float(&rng), fr_rng_float(&rng), fr_rng_float(&rng)}, 0, {d.x, d.y, d.z}, INFINITY};
+      path[l] = (fr_wpath){{fr_rng_float(&rng), fr_rng_float(&rng), fr_rng_float(&rng)}, (uint16_t)l, 0};
       hits[l].t = 3.0f * fr_rng_float(&rng);
       hits[l].prim = fr_rng_u32(&rng) % 5 ? (uint32_t)l : FR_INVALID_ID;
       in.hits |= (unsigned)(hits[l].prim != FR_INVALID_ID) << l;

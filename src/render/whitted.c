@@ -158,12 +158,16 @@ void fr_whitted_shade16(const fr_wshade_in *in, fr_wshade_out *out) {
 
 /* ---- the tile engine ------------------------------------------------------------ */
 
-typedef fr_wray wray;
+/* A generation of rays: the rays, in the layout the tracers take, and beside
+ * them what each carries. */
+typedef struct wgen {
+  fr_ray *r;
+  fr_wpath *p;
+} wgen;
 
 typedef struct fr_whitted_scratch {
   size_t cap;
-  wray *cur, *next, *shadow;
-  fr_ray *rays;
+  wgen cur, next, shadow;
   fr_hit *hits;
   uint8_t *occ;
   fr_whitted_tri *surf;       /* a generation's geometric normals (not unit) and materials */
@@ -179,12 +183,15 @@ static int grow(void **p, size_t bytes) {
   return 1;
 }
 
+static int grow_gen(wgen *g, size_t cap) {
+  return grow((void **)&g->r, cap * sizeof *g->r) && grow((void **)&g->p, cap * sizeof *g->p);
+}
+
 static int reserve(fr_whitted_scratch *S, size_t n) {
   if (n <= S->cap) return 1;
   size_t cap = S->cap ? S->cap : 4096;
   while (cap < n) cap *= 2;
-  if (!grow((void **)&S->cur, cap * sizeof *S->cur) || !grow((void **)&S->next, cap * sizeof *S->next) ||
-      !grow((void **)&S->shadow, cap * sizeof *S->shadow) || !grow((void **)&S->rays, cap * sizeof *S->rays) ||
+  if (!grow_gen(&S->cur, cap) || !grow_gen(&S->next, cap) || !grow_gen(&S->shadow, cap) ||
       !grow((void **)&S->hits, cap * sizeof *S->hits) || !grow((void **)&S->occ, cap) ||
       !grow((void **)&S->surf, cap * sizeof *S->surf))
     return 0;
@@ -201,20 +208,20 @@ void fr_whitted_scratch_stages(const fr_whitted_scratch *S, double stage[FR_STAG
 
 void fr_whitted_scratch_free(fr_whitted_scratch *S) {
   if (!S) return;
-  free(S->cur); free(S->next); free(S->shadow); free(S->rays); free(S->hits); free(S->occ);
-  free(S->surf);
+  wgen *g[3] = {&S->cur, &S->next, &S->shadow};
+  for (int i = 0; i < 3; i++) { free(g[i]->r); free(g[i]->p); }
+  free(S->hits); free(S->occ); free(S->surf);
   free(S);
 }
 
 /* Hands rays [0, n) of a generation to the tracer, one call per packet (run
  * of equal keys). */
-static void trace_runs(const fr_tracer *t, const wray *g, fr_ray *rays, fr_hit *hits, uint8_t *occ, size_t n) {
-  for (size_t i = 0; i < n; i++) rays[i] = g[i].r;
+static void trace_runs(const fr_tracer *t, wgen g, fr_hit *hits, uint8_t *occ, size_t n) {
   for (size_t a = 0; a < n;) {
     size_t b = a + 1;
-    while (b < n && g[b].key == g[a].key) b++;
-    if (occ) t->occluded(t->ctx, rays + a, occ + a, b - a, 1);
-    else t->intersect(t->ctx, rays + a, hits + a, b - a, 1);
+    while (b < n && g.p[b].key == g.p[a].key) b++;
+    if (occ) t->occluded(t->ctx, g.r + a, occ + a, b - a, 1);
+    else t->intersect(t->ctx, g.r + a, hits + a, b - a, 1);
     a = b;
   }
 }
@@ -246,9 +253,7 @@ static void trace_runs(const fr_tracer *t, const wray *g, fr_ray *rays, fr_hit *
  * What makes no frustum (see fr_mft_fns.from_rays) goes as rays; a batch
  * over its node budget goes as rays, and so does the rest of the
  * generation (with w->mft_no_fallback, no budget). */
-static void trace_shadow_frusta(const fr_workload *w, const fr_tracer *t, const wray *g, fr_ray *rays, uint8_t *occ,
-                                size_t n) {
-  for (size_t i = 0; i < n; i++) rays[i] = g[i].r;
+static void trace_shadow_frusta(const fr_workload *w, const fr_tracer *t, const fr_ray *rays, uint8_t *occ, size_t n) {
   fr_mft_batch b;
   static _Thread_local fr_mft_sets T;
   uint16_t bits[FR_MFT_FRUSTA];
@@ -290,15 +295,11 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
     for (int q = 0; q < 4; q++) {
       int qx = tx + 16 * (q % 2), qy = ty + 16 * (q / 2);
       if (qx + 16 > W || qy + 16 > H) continue;
-      fr_camera_frusta(w, t, qx, qy, S->rays + n, S->hits + n);
+      fr_camera_frusta(w, t, qx, qy, S->cur.r + n, S->hits + n);
       for (int i = 0; i < 256; i++, n++) {
         int f = i / 16, k = i % 16;
         int X = qx + 4 * (f % 4) + k % 4, Y = qy + 4 * (f / 4) + k / 4;
-        wray *g = &S->cur[n];
-        g->r = S->rays[n];
-        g->w[0] = g->w[1] = g->w[2] = 1.0f;
-        g->pix = (uint16_t)((Y - ty) * WT + (X - tx));
-        g->key = 0;
+        S->cur.p[n] = (fr_wpath){{1.0f, 1.0f, 1.0f}, (uint16_t)((Y - ty) * WT + (X - tx)), 0};
       }
     }
     traced = n;
@@ -309,17 +310,14 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
         int X = tx + (b % per) * side + x, Y = ty + (b / per) * side + y;
         if (X >= W || Y >= H) continue;
         if (traced && X + 16 - X % 16 <= W && Y + 16 - Y % 16 <= H) continue; /* in a traced quarter */
-        wray *g = &S->cur[n++];
-        g->r = fr_camera_ray(&w->cam, X, Y);
-        g->w[0] = g->w[1] = g->w[2] = 1.0f;
-        g->pix = (uint16_t)((Y - ty) * WT + (X - tx));
-        g->key = (uint16_t)(2 * b);
+        S->cur.r[n] = fr_camera_ray(&w->cam, X, Y);
+        S->cur.p[n++] = (fr_wpath){{1.0f, 1.0f, 1.0f}, (uint16_t)((Y - ty) * WT + (X - tx)), (uint16_t)(2 * b)};
       }
   for (int i = 0; i < WT_PIX; i++) S->colour[i] = v3(0, 0, 0);
   uint64_t rays = 0;
   for (int depth = 0; n > 0; depth++) {
     const double t_gen = fr_seconds();
-    trace_runs(t, S->cur + traced, S->rays + traced, S->hits + traced, NULL, n - traced);
+    trace_runs(t, (wgen){S->cur.r + traced, S->cur.p + traced}, S->hits + traced, NULL, n - traced);
     const double t_traced = fr_seconds();
     /* the camera stage runs from the tile's start: making the rays is part of it */
     const double dt = depth == 0 ? t_traced - t_tile : t_traced - t_gen;
@@ -341,7 +339,7 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
       }
       *sf = (fr_whitted_tri){{0.0f, 0.0f, 0.0f}, 0};
       if (h->prim == FR_INVALID_ID) continue;
-      const float *o = S->cur[i].r.org, *d = S->cur[i].r.dir; /* a sphere: the normal is p - c */
+      const float *o = S->cur.r[i].org, *d = S->cur.r[i].dir; /* a sphere: the normal is p - c */
       float pp[3] = {o[0] + d[0] * h->t, o[1] + d[1] * h->t, o[2] + d[2] * h->t};
       fr_scene_geometric_normal(sc, h->prim, pp, sf->ng);
       sf->mat = (int32_t)mat_index(sc, w->mats, h->prim);
@@ -350,7 +348,8 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
     memcpy(in.light, &w->view.light, sizeof in.light);
     for (size_t i0 = 0; i0 < n; i0 += FR_WS_LANES) {
       const size_t lanes = n - i0 < FR_WS_LANES ? n - i0 : FR_WS_LANES;
-      in.ray = S->cur + i0;
+      in.ray = S->cur.r + i0;
+      in.path = S->cur.p + i0;
       in.hit = S->hits + i0;
       in.surf = S->surf + i0;
       in.valid = (unsigned)((1u << lanes) - 1u);
@@ -359,7 +358,7 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
       fr_wshade_out out;
       fr_whitted_shade16(&in, &out);
       for (size_t l = 0; l < lanes; l++) {
-        const wray *g = &S->cur[i0 + l];
+        const fr_wpath *g = &S->cur.p[i0 + l];
         vec3 *c = &S->colour[g->pix];
         *c = v3_add(*c, v3(out.add[0][l], out.add[1][l], out.add[2][l]));
         const fr_ray base = {{out.p[0][l], out.p[1][l], out.p[2][l]}, w->eps, {0, 0, 0}, INFINITY};
@@ -372,37 +371,43 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
           const float dist = out.ldist[l];
           const fr_ray from_light = {{w->view.light.x, w->view.light.y, w->view.light.z}, dist * 1e-4f,
                                      {-out.l[0][l], -out.l[1][l], -out.l[2][l]}, dist - w->eps};
-          S->shadow[ns++] =
-              (wray){from_light, {out.lw[0][l], out.lw[1][l], out.lw[2][l]}, g->pix, (uint16_t)(g->key / 2)};
+          S->shadow.r[ns] = from_light;
+          S->shadow.p[ns++] = (fr_wpath){{out.lw[0][l], out.lw[1][l], out.lw[2][l]}, g->pix, (uint16_t)(g->key / 2)};
         }
         if ((out.refl >> l) & 1) {
-          wray *r = &S->next[nn++];
-          *r = (wray){base, {out.rw[0][l], out.rw[1][l], out.rw[2][l]}, g->pix, (uint16_t)(g->key & ~1u)};
-          r->r.dir[0] = out.rd[0][l]; r->r.dir[1] = out.rd[1][l]; r->r.dir[2] = out.rd[2][l];
+          fr_ray *r = &S->next.r[nn];
+          *r = base;
+          r->dir[0] = out.rd[0][l]; r->dir[1] = out.rd[1][l]; r->dir[2] = out.rd[2][l];
+          S->next.p[nn++] = (fr_wpath){{out.rw[0][l], out.rw[1][l], out.rw[2][l]}, g->pix, (uint16_t)(g->key & ~1u)};
         }
         if ((out.refr >> l) & 1) {
-          wray *r = &S->next[nn++];
-          *r = (wray){base, {out.tw[0][l], out.tw[1][l], out.tw[2][l]}, g->pix, (uint16_t)(g->key | 1u)};
-          r->r.dir[0] = out.td[0][l]; r->r.dir[1] = out.td[1][l]; r->r.dir[2] = out.td[2][l];
+          fr_ray *r = &S->next.r[nn];
+          *r = base;
+          r->dir[0] = out.td[0][l]; r->dir[1] = out.td[1][l]; r->dir[2] = out.td[2][l];
+          S->next.p[nn++] = (fr_wpath){{out.tw[0][l], out.tw[1][l], out.tw[2][l]}, g->pix, (uint16_t)(g->key | 1u)};
         }
       }
     }
     /* shadow rays, packet by packet (they follow their block's order) */
     const double t_shadow = fr_seconds();
-    if (t->occluded_frusta && depth == 0) trace_shadow_frusta(w, t, S->shadow, S->rays, S->occ, ns);
-    else trace_runs(t, S->shadow, S->rays, NULL, S->occ, ns);
+    if (t->occluded_frusta && depth == 0) trace_shadow_frusta(w, t, S->shadow.r, S->occ, ns);
+    else trace_runs(t, S->shadow, NULL, S->occ, ns);
     const double ds = fr_seconds() - t_shadow;
     S->stage[FR_STAGE_SHADOW] += ds;
     traced_s += ds;
     rays += ns;
     for (size_t i = 0; i < ns; i++)
-      if (!S->occ[i]) S->colour[S->shadow[i].pix] = v3_add(S->colour[S->shadow[i].pix], v3_load(S->shadow[i].w));
+      if (!S->occ[i]) S->colour[S->shadow.p[i].pix] = v3_add(S->colour[S->shadow.p[i].pix], v3_load(S->shadow.p[i].w));
     /* the next generation grouped by key: reflection and refraction packets of each block */
     size_t count[2 * WT_PIX + 1];
     memset(count, 0, (2 * (size_t)(per * per) + 1) * sizeof count[0]);
-    for (size_t i = 0; i < nn; i++) count[S->next[i].key + 1]++;
+    for (size_t i = 0; i < nn; i++) count[S->next.p[i].key + 1]++;
     for (int k = 1; k <= 2 * per * per; k++) count[k] += count[k - 1];
-    for (size_t i = 0; i < nn; i++) S->cur[count[S->next[i].key]++] = S->next[i];
+    for (size_t i = 0; i < nn; i++) {
+      size_t j = count[S->next.p[i].key]++;
+      S->cur.r[j] = S->next.r[i];
+      S->cur.p[j] = S->next.p[i];
+    }
     n = nn;
   }
   S->stage[FR_STAGE_SHADE] += fr_seconds() - t_tile - traced_s;

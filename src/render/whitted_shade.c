@@ -42,25 +42,30 @@ FR_INLINE v3p mat_field3(const mat_lanes *m, int f) {
 }
 
 void FR_ISA_FN(fr_whitted_shade16)(const fr_wshade_in *in, fr_wshade_out *out) {
-  enum { RAY = sizeof(fr_wray) / sizeof(float), HIT = sizeof(fr_hit) / sizeof(float) };
-  _Static_assert(sizeof(fr_wray) % sizeof(float) == 0 && sizeof(fr_hit) % sizeof(float) == 0, "whole floats");
-  _Static_assert(sizeof(fr_whitted_tri) == 4 * sizeof(float), "a surface record is 4 floats");
-  _Static_assert(offsetof(fr_wray, r.org) == 0 && offsetof(fr_wray, r.dir) == 4 * sizeof(float) &&
-                     offsetof(fr_wray, w) == 8 * sizeof(float), "a ray record: org, tnear, dir, tfar, w");
+  enum { HIT = sizeof(fr_hit) / sizeof(float) };
+  _Static_assert(sizeof(fr_hit) % sizeof(float) == 0, "whole floats");
+  _Static_assert(sizeof(fr_ray) == 8 * sizeof(float) && offsetof(fr_ray, dir) == 4 * sizeof(float),
+                 "a ray record: org, tnear, dir, tfar");
+  _Static_assert(sizeof(fr_wpath) == 4 * sizeof(float) && sizeof(fr_whitted_tri) == 4 * sizeof(float),
+                 "path and surface records of 4 floats");
   int32_t hi[FR_WS_LANES] __attribute__((aligned(64)));
   int32_t mi[FR_WS_LANES] __attribute__((aligned(64))); /* the gathers want aligned indices */
-  const fr_wray *ray = in->ray;
+  const fr_ray *ray = in->ray;
+  const fr_wpath *path = in->path;
   const fr_whitted_tri *surf = in->surf;
-  fr_wray ray_pad[FR_WS_LANES];
+  fr_ray ray_pad[FR_WS_LANES];
+  fr_wpath path_pad[FR_WS_LANES];
   fr_whitted_tri surf_pad[FR_WS_LANES];
   int first = __builtin_ctz(in->valid);
   if (in->valid != (1u << FR_WS_LANES) - 1u) { /* absent lanes copy a present one: whole records load below */
     for (int l = 0; l < FR_WS_LANES; l++) {
       int s = (in->valid >> l) & 1 ? l : first;
       ray_pad[l] = ray[s];
+      path_pad[l] = path[s];
       surf_pad[l] = surf[s];
     }
     ray = ray_pad;
+    path = path_pad;
     surf = surf_pad;
   }
   int same = 1;
@@ -71,12 +76,12 @@ void FR_ISA_FN(fr_whitted_shade16)(const fr_wshade_in *in, fr_wshade_out *out) {
   }
   const mat_lanes M = {in->mats, in->mat_count, mi, same};
   const float *hf = (const float *)in->hit;
-  /* whole records, transposed: floats 0-7 (org, tnear, dir, tfar) and 4-11 (dir, tfar, w, pix and key) */
-  vpf r0[8], r4[8], sf[4];
-  vp_load_records8_at((const float *)ray, RAY, r0);
-  vp_load_records8_at((const float *)ray + 4, RAY, r4);
+  /* whole records, transposed */
+  vpf rf[8], pf[4], sf[4];
+  vp_load_records8((const float *)ray, rf);
+  vp_load_records4((const float *)path, pf);
   vp_load_records4((const float *)surf, sf);
-  v3p o = {r0[0], r0[1], r0[2]}, d = {r0[4], r0[5], r0[6]}, w = {r4[4], r4[5], r4[6]};
+  v3p o = {rf[0], rf[1], rf[2]}, d = {rf[4], rf[5], rf[6]}, w = {pf[0], pf[1], pf[2]};
   vpf t = vp_gather(hf + offsetof(fr_hit, t) / sizeof(float), hi);
   vpm hit = vpm_bits_to(in->hits);
 

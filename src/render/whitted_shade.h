@@ -17,14 +17,15 @@
 
 #define FR_WS_LANES 16
 
-/* a ray of a generation: its pixel, the weight it carries, its packet key
- * (block * 2 + kind: 0 camera or reflection, 1 refraction) */
-typedef struct fr_wray {
-  fr_ray r;
+/* What a ray of a generation carries, beside the ray itself (kept in an
+ * array of its own, so the tracers read a generation in place): the weight,
+ * its pixel, its packet key (block * 2 + kind: 0 camera or reflection, 1
+ * refraction). */
+typedef struct fr_wpath {
   float w[3];
   uint16_t pix;
   uint16_t key;
-} fr_wray;
+} fr_wpath;
 
 /* Materials as structure of arrays: field f of material i at soa[f * count + i]. */
 enum {
@@ -41,7 +42,8 @@ enum {
 };
 
 typedef struct fr_wshade_in {
-  const fr_wray *ray;   /* 16 rays (lanes past `valid` are not read) */
+  const fr_ray *ray;    /* 16 rays (lanes past `valid` are not read) */
+  const fr_wpath *path; /* what they carry */
   const fr_hit *hit;    /* their hits */
   const fr_whitted_tri *surf; /* per ray: geometric normal (not unit) and material index
                                  (any valid index for a miss) */

@@ -368,12 +368,12 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
   return r;
 }
 
-static void frusta_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
+static void frusta_intersect(void *ctx, const fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
   (void)coherent;
   fr_intersect_stream((const fr_scene *)ctx, rays, hits, n);
 }
 
-static void frusta_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
+static void frusta_occluded(void *ctx, const fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
   (void)coherent;
   fr_occluded_stream((const fr_scene *)ctx, rays, occ, n);
 }
@@ -383,12 +383,12 @@ fr_tracer fr_tracer_frusta(const fr_scene *s) {
   return t;
 }
 
-static void mft_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
+static void mft_intersect(void *ctx, const fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
   (void)coherent;
   fr_intersect_stream(((const fr_mft_tracer *)ctx)->scene, rays, hits, n);
 }
 
-static void mft_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
+static void mft_occluded(void *ctx, const fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
   const fr_scene *s = ((const fr_mft_tracer *)ctx)->scene;
   if (coherent == FR_RAYS_DIVERGENT) fr_occluded_raystream(s, rays, occ, n);
   else fr_occluded_stream(s, rays, occ, n);
@@ -424,7 +424,7 @@ static fr_lpacket *thread_packet(void) {
 }
 
 /* consecutive packets of side x side rays; closest hits into hits, or any hits into occ */
-static void lp_trace(const fr_lp_tracer *c, fr_ray *rays, fr_hit *hits, uint8_t *occ, size_t n) {
+static void lp_trace(const fr_lp_tracer *c, const fr_ray *rays, fr_hit *hits, uint8_t *occ, size_t n) {
   fr_lpacket *p = thread_packet();
   const size_t size = (size_t)c->side * (size_t)c->side;
   const fr_lp_scene *g = &c->geom;
@@ -446,12 +446,12 @@ static void lp_trace(const fr_lp_tracer *c, fr_ray *rays, fr_hit *hits, uint8_t 
   }
 }
 
-static void lp_intersect(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
+static void lp_intersect(void *ctx, const fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
   (void)coherent;
   lp_trace(ctx, rays, hits, NULL, n);
 }
 
-static void lp_occluded(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
+static void lp_occluded(void *ctx, const fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
   (void)coherent;
   lp_trace(ctx, rays, NULL, occ, n);
 }

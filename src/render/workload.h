@@ -41,8 +41,8 @@ int fr_workload_parse(const char *name, fr_workload_kind *k);
 #define FR_RAYS_DIVERGENT (-1)
 typedef struct fr_tracer {
   void *ctx;
-  void (*intersect)(void *ctx, fr_ray *rays, fr_hit *hits, size_t n, int coherent);
-  void (*occluded)(void *ctx, fr_ray *rays, uint8_t *occ, size_t n, int coherent);
+  void (*intersect)(void *ctx, const fr_ray *rays, fr_hit *hits, size_t n, int coherent);
+  void (*occluded)(void *ctx, const fr_ray *rays, uint8_t *occ, size_t n, int coherent);
   unsigned (*intersect_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *hits);
   /* both return the triangles the batch fetched (see soft_shadows in workload.c) */
   unsigned (*occluded_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[FR_MFT_FRUSTA],

@@ -176,7 +176,7 @@ static struct RTCIntersectContext make_context(int coherent) {
   return ctx;
 }
 
-static void ebr_intersect(void *c, fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
+static void ebr_intersect(void *c, const fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
   struct ebr_ctx *x = c;
   ebr_scene *e = x->e;
   struct RTCIntersectContext ctx = make_context(coherent);
@@ -205,7 +205,7 @@ static void ebr_intersect(void *c, fr_ray *rays, fr_hit *hits, size_t n, int coh
   }
 }
 
-static void ebr_occluded(void *c, fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
+static void ebr_occluded(void *c, const fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
   struct ebr_ctx *x = c;
   ebr_scene *e = x->e;
   struct RTCIntersectContext ctx = make_context(coherent);
