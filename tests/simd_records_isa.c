@@ -1,14 +1,15 @@
 /* The transposing record loads of base/simd_packet.h compiled for one ISA
  * (16 lanes), called by test_kernels through a plain-C signature: out8[k]
  * gets field k of the 16 records `stride` floats apart at src, out4[k]
- * field k of 16 records of 4 floats. */
+ * field k of 16 records of 4 floats; back4 gets those 16 records stored
+ * again from out4's fields. */
 #define FR_PACKET 16
 #include "base/simd_packet.h"
 
 #define NAME2(isa) fr_test_load_records_##isa
 #define NAME(isa) NAME2(isa)
-void NAME(FR_ISA_SUFFIX)(const float *src, size_t stride, float (*out8)[16], float (*out4)[16]);
-void NAME(FR_ISA_SUFFIX)(const float *src, size_t stride, float (*out8)[16], float (*out4)[16]) {
+void NAME(FR_ISA_SUFFIX)(const float *src, size_t stride, float (*out8)[16], float (*out4)[16], float *back4);
+void NAME(FR_ISA_SUFFIX)(const float *src, size_t stride, float (*out8)[16], float (*out4)[16], float *back4) {
   float R[16] __attribute__((aligned(64)));
   vpf f[8];
   vp_load_records8_at(src, stride, f);
@@ -21,4 +22,7 @@ void NAME(FR_ISA_SUFFIX)(const float *src, size_t stride, float (*out8)[16], flo
     vp_store(R, f[k]);
     memcpy(out4[k], R, sizeof R);
   }
+  float B[64];
+  vp_store_records4(B, f);
+  memcpy(back4, B, sizeof B);
 }

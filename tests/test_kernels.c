@@ -194,12 +194,12 @@ static void test_add_where(void **st) {
   print_message("masked adds: %d lane sets\n", tested);
 }
 
-typedef void (*load_records_fn)(const float *, size_t, float (*)[16], float (*)[16]);
-void fr_test_load_records_scalar(const float *src, size_t stride, float (*out8)[16], float (*out4)[16]);
-void fr_test_load_records_avx2(const float *src, size_t stride, float (*out8)[16], float (*out4)[16]);
-void fr_test_load_records_avx512(const float *src, size_t stride, float (*out8)[16], float (*out4)[16]);
+typedef void (*load_records_fn)(const float *, size_t, float (*)[16], float (*)[16], float *);
+void fr_test_load_records_scalar(const float *src, size_t stride, float (*out8)[16], float (*out4)[16], float *back4);
+void fr_test_load_records_avx2(const float *src, size_t stride, float (*out8)[16], float (*out4)[16], float *back4);
+void fr_test_load_records_avx512(const float *src, size_t stride, float (*out8)[16], float (*out4)[16], float *back4);
 
-/* The transposing record loads on every level move bits: field k of record
+/* The transposing record loads (and the 4-float store) on every level move bits: field k of record
  * i lands in lane i of output k, NaNs and all, at the strides the Whitted
  * shading (12) and the packets (8) use. */
 static void test_load_records(void **st) {
@@ -213,8 +213,9 @@ static void test_load_records(void **st) {
   for (size_t l = 0; l < sizeof levels / sizeof levels[0]; l++) {
     if (!fr_isa_supported(levels[l].isa)) continue;
     for (size_t stride = 8; stride <= 12; stride += 4) {
-      float out8[8][16], out4[4][16];
-      levels[l].fn((const float *)src, stride, out8, out4);
+      float out8[8][16], out4[4][16], back4[64];
+      levels[l].fn((const float *)src, stride, out8, out4, back4);
+      assert_memory_equal(back4, src, sizeof back4);
       for (int i = 0; i < 16; i++) {
         for (int k = 0; k < 8; k++) assert_memory_equal(&out8[k][i], &src[stride * (size_t)i + (size_t)k], 4);
         for (int k = 0; k < 4; k++) assert_memory_equal(&out4[k][i], &src[4 * i + k], 4);

@@ -301,6 +301,50 @@ static int same3(vec3 a, const float (*v)[FR_WS_LANES], int l) {
   return !memcmp(&a, b, sizeof b);
 }
 
+static int same_ray(const fr_ray *a, const fr_ray *b) { return !memcmp(a, b, sizeof *a); }
+static int same_path(const fr_wpath *a, const fr_wpath *b) {
+  return !memcmp(a->w, b->w, sizeof a->w) && a->pix == b->pix && a->key == b->key;
+}
+
+/* fr_whitted_emit16 of one level writes, in lane order, the rays the
+ * formulas spawn: shadow rays from the light, then reflections, then
+ * refractions, each carrying its weight, pixel and packet key. */
+static void check_emit(const fr_wshade_in *in, const fr_whitted_mats *mats, const fr_wshade_out *out, int isa) {
+  const float eps = 1e-3f;
+  fr_ray sr[FR_WS_LANES], nr[2 * FR_WS_LANES];
+  fr_wpath sp[FR_WS_LANES], np[2 * FR_WS_LANES];
+  fr_wsink shadow = {sr, sp, 0}, next = {nr, np, 0};
+  if (isa == FR_ISA_AVX512) fr_whitted_emit16_avx512(out, in->light, eps, &shadow, &next);
+  else if (isa == FR_ISA_AVX2) fr_whitted_emit16_avx2(out, in->light, eps, &shadow, &next);
+  else fr_whitted_emit16_scalar(out, in->light, eps, &shadow, &next);
+  size_t ns = 0, nn = 0;
+  for (int kind = 0; kind < 3; kind++)
+    for (int l = 0; l < FR_WS_LANES; l++) {
+      if (!((in->valid >> l) & 1)) continue;
+      ref_lane r = ref_shade(in, mats, l);
+      const fr_wpath *g = &in->path[l];
+      fr_ray want;
+      fr_wpath carry;
+      if (kind == 0) {
+        if (!r.shadow) continue;
+        want = (fr_ray){{in->light[0], in->light[1], in->light[2]}, r.ldist * 1e-4f, {-r.l.x, -r.l.y, -r.l.z},
+                        r.ldist - eps};
+        carry = (fr_wpath){{r.lw.x, r.lw.y, r.lw.z}, g->pix, (uint16_t)(g->key / 2)};
+        assert_true(ns < shadow.n && same_ray(&sr[ns], &want) && same_path(&sp[ns], &carry));
+        ns++;
+        continue;
+      }
+      if (kind == 1 ? !r.refl : !r.refr) continue;
+      vec3 dir = kind == 1 ? r.rd : r.td, wt = kind == 1 ? r.rw : r.tw;
+      want = (fr_ray){{r.p.x, r.p.y, r.p.z}, eps, {dir.x, dir.y, dir.z}, INFINITY};
+      carry = (fr_wpath){{wt.x, wt.y, wt.z}, g->pix, (uint16_t)(kind == 1 ? g->key & ~1u : g->key | 1u)};
+      assert_true(nn < next.n && same_ray(&nr[nn], &want) && same_path(&np[nn], &carry));
+      nn++;
+    }
+  assert_int_equal(ns, shadow.n);
+  assert_int_equal(nn, next.n);
+}
+
 /* Random hits (misses, zero normals, grazing and back-facing ones, total
  * internal reflection) on materials of every kind, in partial groups too. */
 static void test_shade_kernel(void **state) {
@@ -344,7 +388,8 @@ static void test_shade_kernel(void **state) {
     for (int l = 0; l < n; l++) {
       vec3 d = v3_norm(v3(2 * fr_rng_float(&rng) - 1, 2 * fr_rng_float(&rng) - 1, 2 * fr_rng_float(&rng) - 1));
       rays[l] = (fr_ray){{fr_rng_float(&rng), fr_rng_float(&rng), fr_rng_float(&rng)}, 0, {d.x, d.y, d.z}, INFINITY};
-      path[l] = (fr_wpath){{fr_rng_float(&rng), fr_rng_float(&rng), fr_rng_float(&rng)}, (uint16_t)l, 0};
+      path[l] = (fr_wpath){{fr_rng_float(&rng), fr_rng_float(&rng), fr_rng_float(&rng)}, (uint16_t)(l * 37),
+                           (uint16_t)(fr_rng_u32(&rng) % 2048)};
       hits[l].t = 3.0f * fr_rng_float(&rng);
       hits[l].prim = fr_rng_u32(&rng) % 5 ? (uint32_t)l : FR_INVALID_ID;
       in.hits |= (unsigned)(hits[l].prim != FR_INVALID_ID) << l;
@@ -375,11 +420,12 @@ static void test_shade_kernel(void **state) {
         counts[0] += r.shadow; counts[1] += r.refl; counts[2] += r.refr;
         lanes_checked++;
       }
+      check_emit(&in, &mats, &out, isa);
     }
   }
   /* every kind of output really came up */
   assert_true(counts[0] > 1000 && counts[1] > 1000 && counts[2] > 1000);
-  print_message("shading kernel: %ld lanes bit-identical to the formulas (%ld shadow, %ld reflection, %ld refraction rays)\n",
+  print_message("shading kernel: %ld lanes bit-identical to the formulas, their new rays too (%ld shadow, %ld reflection, %ld refraction rays)\n",
                 lanes_checked, counts[0], counts[1], counts[2]);
   fr_whitted_mats_free(&mats);
   fr_scene_release(s);

@@ -208,6 +208,10 @@ FR_INLINE void vp_load_records4(const float *src, vpf f[4]) {
   for (int i = 0; i < P; i++)
     for (int k = 0; k < 4; k++) memcpy(&f[k].f[i], src + 4 * i + k, sizeof(float));
 }
+FR_INLINE void vp_store_records4(float *dst, const vpf f[4]) {
+  for (int i = 0; i < P; i++)
+    for (int k = 0; k < 4; k++) memcpy(dst + 4 * i + k, &f[k].f[i], sizeof(float));
+}
 #else
 /* rows r[0..8) of 8 lanes to records 0..7 (8 floats each), in place */
 FR_INLINE void fr_transpose8(__m256 r[8]) {
@@ -280,6 +284,25 @@ FR_INLINE void vp_load_records4(const float *src, vpf f[4]) {
     r[3][h] = _mm256_shuffle_ps(t[1], t[3], 0xEE);
   }
   for (int k = 0; k < 4; k++) f[k] = fr_vp_from_halves(r[k]);
+}
+/* ... and its inverse */
+FR_INLINE void vp_store_records4(float *dst, const vpf f[4]) {
+  for (int h = 0; h < P / 8; h++) {
+    __m256 t[4], r[4];
+    t[0] = _mm256_unpacklo_ps(fr_vp_half(f[0], h), fr_vp_half(f[1], h)); /* x0 y0 x1 y1 | x4 y4 x5 y5 */
+    t[1] = _mm256_unpackhi_ps(fr_vp_half(f[0], h), fr_vp_half(f[1], h)); /* x2 y2 x3 y3 | ... */
+    t[2] = _mm256_unpacklo_ps(fr_vp_half(f[2], h), fr_vp_half(f[3], h));
+    t[3] = _mm256_unpackhi_ps(fr_vp_half(f[2], h), fr_vp_half(f[3], h));
+    r[0] = _mm256_shuffle_ps(t[0], t[2], 0x44); /* record 0 | record 4 */
+    r[1] = _mm256_shuffle_ps(t[0], t[2], 0xEE);
+    r[2] = _mm256_shuffle_ps(t[1], t[3], 0x44);
+    r[3] = _mm256_shuffle_ps(t[1], t[3], 0xEE);
+    float *d = dst + 32 * h;
+    for (int i = 0; i < 4; i++) {
+      _mm_storeu_ps(d + 4 * i, _mm256_castps256_ps128(r[i]));
+      _mm_storeu_ps(d + 4 * (i + 4), _mm256_extractf128_ps(r[i], 1));
+    }
+  }
 }
 FR_INLINE void vp_store_records(float *dst, const vpf *f, int nf) {
   const __m256i seven = _mm256_setr_epi32(-1, -1, -1, -1, -1, -1, -1, 0);

@@ -156,6 +156,14 @@ void fr_whitted_shade16(const fr_wshade_in *in, fr_wshade_out *out) {
   }
 }
 
+void fr_whitted_emit16(const fr_wshade_out *out, const float light[3], float eps, fr_wsink *shadow, fr_wsink *next) {
+  switch (fr_kernels_active()->isa) {
+  case FR_ISA_AVX512: fr_whitted_emit16_avx512(out, light, eps, shadow, next); break;
+  case FR_ISA_AVX2: fr_whitted_emit16_avx2(out, light, eps, shadow, next); break;
+  default: fr_whitted_emit16_scalar(out, light, eps, shadow, next); break;
+  }
+}
+
 /* ---- the tile engine ------------------------------------------------------------ */
 
 /* A generation of rays: the rays, in the layout the tracers take, and beside
@@ -279,6 +287,13 @@ static void trace_shadow_frusta(const fr_workload *w, const fr_tracer *t, const 
   if (a < n) t->occluded(t->ctx, rays + a, occ + a, n - a, 1);
 }
 
+/* The pixel of ray i of a 16x16 quarter's frusta (ray k = i % 16 of 4x4
+ * frustum f = i / 16), from the quarter's corner in a tile row of WT:
+ * row 4 (f / 4) + k / 4, column 4 (f % 4) + k % 4. */
+static inline unsigned frustum_pix(unsigned i) {
+  return (((i >> 4) & 12u) + ((i >> 2) & 3u)) * WT + ((i >> 2) & 12u) + (i & 3u);
+}
+
 uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_scratch *S, int tx, int ty) {
   const int W = w->cam.width, H = w->cam.height;
   const int side = t->packet_side > 0 && t->packet_side <= WT ? t->packet_side : WT, per = WT / side;
@@ -296,11 +311,8 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
       int qx = tx + 16 * (q % 2), qy = ty + 16 * (q / 2);
       if (qx + 16 > W || qy + 16 > H) continue;
       fr_camera_frusta(w, t, qx, qy, S->cur.r + n, S->hits + n);
-      for (int i = 0; i < 256; i++, n++) {
-        int f = i / 16, k = i % 16;
-        int X = qx + 4 * (f % 4) + k % 4, Y = qy + 4 * (f / 4) + k / 4;
-        S->cur.p[n] = (fr_wpath){{1.0f, 1.0f, 1.0f}, (uint16_t)((Y - ty) * WT + (X - tx)), 0};
-      }
+      const int corner = (qy - ty) * WT + (qx - tx);
+      for (int i = 0; i < 256; i++, n++) S->cur.p[n] = (fr_wpath){{1.0f, 1.0f, 1.0f}, (uint16_t)(corner + (int)frustum_pix((unsigned)i)), 0};
     }
     traced = n;
   }
@@ -325,8 +337,9 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
     traced_s += dt;
     traced = 0;
     rays += n;
-    size_t ns = 0, nn = 0;
-    if (!reserve(S, 2 * n)) return rays;
+    /* room for two new rays per ray, and a whole group of 16 past them */
+    if (!reserve(S, 2 * n + 2 * FR_WS_LANES)) return rays;
+    fr_wsink shadow = {S->shadow.r, S->shadow.p, 0}, next = {S->next.r, S->next.p, 0};
     /* First what each hit needs from memory, its material and normal, in a
      * loop short enough that the cache misses of many hits overlap; then the
      * arithmetic 16 hits at a time; then the new rays, in ray order. */
@@ -358,36 +371,18 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
       fr_wshade_out out;
       fr_whitted_shade16(&in, &out);
       for (size_t l = 0; l < lanes; l++) {
-        const fr_wpath *g = &S->cur.p[i0 + l];
-        vec3 *c = &S->colour[g->pix];
+        vec3 *c = &S->colour[S->cur.p[i0 + l].pix];
         *c = v3_add(*c, v3(out.add[0][l], out.add[1][l], out.add[2][l]));
-        const fr_ray base = {{out.p[0][l], out.p[1][l], out.p[2][l]}, w->eps, {0, 0, 0}, INFINITY};
-        if ((out.shadow >> l) & 1) {
-          /* Traced from the light to just short of the surface, so that a
-           * block's shadow rays share an origin and a large packet's frustum
-           * one apex (whitted packet16x16: museum's shadow stage -20%,
-           * kitchen's -12%; the stream kernels and Embree don't mind). The
-           * light's own end skips 1e-4 of the way, for a light on a surface. */
-          const float dist = out.ldist[l];
-          const fr_ray from_light = {{w->view.light.x, w->view.light.y, w->view.light.z}, dist * 1e-4f,
-                                     {-out.l[0][l], -out.l[1][l], -out.l[2][l]}, dist - w->eps};
-          S->shadow.r[ns] = from_light;
-          S->shadow.p[ns++] = (fr_wpath){{out.lw[0][l], out.lw[1][l], out.lw[2][l]}, g->pix, (uint16_t)(g->key / 2)};
-        }
-        if ((out.refl >> l) & 1) {
-          fr_ray *r = &S->next.r[nn];
-          *r = base;
-          r->dir[0] = out.rd[0][l]; r->dir[1] = out.rd[1][l]; r->dir[2] = out.rd[2][l];
-          S->next.p[nn++] = (fr_wpath){{out.rw[0][l], out.rw[1][l], out.rw[2][l]}, g->pix, (uint16_t)(g->key & ~1u)};
-        }
-        if ((out.refr >> l) & 1) {
-          fr_ray *r = &S->next.r[nn];
-          *r = base;
-          r->dir[0] = out.td[0][l]; r->dir[1] = out.td[1][l]; r->dir[2] = out.td[2][l];
-          S->next.p[nn++] = (fr_wpath){{out.tw[0][l], out.tw[1][l], out.tw[2][l]}, g->pix, (uint16_t)(g->key | 1u)};
-        }
       }
+      /* Shadow rays are traced from the light to just short of the
+       * surface, so that a block's shadow rays share an origin and a large
+       * packet's frustum one apex (whitted packet16x16: museum's shadow
+       * stage -20%, kitchen's -12%; the stream kernels and Embree don't
+       * mind). The light's own end skips 1e-4 of the way, for a light on a
+       * surface. */
+      fr_whitted_emit16(&out, in.light, w->eps, &shadow, &next);
     }
+    const size_t ns = shadow.n, nn = next.n;
     /* shadow rays, packet by packet (they follow their block's order) */
     const double t_shadow = fr_seconds();
     if (t->occluded_frusta && depth == 0) trace_shadow_frusta(w, t, S->shadow.r, S->occ, ns);

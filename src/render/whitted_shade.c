@@ -82,6 +82,7 @@ void FR_ISA_FN(fr_whitted_shade16)(const fr_wshade_in *in, fr_wshade_out *out) {
   vp_load_records4((const float *)path, pf);
   vp_load_records4((const float *)surf, sf);
   v3p o = {rf[0], rf[1], rf[2]}, d = {rf[4], rf[5], rf[6]}, w = {pf[0], pf[1], pf[2]};
+  vp_store((float *)out->pk, pf[3]);
   vpf t = vp_gather(hf + offsetof(fr_hit, t) / sizeof(float), hi);
   vpm hit = vpm_bits_to(in->hits);
 
@@ -158,5 +159,55 @@ void FR_ISA_FN(fr_whitted_shade16)(const fr_wshade_in *in, fr_wshade_out *out) {
   if (out->refr) {
     v3p_store(out->td, v3p_norm(tdir));
     v3p_store(out->tw, wt);
+  }
+}
+
+/* Lanes `mask` of the 16 records just stored at r[0..16), p[0..16) moved
+ * down to r[0..popcount), in lane order. */
+static void compact(fr_ray *r, fr_wpath *p, unsigned mask) {
+  if (mask == (1u << FR_WS_LANES) - 1u) return;
+  for (size_t j = 0; mask; mask &= mask - 1, j++) {
+    int l = __builtin_ctz(mask);
+    r[j] = r[l];
+    p[j] = p[l];
+  }
+}
+
+/* Appends lanes `mask` of rays (org, tnear, dir, tfar) carrying (w, pk) to k:
+ * all 16 records stored at once (two transposes), then the absent ones
+ * squeezed out. */
+static void emit(fr_wsink *k, unsigned mask, v3p org, vpf tnear, v3p dir, vpf tfar, v3p w, const uint32_t *pk) {
+  if (!mask) return;
+  vpf rec[8] = {org.x, org.y, org.z, tnear, dir.x, dir.y, dir.z, tfar};
+  vpf path[4] = {w.x, w.y, w.z, vp_load((const float *)pk)};
+  vp_store_records((float *)(k->r + k->n), rec, 8);
+  vp_store_records4((float *)(k->p + k->n), path);
+  compact(k->r + k->n, k->p + k->n, mask);
+  k->n += (size_t)__builtin_popcount(mask);
+}
+
+FR_INLINE v3p v3p_load(const float (*a)[FR_WS_LANES]) { v3p r = {vp_load(a[0]), vp_load(a[1]), vp_load(a[2])}; return r; }
+
+void FR_ISA_FN(fr_whitted_emit16)(const fr_wshade_out *out, const float light[3], float eps, fr_wsink *shadow,
+                                  fr_wsink *next) {
+  uint32_t pk[FR_WS_LANES] __attribute__((aligned(64)));
+  if (out->shadow) {
+    /* shadow rays carry key / 2: their block's packet */
+    for (int l = 0; l < FR_WS_LANES; l++) pk[l] = (out->pk[l] & 0xFFFFu) | ((out->pk[l] >> 17) << 16);
+    vpf dist = vp_load(out->ldist);
+    v3p l = v3p_load(out->l);
+    v3p from = {vp_neg(l.x), vp_neg(l.y), vp_neg(l.z)};
+    emit(shadow, out->shadow, v3p_splat(light), vp_mul(dist, vp(1e-4f)), from, vp_sub(dist, vp(eps)),
+         v3p_load(out->lw), pk);
+  }
+  if (!(out->refl | out->refr)) return;
+  v3p p = v3p_load(out->p);
+  if (out->refl) {
+    for (int l = 0; l < FR_WS_LANES; l++) pk[l] = out->pk[l] & ~(1u << 16); /* key & ~1 */
+    emit(next, out->refl, p, vp(eps), v3p_load(out->rd), vp(INFINITY), v3p_load(out->rw), pk);
+  }
+  if (out->refr) {
+    for (int l = 0; l < FR_WS_LANES; l++) pk[l] = out->pk[l] | (1u << 16); /* key | 1 */
+    emit(next, out->refr, p, vp(eps), v3p_load(out->td), vp(INFINITY), v3p_load(out->tw), pk);
   }
 }

@@ -61,8 +61,17 @@ typedef struct fr_wshade_out {
   float lw[3][FR_WS_LANES] __attribute__((aligned(64)));  /* shadow ray: direction to the light, distance, weight if unoccluded */
   float rd[3][FR_WS_LANES] __attribute__((aligned(64))), rw[3][FR_WS_LANES] __attribute__((aligned(64)));
   float td[3][FR_WS_LANES] __attribute__((aligned(64))), tw[3][FR_WS_LANES] __attribute__((aligned(64)));
+  uint32_t pk[FR_WS_LANES] __attribute__((aligned(64))); /* each lane's pix | key << 16, as read */
   unsigned shadow, refl, refr; /* lanes that spawn a shadow, reflection, refraction ray */
 } fr_wshade_out;
+
+/* Where new rays go: n of them so far, room for 16 more (32 for a sink that
+ * takes reflection and refraction rays). */
+typedef struct fr_wsink {
+  fr_ray *r;
+  fr_wpath *p;
+  size_t n;
+} fr_wsink;
 
 #define FR_WHITTED_MIN_WEIGHT 0.01f /* secondary rays carrying less are not traced */
 #define FR_WHITTED_AMBIENT 0.1f
@@ -72,6 +81,17 @@ typedef struct fr_wshade_out {
 FR_DECLARE_WSHADE(avx512)
 FR_DECLARE_WSHADE(avx2)
 FR_DECLARE_WSHADE(scalar)
+/* The rays 16 shaded hits spawn, appended in lane order: shadow rays
+ * (traced from the light to eps short of the hit; see whitted.c) to
+ * `shadow`, then the reflection rays and then the refraction rays to
+ * `next` (whose order within a packet the renderer's sort by key keeps). */
+#define FR_DECLARE_WEMIT(isa)                                                                                  \
+  void fr_whitted_emit16_##isa(const fr_wshade_out *out, const float light[3], float eps, fr_wsink *shadow, \
+                               fr_wsink *next);
+FR_DECLARE_WEMIT(avx512)
+FR_DECLARE_WEMIT(avx2)
+FR_DECLARE_WEMIT(scalar)
 /* the level fr_kernels_active() chose */
 void fr_whitted_shade16(const fr_wshade_in *in, fr_wshade_out *out);
+void fr_whitted_emit16(const fr_wshade_out *out, const float light[3], float eps, fr_wsink *shadow, fr_wsink *next);
 #endif
