@@ -312,7 +312,8 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
       if (qx + 16 > W || qy + 16 > H) continue;
       fr_camera_frusta(w, t, qx, qy, S->cur.r + n, S->hits + n);
       const int corner = (qy - ty) * WT + (qx - tx);
-      for (int i = 0; i < 256; i++, n++) S->cur.p[n] = (fr_wpath){{1.0f, 1.0f, 1.0f}, (uint16_t)(corner + (int)frustum_pix((unsigned)i)), 0};
+      for (int i = 0; i < 256; i++, n++)
+        S->cur.p[n] = (fr_wpath){{1.0f, 1.0f, 1.0f}, (uint16_t)(corner + (int)frustum_pix((unsigned)i)), 0};
     }
     traced = n;
   }

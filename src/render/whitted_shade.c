@@ -186,7 +186,10 @@ static void emit(fr_wsink *k, unsigned mask, v3p org, vpf tnear, v3p dir, vpf tf
   k->n += (size_t)__builtin_popcount(mask);
 }
 
-FR_INLINE v3p v3p_load(const float (*a)[FR_WS_LANES]) { v3p r = {vp_load(a[0]), vp_load(a[1]), vp_load(a[2])}; return r; }
+FR_INLINE v3p v3p_load(const float (*a)[FR_WS_LANES]) {
+  v3p r = {vp_load(a[0]), vp_load(a[1]), vp_load(a[2])};
+  return r;
+}
 
 void FR_ISA_FN(fr_whitted_emit16)(const fr_wshade_out *out, const float light[3], float eps, fr_wsink *shadow,
                                   fr_wsink *next) {
