@@ -256,14 +256,20 @@ FR_INLINE unsigned leaf_tri_cull(frusta *F, const fr_bvh2_tri *r, unsigned m, co
   return left;
 }
 
-/* Frustum f's 16 rays against the triangle of X: the rays hit in (tnear,
- * tcur); *t, *u, *v their hits. */
-FR_INLINE unsigned ray_test(const frusta *F, const tri_frusta *X, const fr_bvh2_tri *r, int f, vpf tcur,
-                            unsigned rays, vpf *t_out, vpf *u_out, vpf *v_out) {
+/* Frustum f's 16 ray directions, made from its start vector and deltas. */
+typedef struct frustum_dirs { vpf x, y, z; } frustum_dirs;
+FR_INLINE frustum_dirs dirs_of(const frusta *F, int f) {
   const fr_mft_set *S = F->set[f];
-  vpf dx = vp_add(vp(F->s[0][f]), vp_load(S->dx));
-  vpf dy = vp_add(vp(F->s[1][f]), vp_load(S->dy));
-  vpf dz = vp_add(vp(F->s[2][f]), vp_load(S->dz));
+  frustum_dirs d = {vp_add(vp(F->s[0][f]), vp_load(S->dx)), vp_add(vp(F->s[1][f]), vp_load(S->dy)),
+                    vp_add(vp(F->s[2][f]), vp_load(S->dz))};
+  return d;
+}
+
+/* Frustum f's 16 rays (directions D) against the triangle of X: the rays
+ * hit in (tnear, tcur); *t, *u, *v their hits. */
+FR_INLINE unsigned ray_test_dirs(const frusta *F, const frustum_dirs *D, const tri_frusta *X, const fr_bvh2_tri *r,
+                                 int f, vpf tcur, unsigned rays, vpf *t_out, vpf *u_out, vpf *v_out) {
+  const vpf dx = D->x, dy = D->y, dz = D->z;
   vpf w[3], E[3][3];
   for (int i = 0; i < 3; i++)
     for (int a = 0; a < 3; a++) E[i][a] = vp(X->e[i][a][f]);
@@ -279,6 +285,12 @@ FR_INLINE unsigned ray_test(const frusta *F, const tri_frusta *X, const fr_bvh2_
   *u_out = vp_mul(w[1], inv);
   *v_out = vp_mul(w[2], inv);
   return m;
+}
+
+FR_INLINE unsigned ray_test(const frusta *F, const tri_frusta *X, const fr_bvh2_tri *r, int f, vpf tcur,
+                            unsigned rays, vpf *t_out, vpf *u_out, vpf *v_out) {
+  const frustum_dirs D = dirs_of(F, f);
+  return ray_test_dirs(F, &D, X, r, f, tcur, rays, t_out, u_out, v_out);
 }
 
 /* The rays of frustum f (among `rays`) whose slab test reaches box k of node
@@ -434,7 +446,7 @@ out:
 static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B, const fr_mft_sets *T,
                               fr_mft_hits *H) {
   frusta F;
-  tri_frusta X;
+  tri_frusta X[FR_BVH2_MAX_LEAF]; /* a leaf's triangles' edges for all frusta */
   unsigned valid = B->valid & 0xFFFFu;
   /* t starts at tfar: a hit must come nearer (reset to +inf for misses at the end) */
   for (int f = 0; f < 16; f++)
@@ -462,21 +474,36 @@ static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr
       static const unsigned all[16] = {0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu,
                                        0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu};
       unsigned changed = 0, rays[16], m = leaf_rays(&F, &e, e.mask, all, (const float(*)[16])H->t, rays);
-      if (m) fetched += count;
-      for (uint32_t i = first; i < first + count && m; i++) {
-        const fr_bvh2_tri *r = &b->tris[i];
-        unsigned left = leaf_tri_cull(&F, r, m, opt, &X);
-        for (; left; left &= left - 1) {
-          int f = __builtin_ctz(left);
-          vpf tb = vp_load(H->t[f]), t, u, v;
-          unsigned hit = ray_test(&F, &X, r, f, tb, rays[f], &t, &u, &v);
+      if (!m) break;
+      fetched += count;
+      /* First every triangle's cull, then frustum by frustum the triangles
+       * left to it, in leaf order (so each ray meets its triangles in the
+       * same order as triangle by triangle, and keeps the same nearest
+       * hit): a frustum's directions and nearest hits stay in registers
+       * across the leaf instead of being made and reloaded per test. */
+      unsigned left[FR_BVH2_MAX_LEAF], any = 0;
+      for (uint32_t k = 0; k < count; k++) any |= left[k] = leaf_tri_cull(&F, &b->tris[first + k], m, opt, &X[k]);
+      for (; any; any &= any - 1) {
+        const int f = __builtin_ctz(any);
+        const frustum_dirs D = dirs_of(&F, f);
+        vpf tb = vp_load(H->t[f]), ub = vp_load(H->u[f]), vb = vp_load(H->v[f]);
+        for (uint32_t k = 0; k < count; k++) {
+          if (!((left[k] >> f) & 1)) continue;
+          const fr_bvh2_tri *r = &b->tris[first + k];
+          vpf t, u, v;
+          unsigned hit = ray_test_dirs(&F, &D, &X[k], r, f, tb, rays[f], &t, &u, &v);
           if (!hit) continue;
           vpm hm = vpm_bits_to(hit);
-          vp_store(H->t[f], vp_select(hm, t, tb));
-          vp_store(H->u[f], vp_select(hm, u, vp_load(H->u[f])));
-          vp_store(H->v[f], vp_select(hm, v, vp_load(H->v[f])));
+          tb = vp_select(hm, t, tb);
+          ub = vp_select(hm, u, ub);
+          vb = vp_select(hm, v, vb);
           for (unsigned mm = hit; mm; mm &= mm - 1) H->prim[f][__builtin_ctz(mm)] = r->prim;
           changed |= 1u << f;
+        }
+        if ((changed >> f) & 1) {
+          vp_store(H->t[f], tb);
+          vp_store(H->u[f], ub);
+          vp_store(H->v[f], vb);
         }
       }
       /* the frusta with hits now end at their farthest ray's hit (open until all rays hit) */
