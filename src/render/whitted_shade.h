@@ -4,10 +4,11 @@
  * Compiled once per ISA (src/render/whitted_shade.c); every level gives the
  * same bits as the others.
  *
- * The renderer (whitted.c) fetches what each hit needs from memory, the
- * geometric normal and the material, and afterwards writes the rays out;
- * this is the arithmetic between, which as scalar code with a branch per
- * material kind took about a third of a Whitted frame.
+ * The renderer (whitted.c) fetches what each hit needs from memory, its
+ * surface record (geometric normal and material); fr_whitted_shade16 does
+ * the arithmetic, which as scalar code with a branch per material kind took
+ * about a third of a Whitted frame, reading rays and records whole; and
+ * fr_whitted_emit16 writes the new rays out 16 at a time.
  */
 #ifndef FR_RENDER_WHITTED_SHADE_H
 #define FR_RENDER_WHITTED_SHADE_H
