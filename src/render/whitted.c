@@ -343,7 +343,7 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
     fr_wsink shadow = {S->shadow.r, S->shadow.p, 0}, next = {S->next.r, S->next.p, 0};
     /* First what each hit needs from memory, its material and normal, in a
      * loop short enough that the cache misses of many hits overlap; then the
-     * arithmetic 16 hits at a time; then the new rays, in ray order. */
+     * arithmetic 16 hits at a time, and the new rays each group spawns. */
     for (size_t i = 0; i < n; i++) {
       const fr_hit *h = &S->hits[i];
       fr_whitted_tri *sf = &S->surf[i];
@@ -392,8 +392,10 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
     S->stage[FR_STAGE_SHADOW] += ds;
     traced_s += ds;
     rays += ns;
-    for (size_t i = 0; i < ns; i++)
-      if (!S->occ[i]) S->colour[S->shadow.p[i].pix] = v3_add(S->colour[S->shadow.p[i].pix], v3_load(S->shadow.p[i].w));
+    for (size_t i = 0; i < ns; i++) {
+      const fr_wpath *g = &S->shadow.p[i];
+      if (!S->occ[i]) S->colour[g->pix] = v3_add(S->colour[g->pix], v3_load(g->w));
+    }
     /* the next generation grouped by key: reflection and refraction packets of each block */
     size_t count[2 * WT_PIX + 1];
     memset(count, 0, (2 * (size_t)(per * per) + 1) * sizeof count[0]);
