@@ -173,7 +173,8 @@ int fr_occluded1(const fr_scene *s, const fr_ray *ray);
  * to trace; lanes not in valid are neither read nor written. The packet
  * traverses the BVH together (8-wide by default, see packet_bvh_width) and,
  * when few of its rays are left in a subtree, continues them one by one (the
- * hybrid of Benthin et al.); the threshold is fr_trace_options.hybrid_threshold. Answers agree with
+ * hybrid of Benthin et al.); the threshold is fr_trace_options.hybrid_threshold, or for a
+ * packet whose rays share a direction octant coherent_threshold if smaller. Answers agree with
  * fr_intersect1's ray by ray (same t; the packet's triangle test is not
  * watertight, so a ray exactly through a shared edge may report either
  * triangle, or, rarely, miss where fr_intersect1 hits). See
@@ -229,9 +230,10 @@ typedef struct fr_trace_options {
                              lie within this distance of its first ray's (probed at 3 rays), else
                              in a ray stream; 0..2: 0 streams every group, 2 none (default
                              FR_STREAM_SPREAD_DEFAULT) */
-  int coherent_threshold; /* FR_TRACE_AUTO: its coherent groups are hybrid packets that drop to
-                             single rays at this many active rays, 0..16 (default 2, as Embree's
-                             coherent packets; hybrid_threshold is FR_TRACE_HYBRID16's) */
+  int coherent_threshold; /* packets known to be coherent drop to single rays at this many active
+                             rays, 0..16 (default 2, as Embree's coherent packets): FR_TRACE_AUTO's
+                             coherent groups, and FR_TRACE_HYBRID16's packets whose rays share a
+                             direction octant (those take the smaller of the two thresholds) */
 } fr_trace_options;
 #define FR_STREAM_SPREAD_DEFAULT 0.1f
 

@@ -61,21 +61,22 @@ typedef struct config {
   fr_trace_mode mode;
   int threshold, width, mailbox, axis_aligned, ia, prefetch;
   float spread; /* auto's stream_spread; 0: the default */
+  int coherent; /* coherent_threshold, which hybrid16's one-octant packets use too; 0: the default */
 } config;
 static const config configs[] = {
-    {"packet16", FR_TRACE_PACKET16, 0, 4, 0, 1, 1, 0, 0.0f},  {"packet8", FR_TRACE_PACKET8, 0, 4, 0, 1, 1, 0, 0.0f},
-    {"hybrid16", FR_TRACE_HYBRID16, 7, 4, 0, 1, 1, 0, 0.0f},  {"hybrid16/t3", FR_TRACE_HYBRID16, 3, 4, 0, 1, 1, 0, 0.0f},
-    {"hybrid16/t16", FR_TRACE_HYBRID16, 16, 4, 0, 1, 1, 0, 0.0f}, {"packet16/bvh8", FR_TRACE_PACKET16, 0, 8, 0, 1, 1, 0, 0.0f},
-    {"hybrid16/bvh8", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 0, 0.0f}, {"packet16/mailbox", FR_TRACE_PACKET16, 0, 4, 1, 1, 1, 0, 0.0f},
-    {"packet16/no-aa", FR_TRACE_PACKET16, 0, 4, 0, 0, 1, 0, 0.0f}, {"packet16/no-ia", FR_TRACE_PACKET16, 0, 4, 0, 1, 0, 0, 0.0f},
-    {"auto", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0, 0.0f},
+    {"packet16", FR_TRACE_PACKET16, 0, 4, 0, 1, 1, 0, 0.0f, 0},  {"packet8", FR_TRACE_PACKET8, 0, 4, 0, 1, 1, 0, 0.0f, 0},
+    {"hybrid16", FR_TRACE_HYBRID16, 7, 4, 0, 1, 1, 0, 0.0f, 0},  {"hybrid16/t3", FR_TRACE_HYBRID16, 3, 4, 0, 1, 1, 0, 0.0f, 3},
+    {"hybrid16/t16", FR_TRACE_HYBRID16, 16, 4, 0, 1, 1, 0, 0.0f, 16}, {"packet16/bvh8", FR_TRACE_PACKET16, 0, 8, 0, 1, 1, 0, 0.0f, 0},
+    {"hybrid16/bvh8", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 0, 0.0f, 0}, {"packet16/mailbox", FR_TRACE_PACKET16, 0, 4, 1, 1, 1, 0, 0.0f, 0},
+    {"packet16/no-aa", FR_TRACE_PACKET16, 0, 4, 0, 0, 1, 0, 0.0f, 0}, {"packet16/no-ia", FR_TRACE_PACKET16, 0, 4, 0, 1, 0, 0, 0.0f, 0},
+    {"auto", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0, 0.0f, 0},
     /* auto with every group a packet, and with the packet/stream split
        inside the camera and shadow packets too */
-    {"auto/packets", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0, 2.0f},
-    {"auto/split", FR_TRACE_AUTO, 7, 8, 0, 1, 1, 0, 0.1f},
-    {"raystream", FR_TRACE_RAYSTREAM, 7, 4, 0, 1, 1, 0, 0.0f},
+    {"auto/packets", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0, 2.0f, 0},
+    {"auto/split", FR_TRACE_AUTO, 7, 8, 0, 1, 1, 0, 0.1f, 0},
+    {"raystream", FR_TRACE_RAYSTREAM, 7, 4, 0, 1, 1, 0, 0.0f, 0},
     /* prefetching, which these small scenes leave off by default */
-    {"hybrid16/bvh8/prefetch", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 1, 0.0f},
+    {"hybrid16/bvh8/prefetch", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 1, 0.0f, 0},
 };
 #define NCONFIGS (sizeof configs / sizeof configs[0])
 
@@ -90,6 +91,7 @@ static void set_config(fr_scene *s, const config *c) {
   o.ia_cull = c->ia;
   o.prefetch = c->prefetch ? 1 : -1;
   if (c->spread > 0.0f) o.stream_spread = c->spread;
+  if (c->coherent > 0) o.coherent_threshold = c->coherent;
   assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
 }
 
@@ -243,7 +245,7 @@ static void test_leaf_against_scalar(void **st) {
       if (!fr_isa_supported((fr_isa)isa)) continue;
       fr_set_isa((fr_isa)isa);
       for (int aa = 0; aa < 2; aa++) {
-        config c = {"leaf", FR_TRACE_PACKET16, 0, 4, 0, aa, 1, 0, 0.0f};
+        config c = {"leaf", FR_TRACE_PACKET16, 0, 4, 0, aa, 1, 0, 0.0f, 0};
         set_config(s, &c);
         fr_tri_shevtsov use = rec;
         if (!aa) use.axis_aligned = 0;

@@ -61,6 +61,7 @@ static const fr_packet_fns *packet_fns(const fr_scene *s, int size, int threshol
   int w8 = s->trace.packet_bvh_width == 8;
   *b = w8 ? &s->bvh8 : &s->bvh4;
   po->hybrid_threshold = threshold;
+  po->uniform_threshold = threshold < s->trace.coherent_threshold ? threshold : s->trace.coherent_threshold;
   po->mailbox = s->trace.mailbox;
   po->axis_aligned = s->trace.axis_aligned;
   po->ia_cull = s->trace.ia_cull;

@@ -17,7 +17,11 @@
  *
  * The hybrid: on each pop, if at most hybrid_threshold rays are still active
  * in the popped subtree, they finish it one by one with the single-ray kernel
- * of the same ISA and width, and the packet goes on with the next pop.
+ * of the same ISA and width, and the packet goes on with the next pop. A
+ * packet whose rays share a direction octant uses uniform_threshold instead:
+ * its few remaining rays still visit nearly the same nodes, and the MIC
+ * paper's 7 left such packets 3-10% behind plain packets (README,
+ * Performance, "The hybrid's threshold for one-octant packets").
  *
  * Compiled once per ISA, packet size (FR_PACKET) and BVH width (FR_WIDTH).
  */
@@ -389,6 +393,7 @@ static void finish(const fr_bvhn *b, const packet *pk, const uint32_t *best, vpf
 static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in, hit_regs *out) {
   packet pk;
   valid = packet_setup(&pk, valid, in);
+  const int threshold = pk.uniform ? o->uniform_threshold : o->hybrid_threshold;
   FR_COUNT(packets, 1);
   FR_COUNT(rays, __builtin_popcount(valid));
   /* Each lane's best triangle (4 * block + lane) as the bits of a float, in
@@ -428,7 +433,7 @@ static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
     }
     if (!active) continue;
     int nactive = __builtin_popcount(active);
-    if (nactive <= o->hybrid_threshold && !(ref & FR_BVHN_LEAF)) {
+    if (nactive <= threshold && !(ref & FR_BVHN_LEAF)) {
       FR_COUNT(switches, 1);
       FR_COUNT(switch_rays, nactive);
       float TF[P] __attribute__((aligned(64))), UU[P] __attribute__((aligned(64))), VV[P] __attribute__((aligned(64)));
@@ -562,6 +567,7 @@ static void intersect_rays_idx(const fr_bvhn *b, const fr_packet_opts *o, const 
 static unsigned occluded_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in) {
   packet pk;
   valid = packet_setup(&pk, valid, in);
+  const int threshold = pk.uniform ? o->uniform_threshold : o->hybrid_threshold;
   FR_COUNT(packets, 1);
   FR_COUNT(rays, __builtin_popcount(valid));
   pregs R;
@@ -590,7 +596,7 @@ static unsigned occluded_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigne
     }
     if (!active) continue;
     int nactive = __builtin_popcount(active);
-    if (nactive <= o->hybrid_threshold && !(ref & FR_BVHN_LEAF)) {
+    if (nactive <= threshold && !(ref & FR_BVHN_LEAF)) {
       FR_COUNT(switches, 1);
       FR_COUNT(switch_rays, nactive);
       for (unsigned m = active; m; m &= m - 1) {

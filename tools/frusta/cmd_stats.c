@@ -14,8 +14,10 @@
 #include "render/workload.h"
 #include "trace/counters.h"
 
-/* Table V: runs the workload once in hybrid16 mode with the counters on. */
-static int table5(const char *path, const cli_view *v, int threads, const char *wl_name, int threshold, int width) {
+/* Table V: runs the workload once in hybrid16 mode with the counters on.
+ * coherent < 0: the library's coherent_threshold. */
+static int table5(const char *path, const cli_view *v, int threads, const char *wl_name, int threshold, int coherent,
+                  int width) {
   fr_workload_kind k;
   if (!fr_workload_parse(wl_name, &k)) return cli_error(CLI_USAGE_ERROR, "unknown workload '%s'", wl_name);
   if (!fr_counters_enabled())
@@ -39,6 +41,7 @@ static int table5(const char *path, const cli_view *v, int threads, const char *
   fr_trace_options_default(&o);
   o.mode = FR_TRACE_HYBRID16;
   o.hybrid_threshold = threshold;
+  if (coherent >= 0) o.coherent_threshold = coherent;
   o.packet_bvh_width = width;
   fr_scene_set_trace_options(s, &o);
   fr_tracer t = fr_tracer_frusta(s);
@@ -49,11 +52,11 @@ static int table5(const char *path, const cli_view *v, int threads, const char *
   double box_p = (double)c.pk_box_lanes, box_s = (double)c.box_tests;
   double tri_p = (double)c.pk_tri_lanes, tri_s = (double)c.tri_tests;
   double box = box_p + box_s, tri = tri_p + tri_s;
-  printf("table5 scene=%s workload=%s threshold=%d packet_bvh_width=%d rays=%llu packets=%llu "
+  printf("table5 scene=%s workload=%s threshold=%d coherent_threshold=%d packet_bvh_width=%d rays=%llu packets=%llu "
          "box_tests_packet=%.1f%% box_tests_single=%.1f%% tri_tests_packet=%.1f%% tri_tests_single=%.1f%% "
          "switches_per_packet=%.2f rays_per_switch=%.2f avg_active_box=%.2f avg_active_tri=%.2f ia_culled_per_packet=%.2f "
          "mailbox_hits_per_packet=%.3f\n",
-         s->name, wl_name, threshold, width, (unsigned long long)r.rays, (unsigned long long)c.packets,
+         s->name, wl_name, threshold, o.coherent_threshold, width, (unsigned long long)r.rays, (unsigned long long)c.packets,
          box > 0 ? 100.0 * box_p / box : 0.0, box > 0 ? 100.0 * box_s / box : 0.0, tri > 0 ? 100.0 * tri_p / tri : 0.0,
          tri > 0 ? 100.0 * tri_s / tri : 0.0, c.packets ? (double)c.switches / c.packets : 0.0,
          c.switches ? (double)c.switch_rays / c.switches : 0.0, c.pk_box_tests ? (double)c.pk_box_lanes / c.pk_box_tests : 0.0,
@@ -66,7 +69,7 @@ static int table5(const char *path, const cli_view *v, int threads, const char *
 
 int cmd_stats(int argc, char **argv) {
   const char *path = NULL, *workload = NULL;
-  int embree = 0, threads = omp_get_num_procs(), threshold = 7, width = 8;
+  int embree = 0, threads = omp_get_num_procs(), threshold = 7, coherent = -1, width = 8;
   cli_view v;
   memset(&v, 0, sizeof v);
   v.width = 1024; v.height = 1024;
@@ -78,6 +81,8 @@ int cmd_stats(int argc, char **argv) {
     else if (strcmp(argv[i], "--workload") == 0 && i + 1 < argc) workload = argv[++i];
     else if (strcmp(argv[i], "--threshold") == 0 && i + 1 < argc) {
       if (!cli_parse_int(argv[++i], 0, 16, &threshold)) return cli_error(CLI_USAGE_ERROR, "--threshold wants 0..16");
+    } else if (strcmp(argv[i], "--coherent-threshold") == 0 && i + 1 < argc) {
+      if (!cli_parse_int(argv[++i], 0, 16, &coherent)) return cli_error(CLI_USAGE_ERROR, "--coherent-threshold wants 0..16");
     } else if (strcmp(argv[i], "--packet-width") == 0 && i + 1 < argc) {
       if (!cli_parse_int(argv[++i], 4, 8, &width) || (width != 4 && width != 8)) return cli_error(CLI_USAGE_ERROR, "--packet-width is 4 or 8");
     }
@@ -89,9 +94,9 @@ int cmd_stats(int argc, char **argv) {
     } else return cli_error(CLI_USAGE_ERROR, "stats: unknown option '%s'", argv[i]);
   }
   if (!path)
-    return cli_error(CLI_USAGE_ERROR, "usage: frusta stats SCENE|--builtin [--embree] [--threads N] [--workload W [--threshold N] [--packet-width 4|8] [view flags]]");
+    return cli_error(CLI_USAGE_ERROR, "usage: frusta stats SCENE|--builtin [--embree] [--threads N] [--workload W [--threshold N] [--coherent-threshold N] [--packet-width 4|8] [view flags]]");
   omp_set_num_threads(threads);
-  if (workload) return table5(path, &v, threads, workload, threshold, width);
+  if (workload) return table5(path, &v, threads, workload, threshold, coherent, width);
   fr_scene *s;
   int lrc = cli_load_scene(path, &s);
   if (lrc) return lrc;

@@ -22,7 +22,7 @@ static void usage(FILE *f) {
           "         embree modes: single packet4 packet8 packet16 stream\n"
           "         packets:      [--threshold N] [--packet-width 4|8] [--mailbox on|off] [--axis-aligned on|off]\n"
           "                       [--ia on|off]\n"
-          "         auto:         [--stream-spread S] [--coherent-threshold N]\n"
+          "         auto:         [--stream-spread S] [--coherent-threshold N] (also hybrid16's one-octant packets)\n"
           "         single rays:  [--prefetch on|off|auto]\n"
           "         multi-frusta: [--light-sets spread|cells] [--corner-rays on|off] [--corner-cost C]\n"
           "                       [--shrink on|corners|off] [--mft-leaf N] [--mft-fallback on|off]\n"
@@ -30,7 +30,7 @@ static void usage(FILE *f) {
           "         whitted:      [--mirror NAME,..|all] [--glass NAME,..] [--depth N]\n"
           "  trace  SCENE RAYS --query closest|any --out FILE [--tracer frusta|embree]\n"
           "         [--mode single|packet8|packet16|hybrid16|auto|raystream]\n"
-          "  stats  SCENE|--builtin [--embree] [--workload W [--threshold N] [--packet-width 4|8]]\n"
+          "  stats  SCENE|--builtin [--embree] [--workload W [--threshold N] [--coherent-threshold N] [--packet-width 4|8]]\n"
           "Scenes: PLY, OBJ(+MTL) and what Assimp reads, optionally .zst. FRUSTA_ISA=avx512|avx2|scalar forces an ISA.\n");
 }
 
