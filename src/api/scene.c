@@ -190,6 +190,37 @@ fr_error fr_scene_build_bvh2(fr_scene *s, int max_leaf, fr_bvh2 *out) {
   return e;
 }
 
+/* The traversal structures, all made from one tree and independent of each
+ * other but for the multi-frusta tree, a copy cut from the binary one. Each
+ * conversion is serial, so two threads share them: the BVH8 (single rays
+ * and packets) on one, the rest on the other. In a row they took 57% of
+ * conference's commit and 59% of dragon's. An error is raised again on the
+ * calling thread, whose message is the one fr_last_error reads. */
+static fr_error convert_tree(fr_scene *s, const fr_build_tree *tree) {
+  const fr_mesh *m = &s->mesh;
+  fr_error e[2] = {FR_OK, FR_OK};
+  char msg[2][256] = {"", ""};
+#pragma omp parallel sections
+  {
+#pragma omp section
+    {
+      e[0] = fr_bvhn_from_build(tree, m, 8, &s->bvh8);
+      if (e[0]) snprintf(msg[0], sizeof msg[0], "%s", fr_last_error());
+    }
+#pragma omp section
+    {
+      e[1] = fr_bvh2_from_build(tree, m, FR_BUILD_MAX_LEAF, &s->bvh2);
+      if (!e[1]) e[1] = fr_bvh2_shallow(tree, &s->bvh2, FR_MFT_LEAF, &s->bvh2_mft);
+      if (!e[1]) e[1] = fr_bvhn_from_build(tree, m, 4, &s->bvh4);
+      if (!e[1]) e[1] = fr_sphere_bvh_build(&s->spheres, &s->sphere_bvh);
+      if (e[1]) snprintf(msg[1], sizeof msg[1], "%s", fr_last_error());
+    }
+  }
+  for (int i = 0; i < 2; i++)
+    if (e[i]) return fr_fail(e[i], "%s", msg[i]);
+  return FR_OK;
+}
+
 fr_error fr_scene_commit(fr_scene *s) {
   if (!s) return fr_fail(FR_ERR_ARG, "fr_scene_commit: scene is NULL");
   if (s->committed) return FR_OK;
@@ -200,11 +231,7 @@ fr_error fr_scene_commit(fr_scene *s) {
   fr_error e = build_tree(s, &tree, &n);
   if (e) return e;
   s->skipped = m->ntris - n;
-  e = fr_bvh2_from_build(&tree, m, FR_BUILD_MAX_LEAF, &s->bvh2);
-  if (!e) e = fr_bvh2_shallow(&tree, &s->bvh2, FR_MFT_LEAF, &s->bvh2_mft);
-  if (!e) e = fr_bvhn_from_build(&tree, m, 4, &s->bvh4);
-  if (!e) e = fr_bvhn_from_build(&tree, m, 8, &s->bvh8);
-  if (!e) e = fr_sphere_bvh_build(&s->spheres, &s->sphere_bvh);
+  e = convert_tree(s, &tree);
   fr_build_tree_free(&tree);
   if (e) {
     fr_bvh2_free(&s->bvh2_mft); fr_bvh2_free(&s->bvh2); fr_bvhn_free(&s->bvh4); fr_bvhn_free(&s->bvh8); fr_bvh2_free(&s->sphere_bvh);
