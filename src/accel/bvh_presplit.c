@@ -131,9 +131,10 @@ fr_error fr_presplit(const fr_mesh *m, aabb scene, float budget, double min_shar
     np[i] = k < np[i] ? k : np[i];
     pieces += (size_t)np[i];
   }
-  out_refs o = {malloc(fr_mul_size(pieces, sizeof(aabb))), malloc(fr_mul_size(pieces, sizeof(uint32_t))), 0};
+  out_refs o = {fr_alloc_aligned(fr_mul_size(pieces, sizeof(aabb)), 64),
+               fr_alloc_aligned(fr_mul_size(pieces, sizeof(uint32_t)), 64), 0};
   if (!o.boxes || !o.ids) {
-    free(ex); free(np); free(o.boxes); free(o.ids);
+    free(ex); free(np); fr_free_aligned(o.boxes); fr_free_aligned(o.ids);
     return fr_fail(FR_ERR_NOMEM, "presplit: out of memory for %zu references", pieces);
   }
   for (size_t i = 0; i < count; i++) {
@@ -149,8 +150,8 @@ fr_error fr_presplit(const fr_mesh *m, aabb scene, float budget, double min_shar
   }
   free(ex);
   free(np);
-  free(*boxes);
-  free(*ids);
+  fr_free_aligned(*boxes);
+  fr_free_aligned(*ids);
   *boxes = o.boxes;
   *ids = o.ids;
   *n = o.n;

@@ -215,10 +215,10 @@ static fr_error plan_tables(conv *c) {
   size_t rows = 0;
   if (c->row)
     for (size_t i = 0; i < nn; i++) c->row[i] = c->t->nodes[i].count > FR_BUILD_MAX_LEAF ? (int32_t)rows++ : -1;
-  c->cost = malloc(fr_mul_size(rows ? rows : 1, W * sizeof *c->cost));
+  c->cost = fr_alloc_aligned(fr_mul_size(rows ? rows : 1, W * sizeof *c->cost), 64); /* 2 MiB pages, as the build's */
   c->pick = malloc(fr_mul_size(rows ? rows : 1, W + 1));
   if (!c->row || !c->cost || !c->pick) {
-    free(c->row); free(c->cost); free(c->pick);
+    free(c->row); fr_free_aligned(c->cost); free(c->pick);
     return fr_fail(FR_ERR_NOMEM, "BVH%d: out of memory", c->b->width);
   }
   return FR_OK;
@@ -253,7 +253,7 @@ fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width,
     plan_node(&c, 0);
   }
   out->root = convert(&c, 0, 1);
-  free(c.row); free(c.cost); free(c.pick);
+  free(c.row); fr_free_aligned(c.cost); free(c.pick);
   out->prefetch = fr_bvhn_prefetch_auto(out);
   return FR_OK;
 }
