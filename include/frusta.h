@@ -135,17 +135,20 @@ typedef struct fr_bvh_stats {
   size_t bvh2_inner, bvh2_leaves;
   double bvh2_sah, bvh2_leaf_fill;
   size_t bvh2_bytes;
-  fr_wide_stats bvh4, bvh8;
+  fr_wide_stats bvh4, bvh8;      /* bvh4: zeros until the BVH4 is built, which happens when a
+                                    4-wide mode is chosen (fr_scene_set_bvh_width, packet_bvh_width) */
   size_t references;             /* triangles in the BVHs' leaves: more than the scene's where
                                     long thin ones were split into pieces before the build */
-  double build_seconds;          /* SAH build + every layout */
+  double build_seconds;          /* fr_scene_commit: SAH build + the layouts it makes */
   int single_width;              /* the BVH fr_intersect1 uses: 4 or 8 */
 } fr_bvh_stats;
 fr_error fr_scene_stats(const fr_scene *s, fr_bvh_stats *out);
 
 /* Which BVH the single-ray calls traverse: 8-wide (default, fastest on AVX2
  * and AVX-512) or 4-wide (the MIC paper's). FRUSTA_BVH_WIDTH=4|8 sets the
- * default. Both are always built. */
+ * default. The BVH4 is built when first chosen, here or by packet_bvh_width
+ * (after the commit that is a second SAH build: choose it before the
+ * commit, or while no thread traces the scene). */
 fr_error fr_scene_set_bvh_width(fr_scene *s, int width);
 
 /* ---- single rays ----------------------------------------------------------- */

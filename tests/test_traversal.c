@@ -93,6 +93,38 @@ static void check_rays(fr_scene *s, const scene_data *sd, vec3 center, float siz
   assert_true(hits > 100);
 }
 
+/* The scene's stats with its BVH4, which is built on demand. */
+static void stats_with_bvh4(fr_scene *s, fr_bvh_stats *st) {
+  assert_int_equal(fr_scene_set_bvh_width(s, 4), FR_OK);
+  assert_int_equal(fr_scene_stats(s, st), FR_OK);
+  assert_true(st->bvh4.inner + st->bvh4.leaves > 0);
+  assert_int_equal(fr_scene_set_bvh_width(s, 8), FR_OK);
+}
+
+/* The BVH4 is built on demand: not by a default commit, by the commit when
+ * chosen before it, after it when chosen then; the same tree either way. */
+static void test_bvh4_on_demand(void **state) {
+  (void)state;
+  fr_rng r = fr_rng_seed(5, 1);
+  scene_data sd = make_scene(&r, 2000, v3(0, 0, 0), 1.0f);
+  fr_bvh_stats later, before;
+  fr_scene *s = commit_scene(&sd);
+  assert_int_equal(fr_scene_stats(s, &later), FR_OK);
+  assert_int_equal(later.bvh4.inner + later.bvh4.leaves, 0);
+  stats_with_bvh4(s, &later);
+  fr_scene_release(s);
+  s = commit_scene_with(&sd, 0);
+  assert_int_equal(fr_scene_set_bvh_width(s, 4), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  assert_int_equal(fr_scene_stats(s, &before), FR_OK);
+  assert_int_equal(before.single_width, 4);
+  assert_int_equal(before.bvh4.inner, later.bvh4.inner);
+  assert_int_equal(before.bvh4.leaves, later.bvh4.leaves);
+  assert_true(before.bvh4.sah_blocks == later.bvh4.sah_blocks);
+  fr_scene_release(s);
+  free_scene(&sd);
+}
+
 static void check_scene(vec3 center, float size, uint64_t seed) {
   fr_rng r = fr_rng_seed(seed, 1);
   scene_data sd = make_scene(&r, 3000, center, size);
@@ -100,7 +132,7 @@ static void check_scene(vec3 center, float size, uint64_t seed) {
   assert_true(fr_scene_skipped_triangles(s) > 0); /* the degenerate ones */
   /* some leaves hold several blocks, so the kernels' loop over them runs */
   fr_bvh_stats st;
-  assert_int_equal(fr_scene_stats(s, &st), FR_OK);
+  stats_with_bvh4(s, &st);
   assert_true(st.bvh8.blocks > st.bvh8.leaves && st.bvh4.blocks > st.bvh4.leaves);
   assert_true(st.bvh8.block_fill > 0.0 && st.bvh8.block_fill <= 4.0);
   check_rays(s, &sd, center, size, &r, 0, 0);
@@ -157,12 +189,12 @@ static void test_optimal_collapse(void **st) {
     scene_data sd = make_scene(&r, 1000 + 2000 * (size_t)scene, center, 1.0f);
     fr_bvh_stats opt, greedy;
     fr_scene *s = commit_scene(&sd);
-    assert_int_equal(fr_scene_stats(s, &opt), FR_OK);
+    stats_with_bvh4(s, &opt);
     fr_scene_release(s);
     setenv("FRUSTA_COLLAPSE", "greedy", 1);
     s = commit_scene(&sd);
+    stats_with_bvh4(s, &greedy); /* the BVH4 too while the greedy rule is set */
     unsetenv("FRUSTA_COLLAPSE");
-    assert_int_equal(fr_scene_stats(s, &greedy), FR_OK);
     assert_true(opt.bvh8.sah_blocks <= greedy.bvh8.sah_blocks * (1.0 + 1e-5));
     assert_true(opt.bvh4.sah_blocks <= greedy.bvh4.sah_blocks * (1.0 + 1e-5));
     if (scene == 2) {
@@ -214,6 +246,7 @@ static void test_bad_rays(void **st) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_optimal_collapse),
+      cmocka_unit_test(test_bvh4_on_demand),
       cmocka_unit_test(test_random_scene_origin),
       cmocka_unit_test(test_random_scene_far),
       cmocka_unit_test(test_random_scene_tiny),

@@ -31,6 +31,10 @@ void fr_scene_apply_prefetch(fr_scene *s) {
 
 fr_error fr_scene_set_bvh_width(fr_scene *s, int width) {
   if (!s || (width != 4 && width != 8)) return fr_fail(FR_ERR_ARG, "BVH width must be 4 or 8");
+  if (width == 4) {
+    fr_error e = fr_scene_need_bvh4(s);
+    if (e) return e;
+  }
   s->single_width = width;
   return FR_OK;
 }
@@ -190,6 +194,13 @@ fr_error fr_scene_build_bvh2(fr_scene *s, int max_leaf, fr_bvh2 *out) {
   return e;
 }
 
+/* The BVH4 serves only the MIC paper's 4-wide modes (single4, packets on a
+ * BVH4), so it is built when one is asked for (FRUSTA_BVH_WIDTH=4 or set
+ * before the commit, fr_scene_set_bvh_width or packet_bvh_width later):
+ * it was a third of the conversions' time and 45-60 bytes per triangle
+ * that the default modes never read. */
+static int wants_bvh4(const fr_scene *s) { return s->single_width == 4 || s->trace.packet_bvh_width == 4; }
+
 /* The traversal structures, all made from one tree and independent of each
  * other but for the multi-frusta tree, a copy cut from the binary one. Each
  * conversion is serial, so two threads share them: the BVH8 (single rays
@@ -211,7 +222,7 @@ static fr_error convert_tree(fr_scene *s, const fr_build_tree *tree) {
     {
       e[1] = fr_bvh2_from_build(tree, m, FR_BUILD_MAX_LEAF, &s->bvh2);
       if (!e[1]) e[1] = fr_bvh2_shallow(tree, &s->bvh2, FR_MFT_LEAF, &s->bvh2_mft);
-      if (!e[1]) e[1] = fr_bvhn_from_build(tree, m, 4, &s->bvh4);
+      if (!e[1] && wants_bvh4(s)) e[1] = fr_bvhn_from_build(tree, m, 4, &s->bvh4);
       if (!e[1]) e[1] = fr_sphere_bvh_build(&s->spheres, &s->sphere_bvh);
       if (e[1]) snprintf(msg[1], sizeof msg[1], "%s", fr_last_error());
     }
@@ -240,6 +251,22 @@ fr_error fr_scene_commit(fr_scene *s) {
   s->bounds = aabb_merge(s->bounds, s->sphere_bvh.bounds);
   s->build_seconds = fr_seconds() - t0;
   s->committed = 1;
+  fr_scene_apply_prefetch(s);
+  return FR_OK;
+}
+
+/* Builds the BVH4 of a committed scene if it has none: the SAH tree again
+ * (the same tree: the build is deterministic), then its 4-wide layout. */
+fr_error fr_scene_need_bvh4(fr_scene *s) {
+  if (!s->committed || s->bvh4.nodes) return FR_OK;
+  fr_build_tree tree;
+  size_t n;
+  fr_error e = build_tree(s, &tree, &n);
+  if (e) return e;
+  e = fr_bvhn_from_build(&tree, &s->mesh, 4, &s->bvh4);
+  fr_build_tree_free(&tree);
+  if (e) return e;
+  s->bounds = aabb_merge(s->bounds, s->sphere_bvh.bounds); /* build_tree reset them to the triangles' */
   fr_scene_apply_prefetch(s);
   return FR_OK;
 }
@@ -336,6 +363,7 @@ fr_error fr_scene_stats(const fr_scene *s, fr_bvh_stats *st) {
   const fr_bvhn *src[2] = {&s->bvh4, &s->bvh8};
   fr_wide_stats *dst[2] = {&st->bvh4, &st->bvh8};
   for (int i = 0; i < 2; i++) {
+    if (!src[i]->nodes) continue; /* a BVH4 not built yet (wants_bvh4): zeros */
     fr_bvhn_stats b;
     fr_bvhn_stats_get(src[i], &b);
     *dst[i] = (fr_wide_stats){b.inner, b.leaves, b.node_bytes, b.tri_bytes, b.sah, b.sah_blocks, b.node_fill, b.leaf_fill, b.depth, b.packet_tri_bytes, b.blocks, b.block_fill};

@@ -25,6 +25,7 @@ struct fr_scene {
 
 /* Sets the BVH4's and BVH8's prefetching from the trace options. */
 void fr_scene_apply_prefetch(fr_scene *s);
+fr_error fr_scene_need_bvh4(fr_scene *s); /* builds the BVH4 on first need (scene.c) */
 /* Another binary BVH of a committed scene with leaves of up to max_leaf
  * triangles (the shallow trees multi-frusta tracing may prefer); the caller
  * frees it with fr_bvh2_free. */

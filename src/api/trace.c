@@ -39,6 +39,10 @@ fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o) {
     return fr_fail(FR_ERR_ARG, "stream spread %g (0..2)", (double)o->stream_spread);
   if (o->coherent_threshold < 0 || o->coherent_threshold > 16)
     return fr_fail(FR_ERR_ARG, "coherent threshold %d (0..16)", o->coherent_threshold);
+  if (o->packet_bvh_width == 4) {
+    fr_error e = fr_scene_need_bvh4(s);
+    if (e) return e;
+  }
   s->trace = *o;
   fr_scene_apply_prefetch(s);
   return FR_OK;
@@ -174,13 +178,15 @@ static int chunk_order(const fr_ray *rays, size_t n, uint32_t *order, size_t *ru
     oct[i] = (uint8_t)ray_octant(&rays[i]);
     some |= oct[i];
     every &= oct[i];
-    start[oct[i] + 1]++;
   }
   if (some == every) { /* one octant, as most packets of a renderer's calls: no sort */
     for (size_t i = 0; i < n; i++) order[i] = (uint32_t)i;
     run_end[0] = n;
     return 1;
   }
+  /* counted apart from the scan above: one counter incremented ray after ray
+   * is a chain through memory, and most chunks never need the counts */
+  for (size_t i = 0; i < n; i++) start[oct[i] + 1]++;
   int runs = 0;
   for (int o = 0; o < 8; o++) {
     start[o + 1] += start[o];
