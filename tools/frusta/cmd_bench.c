@@ -255,6 +255,14 @@ int cmd_bench(int argc, char **argv) {
   size_t tris = fr_scene_triangle_count(s);
   fr_bvh_stats st;
   fr_scene_stats(s, &st);
+  if (topt.packet_bvh_width == 4 || ((fsel >> 1) & 1)) { /* the BVH4 is built on demand: now, before any run */
+    const int sw = st.single_width;
+    if (fr_scene_set_bvh_width(s, 4) != FR_OK || fr_scene_set_bvh_width(s, sw) != FR_OK) {
+      fr_scene_release(s);
+      return cli_error(1, "%s", fr_last_error());
+    }
+    fr_scene_stats(s, &st);
+  }
   const fr_wide_stats *ws = st.single_width == 4 ? &st.bvh4 : &st.bvh8;
   /* packets traverse the packet BVH and test its Shevtsov records */
   const fr_wide_stats *wp = topt.packet_bvh_width == 4 ? &st.bvh4 : &st.bvh8;
