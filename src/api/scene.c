@@ -261,12 +261,13 @@ fr_error fr_scene_need_bvh4(fr_scene *s) {
   if (!s->committed || s->bvh4.nodes) return FR_OK;
   fr_build_tree tree;
   size_t n;
+  const aabb bounds = s->bounds; /* build_tree sets them to the triangles' alone */
   fr_error e = build_tree(s, &tree, &n);
+  s->bounds = bounds;
   if (e) return e;
   e = fr_bvhn_from_build(&tree, &s->mesh, 4, &s->bvh4);
   fr_build_tree_free(&tree);
   if (e) return e;
-  s->bounds = aabb_merge(s->bounds, s->sphere_bvh.bounds); /* build_tree reset them to the triangles' */
   fr_scene_apply_prefetch(s);
   return FR_OK;
 }
