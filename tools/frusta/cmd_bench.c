@@ -253,16 +253,13 @@ int cmd_bench(int argc, char **argv) {
   w.light_sets_kind = light_sets;
   w.mft_no_fallback = mft_no_fallback;
   size_t tris = fr_scene_triangle_count(s);
+  /* the BVH4 is built on demand: now, before any run, when a 4-wide mode wants it */
+  if ((topt.packet_bvh_width == 4 || ((fsel >> 1) & 1)) && fr_scene_need_bvh4(s) != FR_OK) {
+    fr_scene_release(s);
+    return cli_error(1, "%s", fr_last_error());
+  }
   fr_bvh_stats st;
   fr_scene_stats(s, &st);
-  if (topt.packet_bvh_width == 4 || ((fsel >> 1) & 1)) { /* the BVH4 is built on demand: now, before any run */
-    const int sw = st.single_width;
-    if (fr_scene_set_bvh_width(s, 4) != FR_OK || fr_scene_set_bvh_width(s, sw) != FR_OK) {
-      fr_scene_release(s);
-      return cli_error(1, "%s", fr_last_error());
-    }
-    fr_scene_stats(s, &st);
-  }
   const fr_wide_stats *ws = st.single_width == 4 ? &st.bvh4 : &st.bvh8;
   /* packets traverse the packet BVH and test its Shevtsov records */
   const fr_wide_stats *wp = topt.packet_bvh_width == 4 ? &st.bvh4 : &st.bvh8;

@@ -100,17 +100,13 @@ int cmd_stats(int argc, char **argv) {
   fr_scene *s;
   int lrc = cli_load_scene(path, &s);
   if (lrc) return lrc;
-  fr_bvh_stats st;
-  fr_scene_stats(s, &st);
   /* the BVH4 (the MIC paper's) is built on demand; these tables report it */
-  const int single_width = st.single_width;
-  double build_seconds = st.build_seconds;
-  if (fr_scene_set_bvh_width(s, 4) != FR_OK || fr_scene_set_bvh_width(s, single_width) != FR_OK) {
+  if (fr_scene_need_bvh4(s) != FR_OK) {
     fr_scene_release(s);
     return cli_error(1, "stats: %s", fr_last_error());
   }
+  fr_bvh_stats st;
   fr_scene_stats(s, &st);
-  st.build_seconds = build_seconds;
   size_t nt = fr_scene_triangle_count(s);
   printf("scene=%s tris=%zu skipped_degenerate=%zu references=%zu threads=%d build_seconds=%.3f\n", s->name, nt,
          fr_scene_skipped_triangles(s), st.references, threads, st.build_seconds);
