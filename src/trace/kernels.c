@@ -6,13 +6,21 @@
 
 static _Atomic(const fr_kernels *) active;
 
+/* The AVX2 and AVX-512 kernels are also compiled with BMI, BMI2, LZCNT and
+ * POPCNT (CMakeLists.txt), so the compiler may use them anywhere there. */
+static int bit_ops_supported(void) {
+  return __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("lzcnt") &&
+         __builtin_cpu_supports("popcnt");
+}
+
 int fr_isa_supported(fr_isa isa) {
   switch (isa) {
   case FR_ISA_SCALAR: return 1;
-  case FR_ISA_AVX2: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  case FR_ISA_AVX2: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && bit_ops_supported();
   case FR_ISA_AVX512:
     return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-           __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw");
+           __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("fma") &&
+           bit_ops_supported();
   }
   return 0;
 }
