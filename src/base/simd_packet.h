@@ -131,6 +131,22 @@ FR_INLINE float vp_reduce_min(vpf a) { float r = a.f[0]; for (int i = 1; i < P; 
 FR_INLINE float vp_reduce_max(vpf a) { float r = a.f[0]; for (int i = 1; i < P; i++) r = a.f[i] > r ? a.f[i] : r; return r; }
 #endif
 
+/* a * b + c, fused where the level has FMA, a multiply and an add where
+ * not. The one exception to "every level the same bits": only for bounds
+ * that allow for the rounding of either form (the frusta's corner-ray
+ * culls, whose guard covers the unfused form, which errs more). */
+#if defined(FR_BUILD_ISA_AVX512)
+FR_INLINE vpf vp_madd_bound(vpf a, vpf b, vpf c) { vpf r = {FR_VP_OP(fmadd_ps)(a.v, b.v, c.v)}; return r; }
+#elif defined(FR_BUILD_ISA_AVX2)
+FR_INLINE vpf vp_madd_bound(vpf a, vpf b, vpf c) {
+  vpf r;
+  for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_fmadd_ps(a.v[h], b.v[h], c.v[h]);
+  return r;
+}
+#else
+FR_INLINE vpf vp_madd_bound(vpf a, vpf b, vpf c) { return vp_add(vp_mul(a, b), c); }
+#endif
+
 /* (scalar: FR##op pastes to the FR_CMP_* macros above) */
 FR_VP_CMP(vp_lt, _CMP_LT_OQ) FR_VP_CMP(vp_le, _CMP_LE_OQ) FR_VP_CMP(vp_gt, _CMP_GT_OQ)
 FR_VP_CMP(vp_ge, _CMP_GE_OQ) FR_VP_CMP(vp_eq, _CMP_EQ_OQ)

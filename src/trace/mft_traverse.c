@@ -170,6 +170,11 @@ static void frusta_setup(frusta *F, const fr_mft_batch *B, const fr_mft_sets *T,
 
 #define dot3 fr_dot3v
 
+/* a . b for a cull with a guard: fused where the level has FMA */
+FR_INLINE vpf dot3_bound(vpf ax, vpf ay, vpf az, vpf bx, vpf by, vpf bz) {
+  return vp_madd_bound(ax, bx, vp_madd_bound(ay, by, vp_mul(az, bz)));
+}
+
 /* Child k of a node against the frusta in `m`; *tn: a lower bound of each
  * frustum's entry distance. */
 FR_INLINE unsigned box_test(const frusta *F, const fr_bvh2_node *n, int k, unsigned m, vpf *tn_out) {
@@ -220,7 +225,7 @@ FR_INLINE unsigned tri_cull(const frusta *F, const fr_bvh2_tri *r, unsigned m, i
   for (int i = 0; i < 3; i++) {
     vpf wmax = vp(-INFINITY);
     for (int j = 0; j < 4; j++) {
-      vpf w = dot3(vp_load(F->corner[j][0]), vp_load(F->corner[j][1]), vp_load(F->corner[j][2]), E[i][0], E[i][1], E[i][2]);
+      vpf w = dot3_bound(vp_load(F->corner[j][0]), vp_load(F->corner[j][1]), vp_load(F->corner[j][2]), E[i][0], E[i][1], E[i][2]);
       wmax = vp_max(wmax, vp_xor(w, sg));
     }
     vpf g = vp_mul(guard, vp_add(vp_add(vp_abs(E[i][0]), vp_abs(E[i][1])), vp_abs(E[i][2])));
@@ -229,7 +234,7 @@ FR_INLINE unsigned tri_cull(const frusta *F, const fr_bvh2_tri *r, unsigned m, i
   /* the plane: t = det / (d . n) beyond tfar (or behind) for all four corners */
   vpf gmax = vp(-INFINITY);
   for (int j = 0; j < 4; j++) {
-    vpf g = dot3(vp_load(F->corner[j][0]), vp_load(F->corner[j][1]), vp_load(F->corner[j][2]), nx, ny, nz);
+    vpf g = dot3_bound(vp_load(F->corner[j][0]), vp_load(F->corner[j][1]), vp_load(F->corner[j][2]), nx, ny, nz);
     gmax = vp_max(gmax, vp_xor(g, sg));
   }
   gmax = vp_add(gmax, vp_mul(guard, vp(fabsf(r->n[0]) + fabsf(r->n[1]) + fabsf(r->n[2]))));
