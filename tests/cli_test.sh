@@ -44,7 +44,7 @@ for ext in png exr pfm; do
   [ -s "$T/b.$ext" ] && ok || bad "no $ext written"
 done
 head -c 4 "$T/b.png" | od -c | grep -q 'P   N   G' && ok || bad "not a PNG"
-# camera rays go as multi-frusta by default; --mft off traces them as streams, to (almost) the same image
+# camera rays go as multi-frusta by default; --mft off traces them as streams
 expect 0 "$F" render --builtin --size 64x48 --out "$T/e1.pfm"
 grep -q 'shade=eyelight tracer=mft ' "$T/out" && ok || bad "render: camera rays not as frusta"
 expect 0 "$F" render --builtin --size 64x48 --mft off --out "$T/e2.pfm"

@@ -151,7 +151,7 @@ int cmd_render(int argc, char **argv) {
     return cli_error(CLI_USAGE_ERROR, "--mft on and --packet/--traversal/--cull: large packets need --mft off");
   }
   /* multi-frusta tracing does not see spheres: such scenes go the packet
-   * way. Camera rays are traced as frusta by default for every shade (2.5x
+   * way. Camera rays are traced as frusta by default for every shade (1.5-2.8x
    * packets on the shared scenes, README "Multi-frusta triangle tests
    * without branches"); the rest as streams (auto). */
   const int use_mft = mft != 0 && !fr_scene_sphere_count(s) && !(w.kind == FR_WL_WHITTED && wo.large_flags);
