@@ -63,8 +63,6 @@ fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_le
     const uint32_t *ix = m->idx + 3 * (size_t)t->prims[i];
     float *dst[3] = {r->v0, r->v1, r->v2};
     for (int k = 0; k < 3; k++) memcpy(dst[k], m->pos + 3 * (size_t)ix[k], 3 * sizeof(float));
-    vec3 a = v3_load(r->v0), n = v3_cross(v3_sub(v3_load(r->v1), a), v3_sub(v3_load(r->v2), a));
-    r->n[0] = n.x; r->n[1] = n.y; r->n[2] = n.z;
     r->prim = t->prims[i];
     r->edge_flip = 0;
     const float *ends[3][2] = {{r->v1, r->v2}, {r->v2, r->v0}, {r->v0, r->v1}};
@@ -73,7 +71,7 @@ fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_le
       int gt = p[0] != q[0] ? p[0] > q[0] : p[1] != q[1] ? p[1] > q[1] : p[2] > q[2];
       r->edge_flip |= (uint32_t)gt << e;
     }
-    r->pad[0] = r->pad[1] = 0;
+    r->pad = 0;
   }
   fr_error e = make_nodes(t, max_leaf, out);
   if (e) fr_bvh2_free(out);

@@ -25,19 +25,27 @@ typedef struct fr_bvh2_node {
 _Static_assert(sizeof(fr_bvh2_node) == 64, "BVH2 node is one cache line");
 
 /* A triangle as the multi-frusta kernels read it, in leaf order: the
- * vertices in mesh order, the unnormalized normal (v1 - v0) x (v2 - v0), and
- * per edge i (v1->v2, v2->v0, v0->v1) whether its first vertex is the
- * lexicographically larger one (bit i of edge_flip): the kernels compute an
- * edge's cross product from its smaller vertex, so the neighbouring triangle
- * gets exactly the negated value (watertight). One cache line. */
+ * vertices in mesh order and per edge i (v1->v2, v2->v0, v0->v1) whether its
+ * first vertex is the lexicographically larger one (bit i of edge_flip): the
+ * kernels compute an edge's cross product from its smaller vertex, so the
+ * neighbouring triangle gets exactly the negated value (watertight). 48
+ * bytes, four to three cache lines: the kernels make the normal themselves
+ * (fr_bvh2_tri_normal). */
 typedef struct fr_bvh2_tri {
-  float v0[3], v1[3], v2[3], n[3];
+  float v0[3], v1[3], v2[3];
   uint32_t prim;
   uint32_t edge_flip;
-  uint32_t pad[2];
-} __attribute__((aligned(64))) fr_bvh2_tri;
+  uint32_t pad;
+} __attribute__((aligned(16))) fr_bvh2_tri;
 
-_Static_assert(sizeof(fr_bvh2_tri) == 64, "BVH2 triangle is one cache line");
+_Static_assert(sizeof(fr_bvh2_tri) == 48, "BVH2 triangle is 48 bytes");
+
+/* The unnormalized normal (v1 - v0) x (v2 - v0), in float: the same bits
+ * at every ISA level (no contraction) and in every kernel. */
+static inline void fr_bvh2_tri_normal(const fr_bvh2_tri *r, float n[3]) {
+  vec3 a = v3_load(r->v0), c = v3_cross(v3_sub(v3_load(r->v1), a), v3_sub(v3_load(r->v2), a));
+  n[0] = c.x; n[1] = c.y; n[2] = c.z;
+}
 
 /* leaves hold at most this many triangles (the count field has 4 bits) */
 #define FR_BVH2_MAX_LEAF 15
@@ -75,8 +83,10 @@ static inline void fr_bvh2_prefetch(const fr_bvh2 *b, uint32_t ref, uint32_t max
     return;
   }
   uint32_t first = ref & FR_BVH2_FIRST_MASK, count = (ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
-  if (b->tris)
-    for (uint32_t i = 0; i < count && i < max_lines; i++) __builtin_prefetch(&b->tris[first + i]);
+  if (b->tris) { /* the lines the records span, up to max_lines */
+    const uintptr_t lo = (uintptr_t)&b->tris[first] & ~(uintptr_t)63, hi = (uintptr_t)&b->tris[first + count];
+    for (uintptr_t a = lo; a < hi && a < lo + 64u * max_lines; a += 64) __builtin_prefetch((const void *)a);
+  }
   else if (b->spheres) /* four to a line */
     for (uint32_t i = 0; i < count && i < 4 * max_lines; i += 4) __builtin_prefetch(&b->spheres[first + i]);
 }

@@ -63,7 +63,7 @@ void fr_lpacket_hits(const fr_lpacket *p, const fr_lp_scene *g, fr_hit *hits) {
     h->u = p->u[i];
     h->v = p->v[i];
     h->prim = r->prim;
-    for (int a = 0; a < 3; a++) h->ng[a] = r->n[a];
+    fr_bvh2_tri_normal(r, h->ng);
   }
 }
 

@@ -56,12 +56,12 @@ FR_INLINE unsigned box16(const fr_lpacket *p, int c, const fr_bvh2_node *n, int 
 }
 
 /* The edge vectors of triangle r seen from chunk c's origins. */
-typedef struct edges16 { vpf E[3][3], det; } edges16;
+typedef struct edges16 { vpf E[3][3], det; float n[3]; } edges16;
 
 FR_INLINE void chunk_edges(const fr_lpacket *p, int c, const fr_bvh2_tri *r, edges16 *e) {
   const int i = 16 * c;
   vpf o[3] = {vp_load(p->o[0] + i), vp_load(p->o[1] + i), vp_load(p->o[2] + i)};
-  fr_tri_edges16(r, o, e->E, &e->det);
+  fr_tri_edges16(r, e->n, o, e->E, &e->det);
 }
 
 /* Chunk c's rays of m against triangle index ti (edges e); closest: keeps
@@ -74,7 +74,7 @@ FR_INLINE unsigned tri16(fr_lpacket *p, int c, const fr_bvh2_tri *r, edges16 *e,
   m = fr_tri_edges16_inside(dx, dy, dz, e->E, det, m, w);
   if (!m) return 0;
   vpf tf = vp_load(p->tfar + i);
-  vpf t = vp_div(det, fr_dot3v(dx, dy, dz, vp(r->n[0]), vp(r->n[1]), vp(r->n[2])));
+  vpf t = vp_div(det, fr_dot3v(dx, dy, dz, vp(e->n[0]), vp(e->n[1]), vp(e->n[2])));
   m &= vpm_bits(vpm_and(vp_gt(t, vp_load(p->tnear + i)), vp_lt(t, tf)));
   if (!m || !closest) return m;
   vpf inv = vp_div(vp(1.0f), vp_add(vp_add(w[0], w[1]), w[2]));
@@ -402,6 +402,8 @@ static void leaf(state *S, const entry *e, int closest) {
     }
     edges16 ed;
     int have_edges = 0;
+    if (r) fr_bvh2_tri_normal(r, ed.n);
+    else ed.n[0] = ed.n[1] = ed.n[2] = 0.0f; /* spheres: no edges */
     for (int jc = 0; jc < nc; jc++) {
       int c = S->opt->traversal == FR_LP_RANGED ? e->a + jc : S->opt->traversal == FR_LP_PARTITION ? p->list[jc] : jc;
       unsigned m = p->alive[c];
@@ -415,7 +417,7 @@ static void leaf(state *S, const entry *e, int closest) {
         if (!S->shared) chunk_edges(p, c, r, &ed);
         else if (!have_edges) {
           const vpf o[3] = {vp(S->o0[0]), vp(S->o0[1]), vp(S->o0[2])};
-          fr_tri_edges16(r, o, ed.E, &ed.det);
+          fr_tri_edges16(r, ed.n, o, ed.E, &ed.det);
           have_edges = 1;
         }
         hit = tri16(p, c, r, &ed, first + j, m, closest);

@@ -208,16 +208,18 @@ FR_INLINE unsigned box_test(const frusta *F, const fr_bvh2_node *n, int k, unsig
 typedef struct tri_frusta {
   float e[3][3][16] __attribute__((aligned(64)));
   float det[16] __attribute__((aligned(64)));
+  float n[3]; /* the triangle's normal (fr_bvh2_tri_normal) */
 } tri_frusta;
 
 /* The frusta of m that may hit triangle r; fills X. */
 FR_INLINE unsigned tri_cull(const frusta *F, const fr_bvh2_tri *r, unsigned m, int corner_rays, tri_frusta *X) {
   vpf o[3] = {vp_load(F->o[0]), vp_load(F->o[1]), vp_load(F->o[2])};
   vpf E[3][3], det;
-  fr_tri_edges16(r, o, E, &det);
+  fr_bvh2_tri_normal(r, X->n);
+  fr_tri_edges16(r, X->n, o, E, &det);
   for (int i = 0; i < 3; i++)
     for (int a = 0; a < 3; a++) vp_store(X->e[i][a], E[i][a]);
-  vpf nx = vp(r->n[0]), ny = vp(r->n[1]), nz = vp(r->n[2]);
+  vpf nx = vp(X->n[0]), ny = vp(X->n[1]), nz = vp(X->n[2]);
   vp_store(X->det, det);
   if (!corner_rays) return m;
   vpf sg = vp_and(det, vp(-0.0f)), zero = vp(0.0f), guard = vp_load(F->guard);
@@ -237,7 +239,7 @@ FR_INLINE unsigned tri_cull(const frusta *F, const fr_bvh2_tri *r, unsigned m, i
     vpf g = dot3_bound(vp_load(F->corner[j][0]), vp_load(F->corner[j][1]), vp_load(F->corner[j][2]), nx, ny, nz);
     gmax = vp_max(gmax, vp_xor(g, sg));
   }
-  gmax = vp_add(gmax, vp_mul(guard, vp(fabsf(r->n[0]) + fabsf(r->n[1]) + fabsf(r->n[2]))));
+  gmax = vp_add(gmax, vp_mul(guard, vp(fabsf(X->n[0]) + fabsf(X->n[1]) + fabsf(X->n[2]))));
   cull |= vpm_bits(vp_le(gmax, zero));
   cull |= vpm_bits(vp_lt(vp_mul(gmax, vp_load(F->tfar)), vp_mul(vp_abs(det), vp(1.0f - 0x1p-18f))));
   return m & ~cull;
@@ -291,7 +293,7 @@ FR_INLINE unsigned ray_hits(const frusta *F, const frustum_dirs *D, const tri_fr
     for (int a = 0; a < 3; a++) E[i][a] = vp(X->e[i][a][f]);
   const vpf det = vp(X->det[f]);
   unsigned m = fr_tri_edges16_inside(dx, dy, dz, E, det, rays, w);
-  *t = vp_div(det, dot3(dx, dy, dz, vp(r->n[0]), vp(r->n[1]), vp(r->n[2])));
+  *t = vp_div(det, dot3(dx, dy, dz, vp(X->n[0]), vp(X->n[1]), vp(X->n[2])));
   return m & vpm_bits(vpm_and(vp_gt(*t, vp(F->tnear[f])), vp_lt(*t, tcur)));
 }
 

@@ -4,7 +4,7 @@
  * after base/simd_packet.h (FR_PACKET 16).
  *
  *   E_0 = (v1-o) x (v2-o), E_1 = (v2-o) x (v0-o), E_2 = (v0-o) x (v1-o)
- *   det = (v0-o) . n
+ *   det = (v0-o) . n,  n = (v1 - v0) x (v2 - v0) (fr_bvh2_tri_normal)
  *
  * A ray o + t d hits when every d . E_i has the sign of det, at
  * t = det / (d . n); the barycentrics of v1, v2 are d . E_1, d . E_2 over
@@ -23,14 +23,14 @@ FR_INLINE vpf fr_dot3v(vpf ax, vpf ay, vpf az, vpf bx, vpf by, vpf bz) {
   return vp_add(vp_add(vp_mul(ax, bx), vp_mul(ay, by)), vp_mul(az, bz));
 }
 
-FR_INLINE void fr_tri_edges16(const fr_bvh2_tri *r, const vpf o[3], vpf E[3][3], vpf *det) {
+FR_INLINE void fr_tri_edges16(const fr_bvh2_tri *r, const float n[3], const vpf o[3], vpf E[3][3], vpf *det) {
   vpf A[3], B[3], C[3];
   for (int a = 0; a < 3; a++) {
     A[a] = vp_sub(vp(r->v0[a]), o[a]);
     B[a] = vp_sub(vp(r->v1[a]), o[a]);
     C[a] = vp_sub(vp(r->v2[a]), o[a]);
   }
-  *det = fr_dot3v(A[0], A[1], A[2], vp(r->n[0]), vp(r->n[1]), vp(r->n[2]));
+  *det = fr_dot3v(A[0], A[1], A[2], vp(n[0]), vp(n[1]), vp(n[2]));
   const float *ends[3][2] = {{r->v1, r->v2}, {r->v2, r->v0}, {r->v0, r->v1}};
   const vpf *from[3][2] = {{B, C}, {C, A}, {A, B}};
   for (int i = 0; i < 3; i++) {
