@@ -356,7 +356,9 @@ FR_INLINE unsigned leaf_rays(frusta *F, const entry *e, unsigned m, const unsign
     /* no parent: the root is a leaf, with no box to test */
     rays[f] = e->parent ? leaf_box_rays(F, e->parent, e->slot, f, tcur ? vp_load(tcur[f]) : vp(F->tfar[f]), base[f])
                         : base[f];
-    if (!rays[f]) m &= ~(1u << f);
+    /* whether any ray of the frustum reaches the leaf is a coin toss too:
+     * no branch (soft16 mft: sibenik 1.06x, conference 1.05x) */
+    m &= ~((unsigned)(rays[f] == 0) << f);
   }
   return m;
 }
