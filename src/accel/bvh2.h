@@ -8,6 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "accel/bvh_build.h"
+#include "base/vec3.h"
 #include "geom/mesh.h"
 #include "geom/sphere.h"
 

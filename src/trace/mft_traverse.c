@@ -287,8 +287,8 @@ FR_INLINE frustum_dirs dirs_of(const frusta *F, int f) {
  * whether any of them hits is a coin toss, and early exits after the edge
  * test mispredicted on about half the tests (primary mft 1.27x on
  * conference, kitchen and sibenik, 1.10x on dragon without them). */
-FR_INLINE unsigned ray_hits(const frusta *F, const frustum_dirs *D, const tri_frusta *X, const fr_bvh2_tri *r, int f,
-                            vpf tcur, unsigned rays, vpf w[3], vpf *t) {
+FR_INLINE unsigned ray_hits(const frusta *F, const frustum_dirs *D, const tri_frusta *X, int f, vpf tcur, unsigned rays,
+                            vpf w[3], vpf *t) {
   const vpf dx = D->x, dy = D->y, dz = D->z;
   vpf E[3][3];
   for (int i = 0; i < 3; i++)
@@ -307,7 +307,7 @@ typedef struct frustum_hits { vpf t, u, v, prim; } frustum_hits;
 FR_INLINE unsigned ray_test_closest(const frusta *F, const frustum_dirs *D, const tri_frusta *X, const fr_bvh2_tri *r,
                                     int f, unsigned rays, frustum_hits *h) {
   vpf w[3], t;
-  const unsigned m = ray_hits(F, D, X, r, f, h->t, rays, w, &t);
+  const unsigned m = ray_hits(F, D, X, f, h->t, rays, w, &t);
   const vpf inv = vp_div(vp(1.0f), vp_add(vp_add(w[0], w[1]), w[2]));
   const vpm hm = vpm_bits_to(m);
   h->t = vp_select(hm, t, h->t);
@@ -450,7 +450,7 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
         /* no branch on the hits, for the same reason as ray_hits */
         for (uint32_t k = 0; k < count; k++) {
           vpf w[3], t;
-          const unsigned hit = (left[k] >> f) & 1 ? ray_hits(&F, &D, &X[k], &b->tris[first + k], f, tf, live, w, &t) : 0u;
+          const unsigned hit = (left[k] >> f) & 1 ? ray_hits(&F, &D, &X[k], f, tf, live, w, &t) : 0u;
           hits |= hit;
           live &= ~hit;
         }
