@@ -85,6 +85,14 @@ unsigned fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int 
  * thread, so that a tile's image does not depend on which thread traced
  * what. */
 #define SOFT_FRUSTA_MAX_TRIS 8
+/* ... and visited more than this many nodes each. Many triangles fetched
+ * in few node visits are a few large leaves the corner rays mostly cull,
+ * which frusta still beat rays on: the first batches of conference's
+ * fallen-back tiles visited 6 nodes per frustum on average, kitchen's 18.
+ * Interleaved, 2 threads, 1024x1024, soft16 mft, 3 pairs: conference
+ * 1.125x, kitchen 1.051x, sibenik 1.026x (3/3 each), dragon 0.99-1.02x;
+ * 8 gained half as much, 16 the same as 12. */
+#define SOFT_FRUSTA_MAX_NODES 12
 /* Where the first batch's frusta fetched more than this many triangles each,
  * the tile's rays part ways at the scale of the triangles, and ray streams
  * (trace/bvhn_stream.c) beat hybrid packets: against packets for every
@@ -136,12 +144,14 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
     rays += 16u * (uint64_t)__builtin_popcount(b.valid);
     if (!as_rays) {
       uint16_t occ[FR_MFT_FRUSTA];
-      unsigned fetched = t->occluded_frusta(t->ctx, &b, T, occ, NULL);
+      unsigned visited = 0; /* in: no budget; out: the nodes the batch visited */
+      unsigned fetched = t->occluded_frusta(t->ctx, &b, T, occ, &visited);
       for (unsigned v = b.valid; v; v &= v - 1) {
         int f = __builtin_ctz(v);
         lit[16 * j + f] = (float)(16 - __builtin_popcount(occ[f])) / 16.0f;
       }
-      as_rays = !w->mft_no_fallback && fetched > SOFT_FRUSTA_MAX_TRIS * (unsigned)__builtin_popcount(b.valid);
+      as_rays = !w->mft_no_fallback && fetched > SOFT_FRUSTA_MAX_TRIS * (unsigned)__builtin_popcount(b.valid) &&
+                visited > SOFT_FRUSTA_MAX_NODES * (unsigned)__builtin_popcount(b.valid);
       as_streams = fetched > SOFT_STREAM_MIN_TRIS * (unsigned)__builtin_popcount(b.valid);
       continue;
     }
