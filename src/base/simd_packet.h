@@ -147,6 +147,15 @@ FR_INLINE vpf vp_madd_bound(vpf a, vpf b, vpf c) {
 FR_INLINE vpf vp_madd_bound(vpf a, vpf b, vpf c) { return vp_add(vp_mul(a, b), c); }
 #endif
 
+/* A triangle id as the bits of a float lane, and a packet's ids as both:
+ * closest-hit kernels keep their hits' ids in a register, one select per
+ * hit instead of a store per lane. */
+FR_INLINE vpf vp_id(uint32_t id) {
+  union { uint32_t u; float f; } c = {id};
+  return vp(c.f);
+}
+typedef union { float f[P]; uint32_t u[P]; } __attribute__((aligned(64))) lane_ids;
+
 /* (scalar: FR##op pastes to the FR_CMP_* macros above) */
 FR_VP_CMP(vp_lt, _CMP_LT_OQ) FR_VP_CMP(vp_le, _CMP_LE_OQ) FR_VP_CMP(vp_gt, _CMP_GT_OQ)
 FR_VP_CMP(vp_ge, _CMP_GE_OQ) FR_VP_CMP(vp_eq, _CMP_EQ_OQ)

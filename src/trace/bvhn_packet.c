@@ -326,13 +326,6 @@ static inline fr_ray lane_ray(const packet *pk, int i, float tfar) {
 /* A closest-hit packet's answers in registers (prim as float bit patterns). */
 typedef struct hit_regs { vpf t, u, v, prim, ng[3]; } hit_regs;
 
-/* A triangle id as the bits of a float lane, and a packet's ids as both. */
-FR_INLINE vpf vp_id(uint32_t id) {
-  union { uint32_t u; float f; } c = {id};
-  return vp(c.f);
-}
-typedef union { float f[P]; uint32_t u[P]; } lane_ids;
-
 /* The answers of fr_hit_finish, for all lanes at once: the hit triangles'
  * vertices gathered lane by lane, the double-precision t of
  * fr_tri_refine_lane in one loop the compiler vectorizes, the normal as
@@ -437,7 +430,7 @@ static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
       FR_COUNT(switches, 1);
       FR_COUNT(switch_rays, nactive);
       float TF[P] __attribute__((aligned(64))), UU[P] __attribute__((aligned(64))), VV[P] __attribute__((aligned(64)));
-      lane_ids B __attribute__((aligned(64)));
+      lane_ids B;
       vp_store(TF, tfar); vp_store(UU, U); vp_store(VV, V); vp_store(B.f, best);
       for (unsigned m = active; m; m &= m - 1) {
         int i = __builtin_ctz(m);
@@ -523,7 +516,7 @@ static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
     }
   }
 
-  lane_ids B __attribute__((aligned(64)));
+  lane_ids B;
   vp_store(B.f, best);
   finish(b, &pk, B.u, tfar, U, V, out);
 }

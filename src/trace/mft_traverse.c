@@ -265,13 +265,6 @@ FR_INLINE unsigned leaf_tri_cull(frusta *F, const fr_bvh2_tri *r, unsigned m, co
   return left;
 }
 
-/* A triangle id as the bits of a float lane (hits keep their ids in registers). */
-FR_INLINE vpf vp_id(uint32_t id) {
-  union { uint32_t u; float f; } c = {id};
-  return vp(c.f);
-}
-typedef union { float f[16]; uint32_t u[16]; } __attribute__((aligned(64))) lane_ids16;
-
 /* Frustum f's 16 ray directions, made from its start vector and deltas. */
 typedef struct frustum_dirs { vpf x, y, z; } frustum_dirs;
 FR_INLINE frustum_dirs dirs_of(const frusta *F, int f) {
@@ -520,7 +513,7 @@ static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr
       for (; any; any &= any - 1) {
         const int f = __builtin_ctz(any);
         const frustum_dirs D = dirs_of(&F, f);
-        lane_ids16 ids;
+        lane_ids ids;
         memcpy(ids.u, H->prim[f], sizeof ids.u);
         frustum_hits h = {vp_load(H->t[f]), vp_load(H->u[f]), vp_load(H->v[f]), vp_load(ids.f)};
         unsigned hits = 0;
