@@ -150,9 +150,9 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
         int f = __builtin_ctz(v);
         lit[16 * j + f] = (float)(16 - __builtin_popcount(occ[f])) / 16.0f;
       }
-      as_rays = !w->mft_no_fallback && fetched > SOFT_FRUSTA_MAX_TRIS * (unsigned)__builtin_popcount(b.valid) &&
-                visited > SOFT_FRUSTA_MAX_NODES * (unsigned)__builtin_popcount(b.valid);
-      as_streams = fetched > SOFT_STREAM_MIN_TRIS * (unsigned)__builtin_popcount(b.valid);
+      const unsigned nf = (unsigned)__builtin_popcount(b.valid);
+      as_rays = !w->mft_no_fallback && fetched > SOFT_FRUSTA_MAX_TRIS * nf && visited > SOFT_FRUSTA_MAX_NODES * nf;
+      as_streams = fetched > SOFT_STREAM_MIN_TRIS * nf;
       continue;
     }
     if (t->occluded_frusta && b.valid) FR_COUNT(mft_ray_batches, 1);
