@@ -48,7 +48,7 @@ static void make_shadow_batch(fr_rng *r, const mesh_ref *m, vec3 lc, float eps, 
   }
 }
 
-typedef struct tally { long rays, disagree, excused; } tally;
+typedef struct tally { long rays, disagree, excused, cache_filled; } tally;
 
 /* The same rays as 16 packets of 16 (one per frustum), traced as pure packets. */
 static void packet16_occluded(fr_scene *s, const fr_mft_batch *b, const fr_mft_sets *T, uint16_t occ[16]) {
@@ -87,8 +87,24 @@ static void check_shadows_vs(const fr_scene *s, const fr_mft_batch *b, const fr_
         uint16_t occ[16];
         memset(occ, 0xAB, sizeof occ); /* poison: every frustum must be written */
         unsigned nodes = ~0u;
-        isa_fns[i]->occluded(&s->bvh2_mft, &o, b, T, occ, &nodes);
+        isa_fns[i]->occluded(&s->bvh2_mft, &o, b, T, occ, &nodes, NULL);
         assert_true(nodes != ~0u);
+        /* occluders cached from the previous batch, and from this batch
+         * itself (its best leaves then occlude rays before any traversal),
+         * change no answer */
+        for (int own = 0; own < 2; own++) {
+          static fr_mft_occluders carried;
+          fr_mft_occluders c = carried;
+          uint16_t occ_c[16];
+          if (own) {
+            memset(&c, 0, sizeof c);
+            isa_fns[i]->occluded(&s->bvh2_mft, &o, b, T, occ_c, NULL, &c);
+            tl->cache_filled += c.n > 0;
+          }
+          isa_fns[i]->occluded(&s->bvh2_mft, &o, b, T, occ_c, NULL, &c);
+          assert_memory_equal(occ_c, occ, sizeof occ);
+          if (!own) carried = c;
+        }
         if (first) {
           memcpy(ref, occ, sizeof ref);
           first = 0;
@@ -233,8 +249,10 @@ static void random_scenes(void **state) {
     fr_scene_release(s);
     free_scene(&sd);
   }
-  print_message("random scenes: %ld rays, %ld disagreements (all at edges or range ends)\n", tl.rays, tl.disagree);
+  print_message("random scenes: %ld rays, %ld disagreements (all at edges or range ends), %ld batches with cached occluders\n",
+                tl.rays, tl.disagree, tl.cache_filled);
   assert_true(tl.disagree * 1000 < tl.rays);
+  assert_true(tl.cache_filled > 0);
 }
 
 /* Frusta around given rays (fr_mft_fns.from_rays), as Whitted's shadow rays
@@ -319,10 +337,10 @@ static void rays_frusta(void **state) {
       uint16_t full[16], part[16];
       unsigned nodes = 0;
       const fr_mft_opts o = fr_mft_opts_default();
-      fr_mft_active()->occluded(&s->bvh2, &o, &b, &T, full, &nodes);
+      fr_mft_active()->occluded(&s->bvh2, &o, &b, &T, full, &nodes, NULL);
       if (nodes > 3) {
         unsigned budget = 3;
-        fr_mft_active()->occluded(&s->bvh2, &o, &b, &T, part, &budget);
+        fr_mft_active()->occluded(&s->bvh2, &o, &b, &T, part, &budget, NULL);
         assert_int_equal(budget, 4);
         for (int f = 0; f < 16; f++) assert_int_equal(part[f] & ~full[f], 0);
         stopped++;
@@ -386,8 +404,10 @@ static void builtin_scene(void **state) {
       camera_shadow_batch(s, &cam, bx, by, lc, centre, 1e-4f * v3_len(ext), &b);
       check_shadows(s, &b, &T, &tl);
     }
-  print_message("built-in scene: %ld rays, %ld disagreements (all at edges or range ends)\n", tl.rays, tl.disagree);
+  print_message("built-in scene: %ld rays, %ld disagreements (all at edges or range ends), %ld batches with cached occluders\n",
+                tl.rays, tl.disagree, tl.cache_filled);
   assert_true(tl.disagree * 1000 < tl.rays);
+  assert_true(tl.cache_filled > 0);
   fr_scene_release(s);
 }
 
@@ -562,10 +582,10 @@ static unsigned counted_intersect_frusta(void *ctx, const fr_mft_batch *b, const
 }
 
 static unsigned counted_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[16],
-                                        unsigned *nodes) {
+                                        unsigned *nodes, fr_mft_occluders *cache) {
   ray_counter *c = ctx;
   c->batches++;
-  return c->inner.occluded_frusta(c->inner.ctx, b, t, occ, nodes);
+  return c->inner.occluded_frusta(c->inner.ctx, b, t, occ, nodes, cache);
 }
 
 static void soft_fallback(void **state) {

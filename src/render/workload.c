@@ -126,6 +126,9 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
   if (t->occluded_frusta && !w->mft_no_fallback && cam_fetched > SOFT_CAMERA_MAX_TRIS * FR_MFT_FRUSTA)
     as_rays = as_streams = 1;
   uint8_t by_rays[TILE_PIX] = {0};
+  /* one per tile, so that what a batch costs does not depend on which
+   * thread traced the tile before */
+  fr_mft_occluders cache = {{0}, 0};
   for (int j = 0; j < (n + 15) / 16; j++) {
     fr_mft_batch b;
     memset(&b, 0, sizeof b);
@@ -145,7 +148,7 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
     if (!as_rays) {
       uint16_t occ[FR_MFT_FRUSTA];
       unsigned visited = 0; /* in: no budget; out: the nodes the batch visited */
-      unsigned fetched = t->occluded_frusta(t->ctx, &b, T, occ, &visited);
+      unsigned fetched = t->occluded_frusta(t->ctx, &b, T, occ, &visited, &cache);
       for (unsigned v = b.valid; v; v &= v - 1) {
         int f = __builtin_ctz(v);
         lit[16 * j + f] = (float)(16 - __builtin_popcount(occ[f])) / 16.0f;
@@ -410,9 +413,9 @@ static unsigned mft_intersect_frusta(void *ctx, const fr_mft_batch *b, const fr_
 }
 
 static unsigned mft_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t,
-                                    uint16_t occ[FR_MFT_FRUSTA], unsigned *nodes) {
+                                    uint16_t occ[FR_MFT_FRUSTA], unsigned *nodes, fr_mft_occluders *cache) {
   const fr_mft_tracer *m = ctx;
-  return fr_mft_active()->occluded(m->shadow_bvh ? m->shadow_bvh : m->bvh, &m->opts, b, t, occ, nodes);
+  return fr_mft_active()->occluded(m->shadow_bvh ? m->shadow_bvh : m->bvh, &m->opts, b, t, occ, nodes, cache);
 }
 
 fr_mft_tracer fr_mft_tracer_of(const fr_scene *s, fr_mft_opts opts) {

@@ -44,9 +44,10 @@ typedef struct fr_tracer {
   void (*intersect)(void *ctx, const fr_ray *rays, fr_hit *hits, size_t n, int coherent);
   void (*occluded)(void *ctx, const fr_ray *rays, uint8_t *occ, size_t n, int coherent);
   unsigned (*intersect_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, fr_mft_hits *hits);
-  /* both return the triangles the batch fetched (see soft_shadows in workload.c) */
+  /* both return the triangles the batch fetched (see soft_shadows in
+   * workload.c); cache as fr_mft_fns.occluded's */
   unsigned (*occluded_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[FR_MFT_FRUSTA],
-                              unsigned *nodes);
+                              unsigned *nodes, fr_mft_occluders *cache);
   int packet_side;
 } fr_tracer;
 
