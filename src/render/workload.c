@@ -129,7 +129,11 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
   /* one per tile, so that what a batch costs does not depend on which
    * thread traced the tile before */
   fr_mft_occluders cache = {{0}, 0};
-  for (int j = 0; j < (n + 15) / 16; j++) {
+  for (int jj = 0; jj < (n + 15) / 16; jj++) {
+    /* a full tile's 4x4 blocks in serpentine order: each batch borrows the
+     * occluders of a neighbour */
+    const int row = jj / (TILE / 4), col = jj % (TILE / 4);
+    const int j = n == TILE_PIX ? row * (TILE / 4) + (row & 1 ? TILE / 4 - 1 - col : col) : jj;
     fr_mft_batch b;
     memset(&b, 0, sizeof b);
     for (int f = 0; f < 16 && 16 * j + f < n; f++) {
