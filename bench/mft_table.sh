@@ -6,7 +6,11 @@
 # (leaves of 8 and 12); shrinking off. Raw lines go to bench/results/mft-raw.txt.
 # With a counters build in build-count/ (cmake -DFRUSTA_COUNTERS=ON) it also
 # records the counters for the paper's Table 1 in bench/results/mft-counters.txt.
+# Table 1's multi-frusta rows trace every ray as frusta (--mft-fallback off)
+# and cull every triangle with the corner rays (--corner-cost 0), as the
+# paper's do.
 # env: SIZE (1024x1024) REPEAT (3) THREADS (2) SCENES ("conference kitchen sibenik dragon")
+#      COUNTERS_ONLY=1: only the counters
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SIZE=${SIZE:-1024x1024}; REPEAT=${REPEAT:-3}; THREADS=${THREADS:-2}
@@ -18,8 +22,9 @@ bench() { # binary tag scene args...
     grep -E '^(scene=|counters|mft_bvh)' | sed "s/^/$tag /"
 }
 mkdir -p bench/results
-: >"$RAW"
+[ "${COUNTERS_ONLY:-0}" = 1 ] || : >"$RAW"
 for s in $SCENES; do
+  [ "${COUNTERS_ONLY:-0}" = 1 ] && break
   bench ./build/frusta main "$s" --workload primary --mode all --tracer both >>"$RAW"
   for ls in spread cells; do
     bench ./build/frusta "main sets=$ls" "$s" --workload soft16 --mode all --tracer both --light-sets "$ls" >>"$RAW"
@@ -35,11 +40,13 @@ if [ -x build-count/frusta ]; then
   : >"$CNT"
   for s in $SCENES; do
     for m in mft packet16; do
-      REPEAT=1 bench ./build-count/frusta "$m" "$s" --workload primary --mode "$m" >>"$CNT"
+      cc=(); [ "$m" = mft ] && cc=(--corner-cost 0)
+      REPEAT=1 bench ./build-count/frusta "$m" "$s" --workload primary --mode "$m" "${cc[@]}" >>"$CNT"
+      fb=(); [ "$m" = mft ] && fb=(--mft-fallback off --corner-cost 0)
       for ls in spread cells; do
-        REPEAT=1 bench ./build-count/frusta "$m sets=$ls" "$s" --workload soft16 --mode "$m" --light-sets "$ls" >>"$CNT"
+        REPEAT=1 bench ./build-count/frusta "$m sets=$ls" "$s" --workload soft16 --mode "$m" --light-sets "$ls" "${fb[@]}" >>"$CNT"
       done
     done
   done
 fi
-echo "raw lines in $RAW"
+[ "${COUNTERS_ONLY:-0}" = 1 ] || echo "raw lines in $RAW"
