@@ -16,6 +16,9 @@
 #define FR_BVH2_LEAF 0x80000000u
 #define FR_BVH2_COUNT_SHIFT 27
 #define FR_BVH2_FIRST_MASK ((1u << FR_BVH2_COUNT_SHIFT) - 1)
+/* a leaf reference's triangles: count of them from index first */
+#define FR_BVH2_LEAF_FIRST(ref) ((ref) & FR_BVH2_FIRST_MASK)
+#define FR_BVH2_LEAF_COUNT(ref) (((ref) & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT)
 
 typedef struct fr_bvh2_node {
   float lo_x[2], hi_x[2], lo_y[2], hi_y[2], lo_z[2], hi_z[2];

@@ -406,7 +406,7 @@ FR_INLINE int visit_node(const frusta *F, const fr_bvh2 *b, uint32_t ref, unsign
 FR_INLINE unsigned occlude_leaf(frusta *F, const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_sets *T,
                                 uint32_t ref, unsigned m, const unsigned rays[16], unsigned active[16],
                                 uint16_t occ[16], unsigned *alive, int eager) {
-  const uint32_t first = ref & FR_BVH2_FIRST_MASK, count = (ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
+  const uint32_t first = FR_BVH2_LEAF_FIRST(ref), count = FR_BVH2_LEAF_COUNT(ref);
   tri_frusta X[FR_BVH2_MAX_LEAF]; /* the triangles' edges for all frusta */
   uint32_t left[FR_BVH2_MAX_LEAF];
   unsigned any = 0, shrink = 0, occluded = 0;
@@ -480,15 +480,14 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
    * the frusta it finishes: callgrind, soft16 mft, 512x512, 1 thread:
    * conference -22% of the instructions, sibenik -1.4%, kitchen +0.9%,
    * dragon +0.1% (there penumbrae are wide and occluders fine, and a
-   * frustum is seldom finished by two leaves). Ranking leaves by the frusta they
-   * finished first, or caching only those that finished one, measured the
-   * same or worse. */
+   * frustum is seldom finished by two leaves). Ranking leaves by the
+   * frusta they finished first, or caching only those that finished one,
+   * measured the same or worse. */
   best_leaves best = {{0}, {0}, 0};
   uint32_t skip[FR_MFT_OCCLUDERS] = {0};
   const unsigned ncache = cache ? cache->n : 0;
   for (unsigned c = 0; c < ncache && c < FR_MFT_OCCLUDERS && alive; c++) {
-    const uint32_t ref = cache->leaf[c], first = ref & FR_BVH2_FIRST_MASK;
-    const uint32_t count = (ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
+    const uint32_t ref = cache->leaf[c], first = FR_BVH2_LEAF_FIRST(ref), count = FR_BVH2_LEAF_COUNT(ref);
     /* any leaf of this tree gives true answers; another tree's is skipped */
     if (!(ref & FR_BVH2_LEAF) || count > FR_BVH2_MAX_LEAF || first + (size_t)count > b->nprims) continue;
     skip[c] = ref;
@@ -514,7 +513,7 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
       if (cached) break;
       unsigned rays[16], m = leaf_rays(&F, &e, e.mask & alive, active, NULL, rays);
       if (!m) break;
-      fetched += (e.ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
+      fetched += FR_BVH2_LEAF_COUNT(e.ref);
       const int eager = opt->shrink && fetched > EAGER_FETCHED;
       const unsigned got = occlude_leaf(&F, b, opt, T, e.ref, m, rays, active, occ, &alive, eager);
       if (got && cache) best_leaves_add(&best, e.ref, got);
@@ -557,7 +556,7 @@ static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr
         if (!visit_node(&F, b, e.ref, e.mask, stack, &sp, &e)) break;
         continue;
       }
-      uint32_t first = e.ref & FR_BVH2_FIRST_MASK, count = (e.ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
+      uint32_t first = FR_BVH2_LEAF_FIRST(e.ref), count = FR_BVH2_LEAF_COUNT(e.ref);
       static const unsigned all[16] = {0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu,
                                        0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu, 0xFFFFu};
       unsigned changed = 0, rays[16], m = leaf_rays(&F, &e, e.mask, all, (const float(*)[16])H->t, rays);
