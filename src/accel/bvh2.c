@@ -109,13 +109,13 @@ static double child_area(const fr_bvh2_node *n, int k) {
 double fr_bvh2_sah(const fr_bvh2 *b) {
   double root = aabb_half_area(b->bounds);
   if (!(root > 0.0)) return 0.0;
-  double cost = (b->root & FR_BVH2_LEAF) ? (double)(b->root >> FR_BVH2_COUNT_SHIFT & 15) : 1.0;
+  double cost = (b->root & FR_BVH2_LEAF) ? (double)FR_BVH2_LEAF_COUNT(b->root) : 1.0;
   for (size_t i = 0; i < b->nnodes; i++) {
     const fr_bvh2_node *n = &b->nodes[i];
     for (int k = 0; k < 2; k++) {
       double w = child_area(n, k) / root;
       uint32_t r = n->child[k];
-      cost += (r & FR_BVH2_LEAF) ? w * (double)(r >> FR_BVH2_COUNT_SHIFT & 15) : w;
+      cost += (r & FR_BVH2_LEAF) ? w * (double)FR_BVH2_LEAF_COUNT(r) : w;
     }
   }
   return cost;

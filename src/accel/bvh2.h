@@ -86,7 +86,7 @@ static inline void fr_bvh2_prefetch(const fr_bvh2 *b, uint32_t ref, uint32_t max
     __builtin_prefetch(&b->nodes[ref]);
     return;
   }
-  uint32_t first = ref & FR_BVH2_FIRST_MASK, count = (ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
+  uint32_t first = FR_BVH2_LEAF_FIRST(ref), count = FR_BVH2_LEAF_COUNT(ref);
   if (b->tris) { /* the lines the records span, up to max_lines */
     const uintptr_t lo = (uintptr_t)&b->tris[first] & ~(uintptr_t)63, hi = (uintptr_t)&b->tris[first + count];
     for (uintptr_t a = lo; a < hi && a < lo + 64u * max_lines; a += 64) __builtin_prefetch((const void *)a);

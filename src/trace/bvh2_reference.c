@@ -39,7 +39,7 @@ static int traverse(const fr_bvh2 *b, const fr_mesh *m, const fr_ray *ray, fr_hi
   while (sp) {
     uint32_t ref = stack[--sp];
     if (ref & FR_BVH2_LEAF) {
-      uint32_t first = ref & FR_BVH2_FIRST_MASK, count = (ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
+      uint32_t first = FR_BVH2_LEAF_FIRST(ref), count = FR_BVH2_LEAF_COUNT(ref);
       for (uint32_t i = first; i < first + count; i++) {
         uint32_t prim = b->prims[i];
         vec3 p0 = vertex(m, prim, 0), p1 = vertex(m, prim, 1), p2 = vertex(m, prim, 2);

@@ -384,7 +384,7 @@ FR_INLINE int narrow(state *S, const entry *e, entry *out) {
 static void leaf(state *S, const entry *e, int closest) {
   fr_lpacket *p = S->p;
   const fr_bvh2 *b = S->b;
-  uint32_t ref = e->ref, first = ref & FR_BVH2_FIRST_MASK, count = (ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
+  uint32_t ref = e->ref, first = FR_BVH2_LEAF_FIRST(ref), count = FR_BVH2_LEAF_COUNT(ref);
   FR_COUNT(lp_leaves, 1);
   const int nc = S->opt->traversal == FR_LP_RANGED ? e->b - e->a + 1 : S->opt->traversal == FR_LP_PARTITION ? e->a : p->nchunks;
   /* the cull pays only where it may save more than one chunk's test */

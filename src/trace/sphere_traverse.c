@@ -47,7 +47,7 @@ static int traverse(const fr_bvh2 *b, const fr_ray *ray, float tfar, int any, ui
     if (stack[sp].t > tfar) continue;
     uint32_t ref = stack[sp].ref;
     if (ref & FR_BVH2_LEAF) {
-      uint32_t first = ref & FR_BVH2_FIRST_MASK, count = (ref & ~FR_BVH2_LEAF) >> FR_BVH2_COUNT_SHIFT;
+      uint32_t first = FR_BVH2_LEAF_FIRST(ref), count = FR_BVH2_LEAF_COUNT(ref);
       for (uint32_t i = first; i < first + count; i++) {
         float th;
         FR_COUNT(sp_tests, 1);
