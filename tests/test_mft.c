@@ -86,9 +86,9 @@ static void check_shadows_vs(const fr_scene *s, const fr_mft_batch *b, const fr_
         fr_mft_opts o = {corner != 0, shrink, corner == 2 ? fr_mft_opts_default().corner_cost : 0.0f};
         uint16_t occ[16];
         memset(occ, 0xAB, sizeof occ); /* poison: every frustum must be written */
-        unsigned nodes = ~0u;
-        isa_fns[i]->occluded(&s->bvh2_mft, &o, b, T, occ, &nodes, NULL);
-        assert_true(nodes != ~0u);
+        fr_mft_budget none = {0, 0, ~0u, -1};
+        isa_fns[i]->occluded(&s->bvh2_mft, &o, b, T, occ, &none, NULL);
+        assert_true(none.visited != ~0u && none.stopped == 0);
         /* occluders cached from the previous batch, and from this batch
          * itself (its best leaves then occlude rays before any traversal),
          * change no answer */
@@ -335,15 +335,31 @@ static void rays_frusta(void **state) {
       check_shadows(s, &b, &T, &tl);
       /* a budget of 3 nodes stops the batch: what it says occluded is */
       uint16_t full[16], part[16];
-      unsigned nodes = 0;
+      fr_mft_budget all = {0, 0, 0, 0};
       const fr_mft_opts o = fr_mft_opts_default();
-      fr_mft_active()->occluded(&s->bvh2, &o, &b, &T, full, &nodes, NULL);
-      if (nodes > 3) {
-        unsigned budget = 3;
+      const unsigned fetched = fr_mft_active()->occluded(&s->bvh2, &o, &b, &T, full, &all, NULL);
+      assert_false(all.stopped);
+      if (all.visited > 3) {
+        fr_mft_budget budget = {3, 0, 0, 0};
         fr_mft_active()->occluded(&s->bvh2, &o, &b, &T, part, &budget, NULL);
-        assert_int_equal(budget, 4);
+        assert_true(budget.stopped);
+        assert_int_equal(budget.visited, 3);
         for (int f = 0; f < 16; f++) assert_int_equal(part[f] & ~full[f], 0);
         stopped++;
+      }
+      /* nodes and triangles together: the batch stops only once it has
+       * spent both, and a budget the whole batch stays within changes
+       * nothing */
+      if (all.visited > 3 && fetched > 0) {
+        fr_mft_budget both = {3, fetched, 0, 0};
+        fr_mft_active()->occluded(&s->bvh2, &o, &b, &T, part, &both, NULL);
+        assert_true(both.visited >= 3);
+        for (int f = 0; f < 16; f++) assert_int_equal(part[f] & ~full[f], 0);
+        fr_mft_budget roomy = {all.visited + 1, fetched + 1, 0, 0};
+        fr_mft_active()->occluded(&s->bvh2, &o, &b, &T, part, &roomy, NULL);
+        assert_false(roomy.stopped);
+        assert_int_equal(roomy.visited, all.visited);
+        assert_memory_equal(part, full, sizeof part);
       }
     }
     fr_scene_release(s);
@@ -558,13 +574,12 @@ static void light_sets_are_nets(void **state) {
   }
 }
 
-/* Soft shadows of a tile go as rays where a batch's frusta fetch many
- * triangles each (render/workload.c), as hybrid packets or, with more, as
- * ray streams. On the kitchen at 64x64 all three paths run (on the dragon,
- * since tiles' batches go in serpentine order, every fallen-back tile
- * takes streams): the visibility must match the stream tracer's, pixel by
- * pixel, up to rays grazing an edge. */
-typedef struct ray_counter { fr_tracer inner; size_t rays, batches, stream_rays; } ray_counter;
+/* Soft shadows of a tile go as ray streams where a batch's frusta fetch
+ * many triangles each (render/workload.c), and the batch that tells stops
+ * short, its rays still open joining the streams. On the kitchen at 64x64
+ * every path runs (frusta, streams, a stopped batch): the visibility must
+ * match the stream tracer's, pixel by pixel, up to rays grazing an edge. */
+typedef struct ray_counter { fr_tracer inner; size_t rays, batches, stream_rays, stopped; } ray_counter;
 
 static void counted_occluded(void *ctx, const fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
   ray_counter *c = ctx;
@@ -584,10 +599,12 @@ static unsigned counted_intersect_frusta(void *ctx, const fr_mft_batch *b, const
 }
 
 static unsigned counted_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[16],
-                                        unsigned *nodes, fr_mft_occluders *cache) {
+                                        fr_mft_budget *budget, fr_mft_occluders *cache) {
   ray_counter *c = ctx;
   c->batches++;
-  return c->inner.occluded_frusta(c->inner.ctx, b, t, occ, nodes, cache);
+  const unsigned fetched = c->inner.occluded_frusta(c->inner.ctx, b, t, occ, budget, cache);
+  c->stopped += budget && budget->stopped;
+  return fetched;
 }
 
 static void soft_fallback(void **state) {
@@ -610,15 +627,16 @@ static void soft_fallback(void **state) {
   fr_softshadow_opts so = {16, 0, FR_LIGHT_SETS_SPREAD};
   static float img[SZ * SZ * 3], vis_mft[SZ * SZ], vis_rays[SZ * SZ];
   fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
-  ray_counter c = {fr_tracer_mft(&mctx), 0, 0, 0};
+  ray_counter c = {fr_tracer_mft(&mctx), 0, 0, 0, 0};
   fr_tracer counted = {&c, counted_intersect, counted_occluded, counted_intersect_frusta, counted_occluded_frusta, 0};
   fr_workload_result r;
   assert_int_equal(fr_render_softshadow(&w, &counted, &so, img, vis_mft, &r), FR_OK);
   fr_tracer rays = fr_tracer_frusta(s);
   assert_int_equal(fr_render_softshadow(&w, &rays, &so, img, vis_rays, &r), FR_OK);
-  print_message("kitchen soft shadows: %zu frusta batches, %zu rays as rays, %zu of them in ray streams\n", c.batches,
-                c.rays, c.stream_rays);
-  assert_true(c.batches > 0 && c.rays > c.stream_rays && c.stream_rays > 0); /* all three paths ran */
+  print_message("kitchen soft shadows: %zu frusta batches (%zu stopped short), %zu rays as rays, %zu of them in ray "
+                "streams\n", c.batches, c.stopped, c.rays, c.stream_rays);
+  /* every path ran; fallen-back tiles take streams only */
+  assert_true(c.batches > 0 && c.rays > 0 && c.rays == c.stream_rays && c.stopped > 0);
   double sum = 0.0;
   for (int i = 0; i < SZ * SZ; i++) {
     float d = fabsf(vis_mft[i] - vis_rays[i]);

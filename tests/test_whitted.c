@@ -76,11 +76,10 @@ static unsigned check_intersect_frusta(void *ctx, const fr_mft_batch *b, const f
 /* shadow frusta from the light: each ray as fr_mft_ray makes it; a batch
  * stopped by its node budget answers only for the rays it found occluded */
 static unsigned check_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[16],
-                                      unsigned *nodes, fr_mft_occluders *cache) {
+                                      fr_mft_budget *budget, fr_mft_occluders *cache) {
   checker *c = ctx;
-  const unsigned budget = nodes ? *nodes : 0;
-  unsigned fetched = c->inner.occluded_frusta(c->inner.ctx, b, t, occ, nodes, cache);
-  const int stopped = budget && nodes && *nodes > budget;
+  unsigned fetched = c->inner.occluded_frusta(c->inner.ctx, b, t, occ, budget, cache);
+  const int stopped = budget && budget->stopped;
   mesh_ref m = scene_mesh(c->s);
   for (int f = 0; f < FR_MFT_FRUSTA; f++) {
     if (!((b->valid >> f) & 1)) continue;

@@ -270,12 +270,12 @@ static void trace_shadow_frusta(const fr_workload *w, const fr_tracer *t, const 
   while (a < n) {
     const size_t m = n - a < per ? n - a : per;
     const unsigned valid = fr_mft_active()->from_rays(&b, &T, rays + a, m);
-    const unsigned budget = w->mft_no_fallback ? 0 : SHADOW_FRUSTA_MAX_NODES * (unsigned)__builtin_popcount(valid);
-    unsigned nodes = budget;
+    fr_mft_budget budget = {w->mft_no_fallback ? 0 : SHADOW_FRUSTA_MAX_NODES * (unsigned)__builtin_popcount(valid), 0, 0,
+                            0};
     /* no occluder cache: point-light frusta are thin and end at their first
      * occluder anyway (museum and kitchen whitted measured the same) */
-    if (valid) t->occluded_frusta(t->ctx, &b, &T, bits, &nodes, NULL);
-    if (budget && nodes > budget) break; /* these rays too */
+    if (valid) t->occluded_frusta(t->ctx, &b, &T, bits, &budget, NULL);
+    if (budget.stopped) break; /* these rays too */
     for (size_t f = 0; f * FR_MFT_RAYS < m; f++) {
       size_t first = a + f * FR_MFT_RAYS, cnt = m - f * FR_MFT_RAYS < FR_MFT_RAYS ? m - f * FR_MFT_RAYS : FR_MFT_RAYS;
       if (!((valid >> f) & 1)) {

@@ -78,8 +78,8 @@ unsigned fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int 
 }
 
 /* Frusta that fetch more triangles than this each (the tile's first batch
- * tells) would be outrun by their rays traced one packet at a time: the rest
- * of the tile goes as rays. Triangles per frustum, 1024x1024, on average:
+ * tells) would be outrun by their rays: the rest of the tile goes as ray
+ * streams. Triangles per frustum, 1024x1024, on average:
  * conference and sibenik ~1, kitchen ~5, dragon ~20 (pure frusta 0.4x the
  * rays there: fine triangles in wide frusta). The tile decides, not the
  * thread, so that a tile's image does not depend on which thread traced
@@ -93,16 +93,18 @@ unsigned fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int 
  * 1.125x, kitchen 1.051x, sibenik 1.026x (3/3 each), dragon 0.99-1.02x;
  * 8 gained half as much, 16 the same as 12. */
 #define SOFT_FRUSTA_MAX_NODES 12
-/* Where the first batch's frusta fetched more than this many triangles each,
- * the tile's rays part ways at the scale of the triangles, and ray streams
- * (trace/bvhn_stream.c) beat hybrid packets: against packets for every
- * fallen-back tile, interleaved, 1 thread, 1024x1024, mft soft16, 6 pairs
- * (CONCURRENT=1 bench/ab.sh): dragon 1.25x (5/6; 72% of its fallen-back
- * batches go as streams), kitchen 1.03x (4/6; 48%); conference sends 55 of
- * its 3523 this way. Streams for all fallen-back tiles (a bound of 8) read
- * 0.89x on conference (1/4), but runs there that changed nothing read 0.91x
- * and 0.94x: this setup's noise; 24 gave dragon 1.12x, 64 1.05x. */
-#define SOFT_STREAM_MIN_TRIS 16
+/* Such a tile's rays part ways at the scale of its triangles, and ray
+ * streams (trace/bvhn_stream.c) beat hybrid packets there. Until session 43
+ * only tiles whose first batch fetched more than 16 triangles per frustum
+ * went as streams, the rest as packets; now the first batch stops as soon
+ * as the verdict above is certain (see soft_shadows), so that bound can no
+ * longer be read, and all go as streams: interleaved, 2 threads,
+ * 1024x1024, soft16 mft, 4 pairs, against stopping at 16: kitchen 1.028x
+ * and 1.057x (3/4, 4/4), dragon 1.022x (4/4); conference's instructions
+ * +0.2% (callgrind; it falls back in 14 tiles). Timed per batch (rdtsc,
+ * warm caches, 1 thread), streams and packets cost the same on the
+ * batches between 8 and 16 triangles per frustum: kitchen 0.153 and 0.156
+ * Gcycles, dragon 0.080 and 0.081. */
 /* A tile whose camera frusta fetched more than this many triangles each
  * skips shadow frusta altogether: its first batch of them would fetch too
  * many as well (at 1024x1024 this sends 1840 more of dragon's batches to
@@ -149,25 +151,42 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
       b.valid |= 1u << f;
     }
     rays += 16u * (uint64_t)__builtin_popcount(b.valid);
+    uint16_t occ[FR_MFT_FRUSTA] = {0};
     if (!as_rays) {
-      uint16_t occ[FR_MFT_FRUSTA];
-      unsigned visited = 0; /* in: no budget; out: the nodes the batch visited */
-      unsigned fetched = t->occluded_frusta(t->ctx, &b, T, occ, &visited, &cache);
-      for (unsigned v = b.valid; v; v &= v - 1) {
-        int f = __builtin_ctz(v);
-        lit[16 * j + f] = (float)(16 - __builtin_popcount(occ[f])) / 16.0f;
-      }
+      /* The batch stops as soon as the rule below is sure to send the rest
+       * of the tile to ray streams, and its rays still open join them:
+       * counts only grow, so the verdict is the same as the whole batch's
+       * but costs a fraction of it (on dragon these first batches of
+       * fallen-back tiles took a quarter of soft16's shadow time, at up to
+       * 7 times their rays' cost as streams; stopping them gained dragon
+       * soft16 1.09x, 4/4 interleaved pairs, kitchen 1.00x). */
       const unsigned nf = (unsigned)__builtin_popcount(b.valid);
-      as_rays = !w->mft_no_fallback && fetched > SOFT_FRUSTA_MAX_TRIS * nf && visited > SOFT_FRUSTA_MAX_NODES * nf;
-      as_streams = fetched > SOFT_STREAM_MIN_TRIS * nf;
-      continue;
+      fr_mft_budget budget = {0, 0, 0, 0};
+      if (!w->mft_no_fallback) {
+        budget.nodes = SOFT_FRUSTA_MAX_NODES * nf + 1;
+        budget.tris = SOFT_FRUSTA_MAX_TRIS * nf + 1;
+      }
+      const unsigned fetched = t->occluded_frusta(t->ctx, &b, T, occ, &budget, &cache);
+      as_rays = as_streams = !w->mft_no_fallback && fetched > SOFT_FRUSTA_MAX_TRIS * nf &&
+                             budget.visited > SOFT_FRUSTA_MAX_NODES * nf;
+      if (!budget.stopped) {
+        for (unsigned v = b.valid; v; v &= v - 1) {
+          int f = __builtin_ctz(v);
+          lit[16 * j + f] = (float)(16 - __builtin_popcount(occ[f])) / 16.0f;
+        }
+        continue;
+      }
+      FR_COUNT(mft_stopped_batches, 1);
     }
     if (t->occluded_frusta && b.valid) FR_COUNT(mft_ray_batches, 1);
     if (as_streams && b.valid) FR_COUNT(mft_stream_batches, 1);
+    /* the rays the frusta left open (all of them, but for a stopped batch);
+     * an occluded ray adds nothing to its pixel's count */
     for (unsigned v = b.valid; v; v &= v - 1) {
       int f = __builtin_ctz(v);
       by_rays[16 * j + f] = 1;
       for (int k = 0; k < FR_MFT_RAYS; k++) {
+        if ((occ[f] >> k) & 1) continue;
         fr_ray *r = &B->rays[m];
         fr_mft_ray(&b, T, f, k, r->org, r->dir);
         r->tnear = b.tnear[f];
@@ -417,9 +436,9 @@ static unsigned mft_intersect_frusta(void *ctx, const fr_mft_batch *b, const fr_
 }
 
 static unsigned mft_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t,
-                                    uint16_t occ[FR_MFT_FRUSTA], unsigned *nodes, fr_mft_occluders *cache) {
+                                    uint16_t occ[FR_MFT_FRUSTA], fr_mft_budget *budget, fr_mft_occluders *cache) {
   const fr_mft_tracer *m = ctx;
-  return fr_mft_active()->occluded(m->shadow_bvh ? m->shadow_bvh : m->bvh, &m->opts, b, t, occ, nodes, cache);
+  return fr_mft_active()->occluded(m->shadow_bvh ? m->shadow_bvh : m->bvh, &m->opts, b, t, occ, budget, cache);
 }
 
 fr_mft_tracer fr_mft_tracer_of(const fr_scene *s, fr_mft_opts opts) {

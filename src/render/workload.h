@@ -47,7 +47,7 @@ typedef struct fr_tracer {
   /* both return the triangles the batch fetched (see soft_shadows in
    * workload.c); cache as fr_mft_fns.occluded's */
   unsigned (*occluded_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[FR_MFT_FRUSTA],
-                              unsigned *nodes, fr_mft_occluders *cache);
+                              fr_mft_budget *budget, fr_mft_occluders *cache);
   int packet_side;
 } fr_tracer;
 

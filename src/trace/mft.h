@@ -104,16 +104,25 @@ typedef struct fr_mft_occluders {
   unsigned n;
 } fr_mft_occluders;
 
+/* What a shadow batch may spend, and what it spent. A batch stops before
+ * an inner-node visit once it has visited `nodes` nodes and fetched at
+ * least `tris` triangles (both 0: no budget); then only the set bits of
+ * occ are answers, and the other rays are still to be traced. Both counts
+ * only grow, so a caller that would judge the batch by them afterwards
+ * can have it stop as soon as the verdict is certain. */
+typedef struct fr_mft_budget {
+  unsigned nodes, tris; /* in */
+  unsigned visited;     /* out: the inner nodes visited */
+  int stopped;          /* out: stopped over budget */
+} fr_mft_budget;
+
 typedef struct fr_mft_fns {
   /* occ[f]: bit k set when ray k of frustum f is occluded; returns the
-   * triangles the batch's leaves fetched, what it cost. nodes, when not
-   * NULL: in, a budget of inner-node visits (0: none); out, the visits. A
-   * batch that would go over its budget stops there (*nodes = budget + 1),
-   * and then only the set bits of occ are answers: the other rays are
-   * still to be traced. cache, when not NULL: the occluders to test first,
-   * replaced by this batch's. */
+   * triangles the batch's leaves fetched, what it cost. budget, when not
+   * NULL: see fr_mft_budget. cache, when not NULL: the occluders to test
+   * first, replaced by this batch's. */
   unsigned (*occluded)(const fr_bvh2 *b, const fr_mft_opts *o, const fr_mft_batch *batch, const fr_mft_sets *sets,
-                       uint16_t occ[FR_MFT_FRUSTA], unsigned *nodes, fr_mft_occluders *cache);
+                       uint16_t occ[FR_MFT_FRUSTA], fr_mft_budget *budget, fr_mft_occluders *cache);
   /* returns the triangles fetched, as occluded does */
   unsigned (*intersect)(const fr_bvh2 *b, const fr_mft_opts *o, const fr_mft_batch *batch, const fr_mft_sets *sets,
                         fr_mft_hits *hits);

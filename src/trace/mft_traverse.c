@@ -459,13 +459,13 @@ static void best_leaves_add(best_leaves *L, uint32_t ref, unsigned rays) {
 }
 
 static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B, const fr_mft_sets *T,
-                             uint16_t occ[16], unsigned *nodes, fr_mft_occluders *cache) {
+                             uint16_t occ[16], fr_mft_budget *budget, fr_mft_occluders *cache) {
   frusta F;
   unsigned valid = B->valid & 0xFFFFu;
   unsigned visited = 0;
-  const unsigned budget = nodes && *nodes ? *nodes : ~0u;
+  const int bounded = budget && (budget->nodes || budget->tris);
   for (int f = 0; f < 16; f++) occ[f] = 0;
-  if (nodes) *nodes = 0;
+  if (budget) budget->visited = 0, budget->stopped = 0;
   FR_COUNT(mft_batches, 1);
   FR_COUNT(rays, 16 * __builtin_popcount(valid));
   if (!valid || !b->nodes) return 0;
@@ -504,7 +504,11 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
     e.mask &= alive;
     while (e.mask) {
       if (!(e.ref & FR_BVH2_LEAF)) {
-        if (visited++ == budget) goto out;
+        if (bounded && visited >= budget->nodes && fetched >= budget->tris) {
+          budget->stopped = 1;
+          goto out;
+        }
+        visited++;
         if (!visit_node(&F, b, e.ref, e.mask, stack, &sp, &e)) break;
         continue;
       }
@@ -525,7 +529,7 @@ out:
     cache->n = best.n;
     for (unsigned c = 0; c < best.n; c++) cache->leaf[c] = best.ref[c];
   }
-  if (nodes) *nodes = visited;
+  if (budget) budget->visited = visited;
   return fetched;
 }
 
