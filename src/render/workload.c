@@ -67,14 +67,13 @@ static vec3 albedo(const fr_scene *s, uint32_t prim) {
   return mat ? v3(mat->diffuse[0], mat->diffuse[1], mat->diffuse[2]) : v3(0.8f, 0.8f, 0.8f);
 }
 
-unsigned fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, fr_ray *rays, fr_hit *hits) {
+void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, fr_ray *rays, fr_hit *hits) {
   fr_mft_batch b;
   static _Thread_local fr_mft_hits h;
   const fr_mft_sets *cam_set = w->camera_set;
   fr_mft_batch_camera(&b, &w->cam, tx, ty);
-  unsigned fetched = t->intersect_frusta(t->ctx, &b, cam_set, &h);
+  t->intersect_frusta(t->ctx, &b, cam_set, &h);
   fr_mft_active()->expand(&b, cam_set, &h, rays, hits);
-  return fetched;
 }
 
 /* Frusta that fetch more triangles than this each (the tile's first batch
@@ -104,29 +103,21 @@ unsigned fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int 
  * +0.2% (callgrind; it falls back in 14 tiles). Timed per batch (rdtsc,
  * warm caches, 1 thread), streams and packets cost the same on the
  * batches between 8 and 16 triangles per frustum: kitchen 0.153 and 0.156
- * Gcycles, dragon 0.080 and 0.081. */
-/* A tile whose camera frusta fetched more than this many triangles each
- * skips shadow frusta altogether: its first batch of them would fetch too
- * many as well (at 1024x1024 this sends 1840 more of dragon's batches to
- * ray streams, 16 of conference's, 48 of kitchen's, none of sibenik's).
- * Interleaved, 2 repetitions, 5 pairs, otherwise as above:
- * dragon soft16 1.07x (5/5), conference 1.00x (3/5). A bound of 16 gave
- * dragon 1.10x (5/5) but conference 0.945x (0/5), kitchen and sibenik
- * 0.99x (0/5 each). */
-#define SOFT_CAMERA_MAX_TRIS 32u
+ * Gcycles, dragon 0.080 and 0.081. A tile whose camera frusta had fetched
+ * more than 32 triangles each used to skip shadow frusta altogether
+ * (dragon 1.07x while first batches ran to their end); with them stopped
+ * early that rule no longer paid (without it, 3 pairs: dragon 1.012x,
+ * kitchen 1.002x) and is gone. */
 
 /* Soft shadows: pixels 16 j .. 16 j + 15 with a primary hit are the frusta of
  * batch j: origin p, rays p + t (c + s e1 + q e2 - p) for the samples of the
  * pixel's interleaved set, t in (eps / |light centre - p|, 1 - 1e-4). Returns
- * the shadow rays traced; lit[i] gets pixel i's unoccluded fraction.
- * cam_fetched: the triangles the tile's camera frusta fetched (0 if none). */
-static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *B, int n, float *lit, unsigned cam_fetched) {
+ * the shadow rays traced; lit[i] gets pixel i's unoccluded fraction. */
+static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *B, int n, float *lit) {
   const fr_mft_sets *T = w->light_sets;
   vec3 centre = v3_add(w->view.area_c, v3_scale(v3_add(w->view.area_e1, w->view.area_e2), 0.5f));
   uint64_t rays = 0;
   int m = 0, as_rays = !t->occluded_frusta, as_streams = 0;
-  if (t->occluded_frusta && !w->mft_no_fallback && cam_fetched > SOFT_CAMERA_MAX_TRIS * FR_MFT_FRUSTA)
-    as_rays = as_streams = 1;
   uint8_t by_rays[TILE_PIX] = {0};
   /* one per tile, so that what a batch costs does not depend on which
    * thread traced the tile before */
@@ -226,9 +217,8 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
           n++;
         }
   uint64_t rays = (uint64_t)n;
-  unsigned cam_fetched = 0;
   if (frusta)
-    cam_fetched = fr_camera_frusta(w, t, tx, ty, B->prim_ray, B->prim_hit);
+    fr_camera_frusta(w, t, tx, ty, B->prim_ray, B->prim_hit);
   else
     t->intersect(t->ctx, B->rays, B->prim_hit, (size_t)n, 1);
   float lit[TILE_PIX];
@@ -240,7 +230,7 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
     break;
   case FR_WL_SOFT16:
     for (int i = 0; i < n; i++) lit[i] = 0.0f;
-    rays += soft_shadows(w, t, B, n, lit, cam_fetched);
+    rays += soft_shadows(w, t, B, n, lit);
     break;
   case FR_WL_SHADOW:
   case FR_WL_AO16: {

@@ -100,7 +100,7 @@ fr_workload_result fr_workload_run(const fr_workload *w, const fr_tracer *t);
  * (t->intersect_frusta): ray and hit 16 f + k are pixel (tx + 4 (f % 4) +
  * k % 4, ty + 4 (f / 4) + k / 4). The rays are fr_mft_ray's with unit
  * directions, as fr_camera_ray makes them, and the hits are in their units. */
-unsigned fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, fr_ray *rays, fr_hit *hits);
+void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, fr_ray *rays, fr_hit *hits);
 
 /* The frusta tracer: streams as the scene's trace options say. */
 fr_tracer fr_tracer_frusta(const fr_scene *s);
