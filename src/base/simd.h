@@ -9,7 +9,8 @@
  * the tests hold them to that.
  *
  *   vfloat4 / vmask4   four lanes: BVH4 node tests, 4-triangle leaves
- *   vfloat8            eight lanes: BVH8 node tests (comparisons give bit masks)
+ *   vfloat8            eight lanes: BVH8 node tests, two rays' 4-triangle tests
+ *                      (comparisons give bit masks)
  *   vbits8             eight 64-bit sets: per child, the rays of a stream that hit it
  */
 #ifndef FR_BASE_SIMD_H
@@ -92,6 +93,19 @@ FR_INLINE vfloat8 vf8_mul(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_mul_ps(a.v
 FR_INLINE vfloat8 vf8_min(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_min_ps(a.v, b.v)}; return r; }
 FR_INLINE vfloat8 vf8_max(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_max_ps(a.v, b.v)}; return r; }
 FR_INLINE vfloat8 vf8_div(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_div_ps(a.v, b.v)}; return r; }
+FR_INLINE vfloat8 vf8_add(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_add_ps(a.v, b.v)}; return r; }
+/* lanes 0-3 from lo, 4-7 from hi: two rays' four-lane values side by side */
+FR_INLINE vfloat8 vf8_join(vfloat4 lo, vfloat4 hi) { vfloat8 r = {_mm256_set_m128(hi.v, lo.v)}; return r; }
+#if defined(FR_BUILD_ISA_AVX512)
+#define FR_CMP8_BITS(a, b, op) _mm256_cmp_ps_mask((a).v, (b).v, op)
+#else
+#define FR_CMP8_BITS(a, b, op) _mm256_movemask_ps(_mm256_cmp_ps((a).v, (b).v, op))
+#endif
+FR_INLINE int vf8_lt_bits(vfloat8 a, vfloat8 b) { return FR_CMP8_BITS(a, b, _CMP_LT_OQ); }
+FR_INLINE int vf8_gt_bits(vfloat8 a, vfloat8 b) { return FR_CMP8_BITS(a, b, _CMP_GT_OQ); }
+FR_INLINE int vf8_ge_bits(vfloat8 a, vfloat8 b) { return FR_CMP8_BITS(a, b, _CMP_GE_OQ); }
+FR_INLINE int vf8_eq_bits(vfloat8 a, vfloat8 b) { return FR_CMP8_BITS(a, b, _CMP_EQ_OQ); }
+FR_INLINE int vf8_ne_bits(vfloat8 a, vfloat8 b) { return FR_CMP8_BITS(a, b, _CMP_NEQ_UQ); }
 #if defined(FR_BUILD_ISA_AVX512)
 FR_INLINE int vf8_le_bits(vfloat8 a, vfloat8 b) { return _mm256_cmp_ps_mask(a.v, b.v, _CMP_LE_OQ); }
 FR_INLINE vfloat8 vf8_add_where(vfloat8 a, int lanes, vfloat8 b) { vfloat8 r = {_mm256_mask_add_ps(a.v, (__mmask8)lanes, a.v, b.v)}; return r; }
@@ -173,6 +187,14 @@ FR_INLINE vfloat8 vf8_min(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] < b.f[i] ? a.f[
 FR_INLINE vfloat8 vf8_max(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] > b.f[i] ? a.f[i] : b.f[i])
 FR_INLINE int vf8_le_bits(vfloat8 a, vfloat8 b) { int m = 0; for (int i = 0; i < 8; i++) m |= (a.f[i] <= b.f[i]) << i; return m; }
 FR_INLINE vfloat8 vf8_div(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] / b.f[i])
+FR_INLINE vfloat8 vf8_add(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] + b.f[i])
+FR_INLINE vfloat8 vf8_join(vfloat4 lo, vfloat4 hi) FR_LANES8(i < 4 ? lo.f[i] : hi.f[i - 4])
+#define FR_BITS8(expr) { int m = 0; for (int i = 0; i < 8; i++) m |= (expr) << i; return m; }
+FR_INLINE int vf8_lt_bits(vfloat8 a, vfloat8 b) FR_BITS8(a.f[i] < b.f[i])
+FR_INLINE int vf8_gt_bits(vfloat8 a, vfloat8 b) FR_BITS8(a.f[i] > b.f[i])
+FR_INLINE int vf8_ge_bits(vfloat8 a, vfloat8 b) FR_BITS8(a.f[i] >= b.f[i])
+FR_INLINE int vf8_eq_bits(vfloat8 a, vfloat8 b) FR_BITS8(a.f[i] == b.f[i])
+FR_INLINE int vf8_ne_bits(vfloat8 a, vfloat8 b) FR_BITS8(!(a.f[i] == b.f[i]))
 FR_INLINE vfloat8 vf8_add_where(vfloat8 a, int lanes, vfloat8 b) FR_LANES8(((lanes >> i) & 1) ? a.f[i] + b.f[i] : a.f[i])
 
 typedef struct vbits8 { uint64_t u[8]; } vbits8;

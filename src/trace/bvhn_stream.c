@@ -132,16 +132,28 @@ static uint64_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint3
       m = child_rays[last];
     }
     {
+      /* block by block, two rays to a test (tri4_occluded2); a ray leaves
+       * the leaf at its first hit, so each ray meets the same blocks as
+       * when it went through them alone */
       const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
-      for (uint64_t mm = m; mm; mm &= mm - 1) {
-        int i = __builtin_ctzll(mm);
-        FR_COUNT(leaves, 1);
-        for (uint32_t k = first; k < first + nb; k++) {
-          FR_COUNT(tri_tests, 4);
-          tri4_result res;
-          tri4_test(&b->tris[k], &pre[i], tfar[i], &res);
-          if (res.mask) { occ |= 1ull << i; break; }
+      FR_COUNT(leaves, (uint64_t)__builtin_popcountll(m));
+      for (uint32_t k = first; k < first + nb && m; k++) {
+        FR_COUNT(tri_tests, 4 * (uint64_t)__builtin_popcountll(m));
+        for (uint64_t mm = m; mm;) {
+          const int i = __builtin_ctzll(mm);
+          mm &= mm - 1;
+          if (!mm) {
+            tri4_result res;
+            tri4_test(&b->tris[k], &pre[i], tfar[i], &res);
+            if (res.mask) occ |= 1ull << i;
+            break;
+          }
+          const int i2 = __builtin_ctzll(mm);
+          mm &= mm - 1;
+          const int hits = tri4_occluded2(&b->tris[k], &pre[i], tfar[i], &pre[i2], tfar[i2]);
+          occ |= (uint64_t)(hits & 1) << i | (uint64_t)(hits >> 1) << i2;
         }
+        m &= ~occ;
       }
       active &= ~occ;
       if (!active) break;
