@@ -96,6 +96,8 @@ FR_INLINE vfloat8 vf8_div(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_div_ps(a.v
 FR_INLINE vfloat8 vf8_add(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_add_ps(a.v, b.v)}; return r; }
 /* lanes 0-3 from lo, 4-7 from hi: two rays' four-lane values side by side */
 FR_INLINE vfloat8 vf8_join(vfloat4 lo, vfloat4 hi) { vfloat8 r = {_mm256_set_m128(hi.v, lo.v)}; return r; }
+FR_INLINE vfloat4 vf8_lo(vfloat8 a) { vfloat4 r = {_mm256_castps256_ps128(a.v)}; return r; }
+FR_INLINE vfloat4 vf8_hi(vfloat8 a) { vfloat4 r = {_mm256_extractf128_ps(a.v, 1)}; return r; }
 #if defined(FR_BUILD_ISA_AVX512)
 #define FR_CMP8_BITS(a, b, op) _mm256_cmp_ps_mask((a).v, (b).v, op)
 #else
@@ -189,6 +191,8 @@ FR_INLINE int vf8_le_bits(vfloat8 a, vfloat8 b) { int m = 0; for (int i = 0; i <
 FR_INLINE vfloat8 vf8_div(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] / b.f[i])
 FR_INLINE vfloat8 vf8_add(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] + b.f[i])
 FR_INLINE vfloat8 vf8_join(vfloat4 lo, vfloat4 hi) FR_LANES8(i < 4 ? lo.f[i] : hi.f[i - 4])
+FR_INLINE vfloat4 vf8_lo(vfloat8 a) FR_LANES4(a.f[i])
+FR_INLINE vfloat4 vf8_hi(vfloat8 a) FR_LANES4(a.f[i + 4])
 #define FR_BITS8(expr) { int m = 0; for (int i = 0; i < 8; i++) m |= (expr) << i; return m; }
 FR_INLINE int vf8_lt_bits(vfloat8 a, vfloat8 b) FR_BITS8(a.f[i] < b.f[i])
 FR_INLINE int vf8_gt_bits(vfloat8 a, vfloat8 b) FR_BITS8(a.f[i] > b.f[i])

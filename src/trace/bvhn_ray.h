@@ -155,14 +155,14 @@ FR_INLINE void tri4_test(const fr_tri4 *tr, const ray_pre *r, float tfar, tri4_r
   res->mask = vm4_bits(ok);
 }
 
-/* Two rays against one block, for occlusion: bit 0 when ray a hits one of
- * its triangles in (tnear, tfar), bit 1 when ray b does. Lanes 0-3 are ray
- * a's, 4-7 ray b's, each lane the same operations as tri4_test, so the
- * answers are tri4_test's; a ray with an edge value of exactly zero takes
- * tri4_test itself (its exact path). For ray streams, whose leaves are
- * mostly reached by several rays: a block's test costs little more for two
- * rays than for one. */
-FR_INLINE int tri4_occluded2(const fr_tri4 *tr, const ray_pre *a, float tfa, const ray_pre *b, float tfb) {
+/* Two rays against one block: *ra and *rb as tri4_test gives them for ray
+ * a and ray b. Lanes 0-3 are ray a's, 4-7 ray b's, each lane the same
+ * operations as tri4_test, so the answers are its own; a ray with an edge
+ * value of exactly zero takes tri4_test itself (its exact path). For ray
+ * streams, whose leaves are mostly reached by several rays: a block's test
+ * costs little more for two rays than for one. */
+FR_INLINE void tri4_test2(const fr_tri4 *tr, const ray_pre *a, float tfa, const ray_pre *b, float tfb,
+                          tri4_result *ra, tri4_result *rb) {
   const float *p = tr->v0[0];
   enum { V1 = 12, V2 = 24 };
 #define TRI4_LOAD2(off) vf8_join(vf4_load(p + a->off), vf4_load(p + b->off))
@@ -184,25 +184,26 @@ FR_INLINE int tri4_occluded2(const fr_tri4 *tr, const ray_pre *a, float tfa, con
   vfloat8 e2 = vf8_sub(vf8_mul(bx, ay), vf8_mul(by, ax));
   const vfloat8 zero = vf8(0.0f);
   const int zeros = vf8_eq_bits(e0, zero) | vf8_eq_bits(e1, zero) | vf8_eq_bits(e2, zero);
+  const int exact = (zeros & 0x0F ? 0x0F : 0) | (zeros & 0xF0 ? 0xF0 : 0);
   vfloat8 lo = vf8_min(e0, vf8_min(e1, e2)), hi = vf8_max(e0, vf8_max(e1, e2));
-  int inside = (vf8_ge_bits(lo, zero) | vf8_le_bits(hi, zero)) & ~(zeros & 0x0F ? 0x0F : 0) & ~(zeros & 0xF0 ? 0xF0 : 0);
-  int hits = 0;
+  const int inside = (vf8_ge_bits(lo, zero) | vf8_le_bits(hi, zero)) & ~exact;
+  vfloat8 t = zero, inv = zero;
+  int ok = 0;
   if (inside) {
     vfloat8 det = vf8_add(vf8_add(e0, e1), e2);
-    vfloat8 inv = vf8_div(vf8(1.0f), det);
+    inv = vf8_div(vf8(1.0f), det);
     vfloat8 nsz = vf8_join(a->nsz, b->nsz);
     vfloat8 tz = vf8_add(vf8_add(vf8_mul(e0, vf8_mul(nsz, az)), vf8_mul(e1, vf8_mul(nsz, bz))), vf8_mul(e2, vf8_mul(nsz, cz)));
-    vfloat8 t = vf8_mul(tz, inv);
+    t = vf8_mul(tz, inv);
     vfloat8 tn = vf8_join(vf4(a->tnear), vf4(b->tnear)), tf = vf8_join(vf4(tfa), vf4(tfb));
-    const int ok = inside & vf8_ne_bits(det, zero) & vf8_gt_bits(t, tn) & vf8_lt_bits(t, tf);
-    hits = (ok & 0x0F ? 1 : 0) | (ok & 0xF0 ? 2 : 0);
+    ok = inside & vf8_ne_bits(det, zero) & vf8_gt_bits(t, tn) & vf8_lt_bits(t, tf);
   }
-  if (__builtin_expect(zeros != 0, 0)) {
-    tri4_result res;
-    if (zeros & 0x0F) { tri4_test(tr, a, tfa, &res); hits |= res.mask ? 1 : 0; }
-    if (zeros & 0xF0) { tri4_test(tr, b, tfb, &res); hits |= res.mask ? 2 : 0; }
+  ra->t = vf8_lo(t); ra->e1 = vf8_lo(e1); ra->e2 = vf8_lo(e2); ra->inv = vf8_lo(inv); ra->mask = ok & 0x0F;
+  rb->t = vf8_hi(t); rb->e1 = vf8_hi(e1); rb->e2 = vf8_hi(e2); rb->inv = vf8_hi(inv); rb->mask = ok >> 4;
+  if (__builtin_expect(exact != 0, 0)) {
+    if (exact & 0x0F) tri4_test(tr, a, tfa, ra);
+    if (exact & 0xF0) tri4_test(tr, b, tfb, rb);
   }
-  return hits;
 }
 
 static inline float tri4_lane(vfloat4 v, int i) {

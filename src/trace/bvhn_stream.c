@@ -132,7 +132,7 @@ static uint64_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint3
       m = child_rays[last];
     }
     {
-      /* block by block, two rays to a test (tri4_occluded2); a ray leaves
+      /* block by block, two rays to a test (tri4_test2); a ray leaves
        * the leaf at its first hit, so each ray meets the same blocks as
        * when it went through them alone */
       const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
@@ -150,8 +150,9 @@ static uint64_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint3
           }
           const int i2 = __builtin_ctzll(mm);
           mm &= mm - 1;
-          const int hits = tri4_occluded2(&b->tris[k], &pre[i], tfar[i], &pre[i2], tfar[i2]);
-          occ |= (uint64_t)(hits & 1) << i | (uint64_t)(hits >> 1) << i2;
+          tri4_result ra, rb;
+          tri4_test2(&b->tris[k], &pre[i], tfar[i], &pre[i2], tfar[i2], &ra, &rb);
+          occ |= (uint64_t)(ra.mask != 0) << i | (uint64_t)(rb.mask != 0) << i2;
         }
         m &= ~occ;
       }
@@ -218,19 +219,34 @@ static void intersect_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t
       m = child_rays[order[0]];
     }
     {
+      /* block by block, two rays to a test (tri4_test2): each ray meets
+       * the blocks in the same order, with the same tfar, as alone; a
+       * leaf is reached by two rays at least (one goes to single_closest) */
       const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
-      for (uint64_t mm = m; mm; mm &= mm - 1) {
-        int i = __builtin_ctzll(mm);
-        FR_COUNT(leaves, 1);
-        FR_COUNT(tri_tests, 4 * nb);
-        for (uint32_t k = first; k < first + nb; k++) {
-          tri4_result res;
-          tri4_test(&b->tris[k], &pre[i], tfar[i], &res);
-          if (!res.mask) continue;
-          tfar[i] = tri4_nearest(&res, k, &best[i]);
-          found |= 1ull << i;
+      FR_COUNT(leaves, (uint64_t)__builtin_popcountll(m));
+      FR_COUNT(tri_tests, 4 * (uint64_t)nb * (uint64_t)__builtin_popcountll(m));
+      for (uint32_t k = first; k < first + nb; k++)
+        for (uint64_t mm = m; mm;) {
+          const int i = __builtin_ctzll(mm);
+          mm &= mm - 1;
+          tri4_result ra, rb;
+          if (!mm) {
+            tri4_test(&b->tris[k], &pre[i], tfar[i], &ra);
+            rb.mask = 0;
+          } else {
+            const int i2 = __builtin_ctzll(mm);
+            mm &= mm - 1;
+            tri4_test2(&b->tris[k], &pre[i], tfar[i], &pre[i2], tfar[i2], &ra, &rb);
+            if (rb.mask) {
+              tfar[i2] = tri4_nearest(&rb, k, &best[i2]);
+              found |= 1ull << i2;
+            }
+          }
+          if (ra.mask) {
+            tfar[i] = tri4_nearest(&ra, k, &best[i]);
+            found |= 1ull << i;
+          }
         }
-      }
       continue;
     }
   single: {
