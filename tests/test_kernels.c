@@ -5,6 +5,7 @@
  * path; degenerate triangles never hit; nothing returns NaN.
  */
 #include <string.h>
+#include "accel/bvhn.h"
 #include "geom/tri_moller.h"
 #include "geom/tri_shevtsov.h"
 #include "geom/tri_watertight.h"
@@ -227,10 +228,76 @@ static void test_load_records(void **st) {
   print_message("record loads: %d level/stride pairs\n", tested);
 }
 
+typedef int (*tri4_pair_fn)(const fr_tri4 *, const fr_ray *, const fr_ray *, int *);
+int fr_test_tri4_pair_scalar(const fr_tri4 *block, const fr_ray *a, const fr_ray *b, int *hits);
+int fr_test_tri4_pair_avx2(const fr_tri4 *block, const fr_ray *a, const fr_ray *b, int *hits);
+int fr_test_tri4_pair_avx512(const fr_tri4 *block, const fr_ray *a, const fr_ray *b, int *hits);
+
+/* The ray streams test two rays against a block at once (tri4_test2): on
+ * every level each ray's lanes must be exactly what the one-ray test
+ * gives, for random triangles and rays, and for rays through the vertices
+ * and edges of axis-aligned triangles, whose edge values are exactly zero
+ * (the exact path), with an unused NaN lane in every other block. */
+static void test_tri4_pair(void **st) {
+  (void)st;
+  const struct { fr_isa isa; tri4_pair_fn fn; } levels[] = {{FR_ISA_SCALAR, fr_test_tri4_pair_scalar},
+                                                            {FR_ISA_AVX2, fr_test_tri4_pair_avx2},
+                                                            {FR_ISA_AVX512, fr_test_tri4_pair_avx512}};
+  fr_rng r = fr_rng_seed(43, 2);
+  long hits = 0, tested = 0;
+  for (int n = 0; n < 4000; n++) {
+    fr_tri4 blk;
+    const int grid = n % 2; /* axis-aligned triangles on integer points */
+    for (int lane = 0; lane < 4; lane++) {
+      vec3 v[3];
+      for (int k = 0; k < 3; k++) {
+        v[k] = grid ? v3((float)(int)urand(&r, -3, 3), (float)(int)urand(&r, -3, 3), 0.0f) : rnd3(&r, 1.0f);
+        const float *c = &v[k].x;
+        float(*dst)[4] = k == 0 ? blk.v0 : k == 1 ? blk.v1 : blk.v2;
+        for (int a = 0; a < 3; a++) dst[a][lane] = (lane == 3 && n % 4 == 1) ? NAN : c[a];
+      }
+      blk.prim[lane] = (uint32_t)lane;
+    }
+    fr_ray ray[2];
+    for (int i = 0; i < 2; i++) {
+      vec3 o, target;
+      if (grid) {
+        /* through a vertex or an edge's midpoint of one of the triangles */
+        const int lane = (int)urand(&r, 0, 3), k = (int)urand(&r, 0, 3);
+        const float(*src)[4] = k == 0 ? blk.v0 : k == 1 ? blk.v1 : blk.v2;
+        const float(*nxt)[4] = k == 0 ? blk.v1 : k == 1 ? blk.v2 : blk.v0;
+        const int mid = urand(&r, 0, 1) < 0.5f;
+        target = v3(src[0][lane], src[1][lane], src[2][lane]);
+        if (mid) target = v3_scale(v3_add(target, v3(nxt[0][lane], nxt[1][lane], nxt[2][lane])), 0.5f);
+        const float z = urand(&r, 0, 1) < 0.5f ? 4.0f : -4.0f;
+        /* straight down the z axis half the time: no shear, so the edge
+         * values through the point are exactly zero */
+        o = urand(&r, 0, 1) < 0.5f ? v3(target.x, target.y, z)
+                                   : v3((float)(int)urand(&r, -3, 3), (float)(int)urand(&r, -3, 3), z);
+      } else {
+        o = rnd3(&r, 3.0f);
+        target = rnd3(&r, 0.5f);
+      }
+      const vec3 d = v3_sub(target, o);
+      ray[i] = (fr_ray){{o.x, o.y, o.z}, 0.0f, {d.x, d.y, d.z}, urand(&r, 0, 1) < 0.2f ? 0.5f : INFINITY};
+    }
+    for (size_t l = 0; l < sizeof levels / sizeof levels[0]; l++) {
+      if (!fr_isa_supported(levels[l].isa)) continue;
+      int h = 0;
+      if (!levels[l].fn(&blk, &ray[0], &ray[1], &h)) fail_msg("level %zu, case %d: the pair test differs", l, n);
+      hits += h;
+      tested++;
+    }
+  }
+  print_message("two-ray block tests: %ld across the levels, %ld rays hit\n", tested, hits);
+  assert_true(hits > tested / 4);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_add_where),
       cmocka_unit_test(test_load_records),
+      cmocka_unit_test(test_tri4_pair),
       cmocka_unit_test(test_agreement),
       cmocka_unit_test(test_child_sort8),
       cmocka_unit_test(test_axis_aligned_fast_path),
