@@ -237,7 +237,7 @@ int fr_test_tri4_pair_avx512(const fr_tri4 *block, const fr_ray *a, const fr_ray
  * every level each ray's lanes must be exactly what the one-ray test
  * gives, for random triangles and rays, and for rays through the vertices
  * and edges of axis-aligned triangles, whose edge values are exactly zero
- * (the exact path), with an unused NaN lane in every other block. */
+ * (the exact path), with an unused NaN lane in every fourth block. */
 static void test_tri4_pair(void **st) {
   (void)st;
   const struct { fr_isa isa; tri4_pair_fn fn; } levels[] = {{FR_ISA_SCALAR, fr_test_tri4_pair_scalar},

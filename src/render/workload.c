@@ -176,20 +176,18 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
     }
     if (t->occluded_frusta && b.valid) FR_COUNT(mft_ray_batches, 1);
     if (as_streams && b.valid) FR_COUNT(mft_stream_batches, 1);
-    if (as_streams) {
+    if (as_streams) { /* frusta fell back: traced below, but for the rays they found occluded */
       for (unsigned v = b.valid; v; v &= v - 1) by_rays[16 * j + __builtin_ctz(v)] = 1;
       B->held[nheld] = b;
       memcpy(B->held_occ[nheld], occ, sizeof occ);
       B->held_j[nheld++] = j;
       continue;
     }
-    /* the rays the frusta left open (all of them, but for a stopped batch);
-     * an occluded ray adds nothing to its pixel's count */
+    /* a tracer without frusta: each pixel's 16 rays in a row, a packet */
     for (unsigned v = b.valid; v; v &= v - 1) {
       int f = __builtin_ctz(v);
       by_rays[16 * j + f] = 1;
       for (int k = 0; k < FR_MFT_RAYS; k++) {
-        if ((occ[f] >> k) & 1) continue;
         fr_ray *r = &B->rays[m];
         fr_mft_ray(&b, T, f, k, r->org, r->dir);
         r->tnear = b.tnear[f];
@@ -198,7 +196,9 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
       }
     }
   }
-  /* Streams take the held batches' rays two samples at a time: the sets
+  /* An occluded ray adds nothing to its pixel's count, so the held
+   * batches' rays the frusta found occluded are not traced again.
+   * Streams take the held batches' rays two samples at a time: the sets
    * are consecutive runs of one Sobol (0,8,2)-net, so sample k of every
    * set lies in the same 1/16-wide strip of the light along e1 (the first
    * coordinate's top bits are k's, reversed), and a pixel's two samples of
