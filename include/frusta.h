@@ -228,7 +228,8 @@ typedef struct fr_trace_options {
   int axis_aligned;       /* Shevtsov's axis-aligned fast path (default on) */
   int ia_cull;            /* interval-arithmetic culling of nodes for whole packets (default on) */
   int prefetch;           /* rays and packets prefetch the children they defer: 1 on, 0 off, -1
-                             (default) on when the BVH and triangles exceed 64 MB (see README) */
+                             (default) on for rays when the BVH and triangles exceed 64 MB, for
+                             packets when the BVH and their triangle records exceed 32 MB (see README) */
   float stream_spread;    /* FR_TRACE_AUTO: a group of 16 goes as a packet when its unit directions
                              lie within this distance of its first ray's (probed at 3 rays), else
                              in a ray stream; 0..2: 0 streams every group, 2 none (default

@@ -255,12 +255,18 @@ fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width,
   out->root = convert(&c, 0, 1);
   free(c.row); fr_free_aligned(c.cost); free(c.pick);
   out->prefetch = fr_bvhn_prefetch_auto(out);
+  out->packet_prefetch = fr_bvhn_packet_prefetch_auto(out);
   return FR_OK;
 }
 
 int fr_bvhn_prefetch_auto(const fr_bvhn *b) {
   size_t node_bytes = b->width == 4 ? sizeof(fr_bvh4_node) : sizeof(fr_bvh8_node);
   return b->nnodes * node_bytes + b->nblocks * sizeof(fr_tri4) > FR_BVHN_PREFETCH_BYTES;
+}
+
+int fr_bvhn_packet_prefetch_auto(const fr_bvhn *b) {
+  size_t node_bytes = b->width == 4 ? sizeof(fr_bvh4_node) : sizeof(fr_bvh8_node);
+  return b->nnodes * node_bytes + 4 * b->nblocks * sizeof(fr_tri_shevtsov) > FR_BVHN_PACKET_PREFETCH_BYTES;
 }
 
 void fr_bvhn_free(fr_bvhn *b) {

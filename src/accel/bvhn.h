@@ -70,9 +70,17 @@ typedef struct fr_bvhn {
    * instructions while it fits: by default (fr_bvhn_prefetch_auto) it is on
    * above FR_BVHN_PREFETCH_BYTES. */
   int prefetch;
+  /* The same for the packet kernels, whose leaves read the Shevtsov
+   * records: on by default (fr_bvhn_packet_prefetch_auto) above
+   * FR_BVHN_PACKET_PREFETCH_BYTES of nodes and records. Dragon (55 MB of
+   * them, 48 MB of nodes and blocks) gained 6% on primary packet16 with
+   * it, where single rays lose (README, Performance, "Packets prefetch on
+   * a lower bound"). */
+  int packet_prefetch;
 } fr_bvhn;
 
 #define FR_BVHN_PREFETCH_BYTES ((size_t)64 << 20)
+#define FR_BVHN_PACKET_PREFETCH_BYTES ((size_t)32 << 20)
 
 typedef struct fr_bvhn_stats {
   size_t inner, leaves, node_bytes, tri_bytes;
@@ -87,6 +95,7 @@ typedef struct fr_bvhn_stats {
 fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width, fr_bvhn *out);
 void fr_bvhn_free(fr_bvhn *b);
 int fr_bvhn_prefetch_auto(const fr_bvhn *b);
+int fr_bvhn_packet_prefetch_auto(const fr_bvhn *b);
 /* SAH with a node visit (one SIMD box test) costing 1, and a triangle test or
  * a block test costing 1. */
 void fr_bvhn_stats_get(const fr_bvhn *b, fr_bvhn_stats *st);

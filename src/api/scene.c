@@ -26,7 +26,10 @@ static fr_scene *scene_new(void) {
 
 void fr_scene_apply_prefetch(fr_scene *s) {
   fr_bvhn *b[2] = {&s->bvh4, &s->bvh8};
-  for (int i = 0; i < 2; i++) b[i]->prefetch = s->trace.prefetch < 0 ? fr_bvhn_prefetch_auto(b[i]) : s->trace.prefetch;
+  for (int i = 0; i < 2; i++) {
+    b[i]->prefetch = s->trace.prefetch < 0 ? fr_bvhn_prefetch_auto(b[i]) : s->trace.prefetch;
+    b[i]->packet_prefetch = s->trace.prefetch < 0 ? fr_bvhn_packet_prefetch_auto(b[i]) : s->trace.prefetch;
+  }
 }
 
 fr_error fr_scene_set_bvh_width(fr_scene *s, int width) {

@@ -59,7 +59,8 @@ typedef vfloat4 vnode;
  * fits, -6% on diffuse8. Hence on only above FR_BVHN_PREFETCH_BYTES. The
  * packet kernels prefetch the children they push too: hairball primary
  * packet16 +13%, shadow packet16 -4%, ao16 and diffuse8 hybrid16 -2%, 0%
- * (all but the first within this VM's noise). */
+ * (all but the first within this VM's noise); they have a lower bound of
+ * their own (fr_bvhn.packet_prefetch). */
 FR_INLINE void prefetch_ref(const fr_bvhn *b, uint32_t ref) {
   const char *p = (ref & FR_BVHN_LEAF) ? (const char *)&b->tris[FR_BVHN_LEAF_FIRST(ref)]
                                        : (const char *)((const node_t *)b->nodes + ref);

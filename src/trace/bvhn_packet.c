@@ -297,7 +297,7 @@ FR_INLINE void prefetch_packet_ref(const fr_bvhn *b, uint32_t ref) {
 FR_INLINE int push_lazy(const fr_bvhn *b, stack_entry *stack, int sp, const node_t *n, int keep, unsigned active,
                         const float *lo, int sorted) {
   const float *f = (const float *)n;
-  if (b->prefetch)
+  if (b->packet_prefetch)
     for (int m = keep; m; m &= m - 1) prefetch_packet_ref(b, n->child[__builtin_ctz((unsigned)m)]);
   if (!sorted) {
     for (; keep; keep &= keep - 1) {
@@ -509,7 +509,7 @@ static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
     }
     for (int a = 0; a < nh; a++) {
       int x = order[a];
-      if (b->prefetch) prefetch_packet_ref(b, n->child[hc[x]]);
+      if (b->packet_prefetch) prefetch_packet_ref(b, n->child[hc[x]]);
       stack[sp] = (stack_entry){n->child[hc[x]], hmask[x], 0, 0.0f, NULL};
       vp_store(stack_tn[sp], vp_load(tn_c[x]));
       sp++;
@@ -627,7 +627,7 @@ static unsigned occluded_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigne
         vpf tn;
         unsigned hm = child_test(f, c, &pk, &R, tfar, active, &tn);
         if (!hm) continue;
-        if (b->prefetch) prefetch_packet_ref(b, n->child[c]);
+        if (b->packet_prefetch) prefetch_packet_ref(b, n->child[c]);
         stack[sp++] = (stack_entry){n->child[c], hm, 0, 0.0f, NULL};
       }
     }

@@ -266,11 +266,13 @@ int cmd_bench(int argc, char **argv) {
   /* packets traverse the packet BVH and test its Shevtsov records */
   const fr_wide_stats *wp = topt.packet_bvh_width == 4 ? &st.bvh4 : &st.bvh8;
   int prefetch = topt.prefetch >= 0 ? topt.prefetch : fr_bvhn_prefetch_auto(st.single_width == 4 ? &s->bvh4 : &s->bvh8);
+  int packet_prefetch =
+      topt.prefetch >= 0 ? topt.prefetch : fr_bvhn_packet_prefetch_auto(topt.packet_bvh_width == 4 ? &s->bvh4 : &s->bvh8);
   printf("build_seconds=%.3f tracer=frusta scene=%s tris=%zu threads=%d isa=%s bvh_width=%d sah=%.2f bytes_per_tri=%.1f "
-         "prefetch=%s packet_bvh_width=%d packet_bytes_per_tri=%.1f\n",
+         "prefetch=%s packet_bvh_width=%d packet_bytes_per_tri=%.1f packet_prefetch=%s\n",
          st.build_seconds, s->name, tris, threads, fr_isa_name(fr_get_isa()), st.single_width, ws->sah,
          (double)(ws->node_bytes + ws->tri_bytes) / (double)tris, prefetch ? "on" : "off", topt.packet_bvh_width,
-         (double)(wp->node_bytes + wp->tri_bytes + wp->packet_tri_bytes) / (double)tris);
+         (double)(wp->node_bytes + wp->tri_bytes + wp->packet_tri_bytes) / (double)tris, packet_prefetch ? "on" : "off");
   if (want_mft && !all_modes && fr_scene_sphere_count(s)) {
     size_t ns = fr_scene_sphere_count(s);
     fr_scene_release(s);
