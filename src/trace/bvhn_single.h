@@ -103,12 +103,12 @@ FR_INLINE int any_hit(const fr_bvhn *b, const ray_pre *rp, uint32_t root, const 
       (void)visit_node(n, rp, tfar, &mask);
       if (!mask) goto next;
       /* Any hit ends the search, so no sorting: descend into the last hit
-       * slot, push the others. Last-first is not arbitrary: the collapse puts
-       * the left child of the original split in slot 0, and going there first
-       * measured up to 2x slower for hemisphere rays leaving a surface
-       * (kitchen ao16: 7.9 -> 13.0 Mrays/s). Nearest-first measured +21% on
-       * hairball soft16 but -30% on kitchen ao16, -18% on dragon soft16 and
-       * -9% on hairball shadow (README, Performance, session 37). */
+       * slot, push the others. The build put the children most likely to
+       * occlude per unit of work last (accel/bvhn.c, occlusion_rank); with
+       * the collapse's own order, going to slot 0 first measured up to 2x
+       * slower (kitchen ao16). Nearest-first measured +21% on hairball
+       * soft16 but -30% on kitchen ao16, -18% on dragon soft16 and -9% on
+       * hairball shadow (README, Performance, sessions 37 and 45). */
       {
         int last = 31 - __builtin_clz((unsigned)mask);
         ref = n->child[last];
