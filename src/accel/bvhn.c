@@ -96,23 +96,22 @@ static uint32_t *node_children(conv *c, uint32_t i) { return (uint32_t *)(node_f
  * p / c minimises the expected cost. Here p is the chance that a ray of
  * random direction through the child's box hits one of its triangles (their
  * area over the box's half area, capped at 1) and c its triangle count. The
- * estimate is crude, so a node's children change places only when theirs
- * differ by a factor of two or more (the rank is log2(p / c) rounded down);
- * otherwise they keep the collapse's order (the lower half of each split
- * in the lower slots). Any-hit takes the last slot first
- * (trace/bvhn_single.h), so the slots hold the children in rising rank.
- * Single rays against the collapse's order: conference ao16 +25%, sibenik
- * ao16 +12%, kitchen ao16 +7%, dragon soft16 -4%. That order tried upper
- * halves first, which suits dragon's light above it and no other light:
- * from below, dragon soft16 took 11.7 node visits per ray with it and 8.8
- * with this one. Ranking by p / c unrounded gained 14% on hairball soft16
- * but lost 9% on dragon (README, Performance, session 45). */
+ * estimate is crude, so children change places only across steps of a
+ * factor of sqrt(2) (the rank is 2 log2(p / c) rounded down); within a
+ * step they keep the collapse's order (the lower half of each split in the
+ * lower slots). Any-hit takes the last slot first (trace/bvhn_single.h),
+ * so the slots hold the children in rising rank. That collapse's order
+ * tried upper halves first, which suits dragon's light above it and no
+ * other light: from below, dragon soft16 took 11.7 node visits per ray
+ * with it and 8.8 with a factor-2 step. Unrounded, the rank gained most on
+ * hairball and lost 9% on dragon; steps of 2 lost least on dragon and
+ * gained least on hairball (README, Performance, session 45). */
 static int occlusion_rank(const conv *c, int32_t bi) {
   const fr_build_node *n = &c->t->nodes[bi];
   double a = c->area[n->first + n->count] - c->area[n->first], h = aabb_half_area(n->box);
   double p = h > 0.0 && a < h ? a / h : 1.0;
   if (!(p > 0.0)) return INT_MIN; /* no area: it can hold no hit */
-  return (int)floor(log2(p / (double)(n->count ? n->count : 1)));
+  return (int)floor(2.0 * log2(p / (double)(n->count ? n->count : 1)));
 }
 
 static void order_for_occlusion(const conv *c, int32_t *kids, int nk) {
