@@ -168,19 +168,20 @@ static inline unsigned ray_octant(const fr_ray *r) {
 #endif
 }
 
-/* The order in which a chunk's rays are grouped: run_end[r] ends the r-th
- * run, the rays of one octant. Returns the number of runs. */
-static int chunk_order(const fr_ray *rays, size_t n, uint32_t *order, size_t *run_end) {
+/* The order in which rays[sel[0..n)] are grouped (sel NULL: rays[0..n)):
+ * run_end[r] ends the r-th run, the rays of one octant. Returns the number
+ * of runs. */
+static int chunk_order(const fr_ray *rays, const uint32_t *sel, size_t n, uint32_t *order, size_t *run_end) {
   size_t start[9] = {0};
   uint8_t oct[STREAM_CHUNK];
   unsigned some = 0, every = 7;
   for (size_t i = 0; i < n; i++) {
-    oct[i] = (uint8_t)ray_octant(&rays[i]);
+    oct[i] = (uint8_t)ray_octant(&rays[sel ? sel[i] : i]);
     some |= oct[i];
     every &= oct[i];
   }
   if (some == every) { /* one octant, as most packets of a renderer's calls: no sort */
-    for (size_t i = 0; i < n; i++) order[i] = (uint32_t)i;
+    for (size_t i = 0; i < n; i++) order[i] = sel ? sel[i] : (uint32_t)i;
     run_end[0] = n;
     return 1;
   }
@@ -192,9 +193,11 @@ static int chunk_order(const fr_ray *rays, size_t n, uint32_t *order, size_t *ru
     start[o + 1] += start[o];
     if (start[o + 1] > start[o]) run_end[runs++] = start[o + 1];
   }
-  for (size_t i = 0; i < n; i++) order[start[oct[i]]++] = (uint32_t)i;
+  for (size_t i = 0; i < n; i++) order[start[oct[i]]++] = sel ? sel[i] : (uint32_t)i;
   return runs;
 }
+
+static const uint32_t identity_idx[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
 
 /* Whether a packet of these rays pays: their unit directions lie within
  * chord length spread of the first ray's. A packet's rays then visit nearly
@@ -237,36 +240,61 @@ static inline void stream_group(const stream_ctx *c, const fr_ray *rays, const u
   for (int i = 0; i < m; i++) occ[idx[i]] = (uint8_t)((o >> i) & 1);
 }
 
-/* FR_TRACE_AUTO and FR_TRACE_RAYSTREAM: per octant run of a chunk, each
- * coherent group of 16 goes as a hybrid packet; the other rays gather into
- * ray streams of up to FR_STREAM_MAX, the last one flushed at the run's end
- * (a stream stays within one octant). spread <= 0: streams only. */
+/* One packet of rays[idx[0..m)]. */
+static inline void packet_group(const stream_ctx *c, const fr_ray *rays, const uint32_t *idx, int m,
+                                uint8_t *occ, fr_hit *hits) {
+  if (hits) { c->pf->intersect_idx(c->pb, &c->po, rays, idx, m, hits); return; }
+  unsigned o = c->pf->occluded_idx(c->pb, &c->po, rays, idx, m);
+  for (int i = 0; i < m; i++) occ[idx[i]] = (uint8_t)((o >> i) & 1);
+}
+
+/* FR_TRACE_AUTO and FR_TRACE_RAYSTREAM: each coherent group of 16
+ * consecutive rays of a chunk goes as a hybrid packet; the other rays are
+ * sorted by octant, where a group of 16 of one run may still be coherent,
+ * and the rest gather into ray streams of up to FR_STREAM_MAX, the last one
+ * flushed at the run's end (a stream stays within one octant). spread <= 0:
+ * streams only. */
 static void octant_trace(const fr_scene *s, const fr_ray *rays, uint8_t *occ, fr_hit *hits, size_t n, float spread) {
   const fr_kernels *k = fr_kernels_active();
   stream_ctx c;
   c.st = s->single_width == 4 ? k->s4 : k->s8;
   c.sb = s->single_width == 4 ? &s->bvh4 : &s->bvh8;
   c.pf = packet_fns(s, 16, s->trace.coherent_threshold, &c.po, &c.pb);
-  uint32_t order[STREAM_CHUNK], pend[FR_STREAM_MAX];
+  uint32_t order[STREAM_CHUNK], pend[FR_STREAM_MAX], rest[STREAM_CHUNK];
   size_t run_end[8];
+  const size_t min_packet = (size_t)s->trace.hybrid_threshold + 1;
   for (size_t c0 = 0; c0 < n; c0 += STREAM_CHUNK) {
     size_t cn = n - c0 < STREAM_CHUNK ? n - c0 : STREAM_CHUNK;
     const fr_ray *cr = rays + c0;
     uint8_t *co = occ ? occ + c0 : NULL;
     fr_hit *ch = hits ? hits + c0 : NULL;
-    int runs = chunk_order(cr, cn, order, run_end);
+    const uint32_t *sel = NULL;
+    size_t ns = cn;
+    if (spread > 0.0f) {
+      /* Coherent groups of 16 in the caller's order go as packets before any
+       * sort: a renderer's neighbouring pixels are most often one coherent
+       * group already, and then the octant sort only costs. */
+      ns = 0;
+      for (size_t g = 0, m; g < cn; g += m) {
+        m = cn - g < 16 ? cn - g : 16;
+        if (m >= min_packet && group_coherent(cr + g, identity_idx, m, spread)) {
+          packet_group(&c, cr + g, identity_idx, (int)m, co ? co + g : NULL, ch ? ch + g : NULL);
+          continue;
+        }
+        for (size_t i = 0; i < m; i++) rest[ns++] = (uint32_t)(g + i);
+      }
+      if (!ns) continue;
+      sel = rest;
+    }
+    int runs = chunk_order(cr, sel, ns, order, run_end);
     size_t g = 0;
     for (int r = 0; r < runs; r++) {
       int np = 0;
       for (size_t m; g < run_end[r]; g += m) {
         m = run_end[r] - g < 16 ? run_end[r] - g : 16;
         const uint32_t *idx = order + g;
-        if (m > (size_t)s->trace.hybrid_threshold && spread > 0.0f && group_coherent(cr, idx, m, spread)) {
-          if (ch) c.pf->intersect_idx(c.pb, &c.po, cr, idx, (int)m, ch);
-          else {
-            unsigned o = c.pf->occluded_idx(c.pb, &c.po, cr, idx, (int)m);
-            for (size_t i = 0; i < m; i++) co[idx[i]] = (uint8_t)((o >> i) & 1);
-          }
+        if (m >= min_packet && spread > 0.0f && group_coherent(cr, idx, m, spread)) {
+          packet_group(&c, cr, idx, (int)m, co, ch);
           continue;
         }
         for (size_t i = 0; i < m; i++) {
@@ -284,8 +312,6 @@ static int packet_size(const fr_scene *s, int *threshold) {
   *threshold = s->trace.mode == FR_TRACE_HYBRID16 ? s->trace.hybrid_threshold : 0;
   return s->trace.mode == FR_TRACE_PACKET8 ? 8 : 16;
 }
-
-static const uint32_t identity_idx[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
 
 /* The triangles of a stream: any hit into occ, or closest hits into hits;
  * the spheres follow in the public calls. */
