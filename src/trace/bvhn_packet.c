@@ -349,10 +349,35 @@ static void finish(const fr_bvhn *b, const packet *pk, const uint32_t *best, vpf
   float A[9][P] __attribute__((aligned(64)));
   vpf prim;
   const float *base = (const float *)b->tris;
-  if (b->nblocks <= (size_t)INT32_MAX / REC) {
+  /* A coherent packet's hits lie on a few triangles: each is read once and
+   * broadcast to its lanes, the first straight over zeros. Sixteen-lane
+   * gathers took a sixth of conference primary packet16's kernel samples
+   * here; they stay for packets whose hits spread over more triangles. */
+  enum { FINISH_BROADCASTS = 4 };
+  unsigned left = hit;
+  int gather = 0;
+  prim = vp_id(FR_INVALID_ID);
+  for (int it = 0; left; it++) {
+    const uint32_t id = best[__builtin_ctz(left)];
+    unsigned same = 0;
+    for (int i = 0; i < P; i++) same |= (unsigned)(best[i] == id) << i;
+    same &= left;
+    /* a first triangle with under a quarter of the hits, or more than
+     * FINISH_BROADCASTS triangles: fine geometry or incoherent rays */
+    if (it == FINISH_BROADCASTS || (!it && 4 * __builtin_popcount(same) < __builtin_popcount(hit))) {
+      gather = 1;
+      break;
+    }
+    left &= ~same;
+    const float *rec = base + (size_t)(id >> 2) * REC + (id & 3);
+    const vpm sm = vpm_bits_to(same);
+    for (int k = 0; k < 9; k++) vp_store(A[k], vp_select(sm, vp(rec[4 * k]), it ? vp_load(A[k]) : zero));
+    prim = vp_select(sm, vp_id(((const uint32_t *)rec)[36]), prim);
+  }
+  if (gather && b->nblocks <= (size_t)INT32_MAX / REC) {
     for (int k = 0; k < 9; k++) vp_store(A[k], vp_gather(base + 4 * k, ix));
     prim = vp_gather(base + 36, ix);
-  } else { /* too many blocks for 32-bit indices */
+  } else if (gather) { /* too many blocks for 32-bit indices */
     float pr[P] __attribute__((aligned(64)));
     for (int i = 0; i < P; i++) {
       const float *rec = base + (hit >> i & 1 ? (size_t)(best[i] >> 2) * REC + (best[i] & 3) : 0);
