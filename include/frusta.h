@@ -227,6 +227,9 @@ typedef struct fr_trace_options {
   int mailbox;            /* inverse mailboxing in packet leaves (default off, see README) */
   int axis_aligned;       /* Shevtsov's axis-aligned fast path (default on) */
   int ia_cull;            /* interval-arithmetic culling of nodes for whole packets (default on) */
+  int quad_leaves;        /* packet leaves reached by only a few active rays test four of them against
+                             four triangles at once, with the single-ray kernel's watertight test
+                             (default on, see README) */
   int prefetch;           /* rays and packets prefetch the children they defer: 1 on, 0 off, -1
                              (default) on for rays when the BVH and triangles exceed 64 MB, for
                              packets when the BVH and their triangle records exceed 32 MB (see README) */

@@ -233,6 +233,44 @@ int fr_test_tri4_pair_scalar(const fr_tri4 *block, const fr_ray *a, const fr_ray
 int fr_test_tri4_pair_avx2(const fr_tri4 *block, const fr_ray *a, const fr_ray *b, int *hits);
 int fr_test_tri4_pair_avx512(const fr_tri4 *block, const fr_ray *a, const fr_ray *b, int *hits);
 
+/* A block of four random triangles, or (grid) of axis-aligned ones on
+ * integer points in z = 0, with an unused NaN lane in every fourth block. */
+static void test_block(fr_rng *r, int n, int grid, fr_tri4 *blk) {
+  for (int lane = 0; lane < 4; lane++) {
+    vec3 v[3];
+    for (int k = 0; k < 3; k++) {
+      v[k] = grid ? v3((float)(int)urand(r, -3, 3), (float)(int)urand(r, -3, 3), 0.0f) : rnd3(r, 1.0f);
+      const float *c = &v[k].x;
+      float(*dst)[4] = k == 0 ? blk->v0 : k == 1 ? blk->v1 : blk->v2;
+      for (int a = 0; a < 3; a++) dst[a][lane] = (lane == 3 && n % 4 == 1) ? NAN : c[a];
+    }
+    blk->prim[lane] = (uint32_t)lane;
+  }
+}
+
+/* A ray at the block. Grid blocks: through a vertex or an edge's midpoint
+ * of one of the triangles, from height z, straight down the z axis half the
+ * time (no shear, so the edge values through the point are exactly zero:
+ * the exact path). Random blocks: from a random point lifted by lift. */
+static fr_ray test_ray(fr_rng *r, int grid, const fr_tri4 *blk, float z, float lift) {
+  vec3 o, target;
+  if (grid) {
+    const int lane = (int)urand(r, 0, 3), k = (int)urand(r, 0, 3);
+    const float(*src)[4] = k == 0 ? blk->v0 : k == 1 ? blk->v1 : blk->v2;
+    const float(*nxt)[4] = k == 0 ? blk->v1 : k == 1 ? blk->v2 : blk->v0;
+    const int mid = urand(r, 0, 1) < 0.5f;
+    target = v3(src[0][lane], src[1][lane], src[2][lane]);
+    if (mid) target = v3_scale(v3_add(target, v3(nxt[0][lane], nxt[1][lane], nxt[2][lane])), 0.5f);
+    o = urand(r, 0, 1) < 0.5f ? v3(target.x, target.y, z)
+                              : v3((float)(int)urand(r, -3, 3), (float)(int)urand(r, -3, 3), z);
+  } else {
+    o = v3_add(rnd3(r, 3.0f), v3(0.0f, 0.0f, lift));
+    target = rnd3(r, 0.5f);
+  }
+  const vec3 d = v3_sub(target, o);
+  return (fr_ray){{o.x, o.y, o.z}, 0.0f, {d.x, d.y, d.z}, urand(r, 0, 1) < 0.2f ? 0.5f : INFINITY};
+}
+
 /* The ray streams test two rays against a block at once (tri4_test2): on
  * every level each ray's lanes must be exactly what the one-ray test
  * gives, for random triangles and rays, and for rays through the vertices
@@ -247,40 +285,10 @@ static void test_tri4_pair(void **st) {
   long hits = 0, tested = 0;
   for (int n = 0; n < 4000; n++) {
     fr_tri4 blk;
-    const int grid = n % 2; /* axis-aligned triangles on integer points */
-    for (int lane = 0; lane < 4; lane++) {
-      vec3 v[3];
-      for (int k = 0; k < 3; k++) {
-        v[k] = grid ? v3((float)(int)urand(&r, -3, 3), (float)(int)urand(&r, -3, 3), 0.0f) : rnd3(&r, 1.0f);
-        const float *c = &v[k].x;
-        float(*dst)[4] = k == 0 ? blk.v0 : k == 1 ? blk.v1 : blk.v2;
-        for (int a = 0; a < 3; a++) dst[a][lane] = (lane == 3 && n % 4 == 1) ? NAN : c[a];
-      }
-      blk.prim[lane] = (uint32_t)lane;
-    }
+    const int grid = n % 2;
+    test_block(&r, n, grid, &blk);
     fr_ray ray[2];
-    for (int i = 0; i < 2; i++) {
-      vec3 o, target;
-      if (grid) {
-        /* through a vertex or an edge's midpoint of one of the triangles */
-        const int lane = (int)urand(&r, 0, 3), k = (int)urand(&r, 0, 3);
-        const float(*src)[4] = k == 0 ? blk.v0 : k == 1 ? blk.v1 : blk.v2;
-        const float(*nxt)[4] = k == 0 ? blk.v1 : k == 1 ? blk.v2 : blk.v0;
-        const int mid = urand(&r, 0, 1) < 0.5f;
-        target = v3(src[0][lane], src[1][lane], src[2][lane]);
-        if (mid) target = v3_scale(v3_add(target, v3(nxt[0][lane], nxt[1][lane], nxt[2][lane])), 0.5f);
-        const float z = urand(&r, 0, 1) < 0.5f ? 4.0f : -4.0f;
-        /* straight down the z axis half the time: no shear, so the edge
-         * values through the point are exactly zero */
-        o = urand(&r, 0, 1) < 0.5f ? v3(target.x, target.y, z)
-                                   : v3((float)(int)urand(&r, -3, 3), (float)(int)urand(&r, -3, 3), z);
-      } else {
-        o = rnd3(&r, 3.0f);
-        target = rnd3(&r, 0.5f);
-      }
-      const vec3 d = v3_sub(target, o);
-      ray[i] = (fr_ray){{o.x, o.y, o.z}, 0.0f, {d.x, d.y, d.z}, urand(&r, 0, 1) < 0.2f ? 0.5f : INFINITY};
-    }
+    for (int i = 0; i < 2; i++) ray[i] = test_ray(&r, grid, &blk, urand(&r, 0, 1) < 0.5f ? 4.0f : -4.0f, 0.0f);
     for (size_t l = 0; l < sizeof levels / sizeof levels[0]; l++) {
       if (!fr_isa_supported(levels[l].isa)) continue;
       int h = 0;
@@ -293,11 +301,78 @@ static void test_tri4_pair(void **st) {
   assert_true(hits > tested / 4);
 }
 
+typedef int (*tri4_quad_fn)(const fr_tri4 *, const fr_ray *, int, int *);
+#define QUAD_FNS(p)                                                                  \
+  int fr_test_tri4_quad##p##_scalar(const fr_tri4 *, const fr_ray *, int, int *);   \
+  int fr_test_tri4_quad##p##_avx2(const fr_tri4 *, const fr_ray *, int, int *);     \
+  int fr_test_tri4_quad##p##_avx512(const fr_tri4 *, const fr_ray *, int, int *);
+QUAD_FNS(8)
+QUAD_FNS(16)
+
+/* Each coordinate of p moved one axis on, rot times (x -> y -> z -> x). */
+static void rotate3(float *p, int rot) {
+  for (int i = 0; i < rot; i++) {
+    const float z = p[2];
+    p[2] = p[1]; p[1] = p[0]; p[0] = z;
+  }
+}
+
+/* Packets test up to four rays against a block at once (quad_test) where
+ * their rays share the shear axes: on every level and at both packet
+ * sizes, each ray's lanes must be exactly the single-ray test's, for one
+ * to eight rays per packet (two or more quad groups), on the cases of the
+ * pair test above turned to each axis and both directions along it. */
+static void test_tri4_quad(void **st) {
+  (void)st;
+  const struct { fr_isa isa; int p; tri4_quad_fn fn; } levels[] = {
+      {FR_ISA_SCALAR, 8, fr_test_tri4_quad8_scalar},  {FR_ISA_SCALAR, 16, fr_test_tri4_quad16_scalar},
+      {FR_ISA_AVX2, 8, fr_test_tri4_quad8_avx2},      {FR_ISA_AVX2, 16, fr_test_tri4_quad16_avx2},
+      {FR_ISA_AVX512, 8, fr_test_tri4_quad8_avx512},  {FR_ISA_AVX512, 16, fr_test_tri4_quad16_avx512}};
+  fr_rng r = fr_rng_seed(47, 2);
+  long hits = 0, tested = 0, declined = 0;
+  for (int n = 0; n < 3000; n++) {
+    fr_tri4 blk;
+    const int grid = n % 2, rot = (n / 2) % 3, nrays = 1 + (n / 6) % 8;
+    const float z = (n / 48) % 2 ? 8.0f : -8.0f; /* beyond the grid's 6: z is every ray's largest axis */
+    test_block(&r, n, grid, &blk);
+    fr_ray rays[8];
+    for (int i = 0; i < nrays; i++) rays[i] = test_ray(&r, grid, &blk, z, z);
+    /* one ray in sixteen off the shared axes: the packet must decline */
+    const int odd = n % 16 == 15 && nrays > 1;
+    if (odd) { rays[1].dir[0] = 100.0f; rays[1].dir[1] = 0.5f; }
+    for (int lane = 0; lane < 4; lane++)
+      for (int k = 0; k < 3; k++) {
+        float(*v)[4] = k == 0 ? blk.v0 : k == 1 ? blk.v1 : blk.v2;
+        float c[3] = {v[0][lane], v[1][lane], v[2][lane]};
+        rotate3(c, rot);
+        for (int a = 0; a < 3; a++) v[a][lane] = c[a];
+      }
+    for (int i = 0; i < nrays; i++) { rotate3(rays[i].org, rot); rotate3(rays[i].dir, rot); }
+    for (size_t l = 0; l < sizeof levels / sizeof levels[0]; l++) {
+      if (!fr_isa_supported(levels[l].isa)) continue;
+      int h = 0;
+      const int res = levels[l].fn(&blk, rays, nrays, &h);
+      if (res < 0) {
+        if (!odd) fail_msg("level %zu (P=%d), case %d: rays along one axis declined", l, levels[l].p, n);
+        declined++;
+        continue;
+      }
+      if (odd) fail_msg("level %zu (P=%d), case %d: rays off the shared axes accepted", l, levels[l].p, n);
+      if (!res) fail_msg("level %zu (P=%d), case %d: the quad test differs", l, levels[l].p, n);
+      hits += h;
+      tested++;
+    }
+  }
+  print_message("quad block tests: %ld across levels and sizes (%ld declined), %ld rays hit\n", tested, declined, hits);
+  assert_true(declined > 0 && hits > tested / 4);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_add_where),
       cmocka_unit_test(test_load_records),
       cmocka_unit_test(test_tri4_pair),
+      cmocka_unit_test(test_tri4_quad),
       cmocka_unit_test(test_agreement),
       cmocka_unit_test(test_child_sort8),
       cmocka_unit_test(test_axis_aligned_fast_path),

@@ -62,21 +62,25 @@ typedef struct config {
   int threshold, width, mailbox, axis_aligned, ia, prefetch;
   float spread; /* auto's stream_spread; 0: the default */
   int coherent; /* coherent_threshold, which hybrid16's one-octant packets use too; 0: the default */
+  int no_quad;  /* quad_leaves off */
 } config;
 static const config configs[] = {
-    {"packet16", FR_TRACE_PACKET16, 0, 4, 0, 1, 1, 0, 0.0f, 0},  {"packet8", FR_TRACE_PACKET8, 0, 4, 0, 1, 1, 0, 0.0f, 0},
-    {"hybrid16", FR_TRACE_HYBRID16, 7, 4, 0, 1, 1, 0, 0.0f, 0},  {"hybrid16/t3", FR_TRACE_HYBRID16, 3, 4, 0, 1, 1, 0, 0.0f, 3},
-    {"hybrid16/t16", FR_TRACE_HYBRID16, 16, 4, 0, 1, 1, 0, 0.0f, 16}, {"packet16/bvh8", FR_TRACE_PACKET16, 0, 8, 0, 1, 1, 0, 0.0f, 0},
-    {"hybrid16/bvh8", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 0, 0.0f, 0}, {"packet16/mailbox", FR_TRACE_PACKET16, 0, 4, 1, 1, 1, 0, 0.0f, 0},
-    {"packet16/no-aa", FR_TRACE_PACKET16, 0, 4, 0, 0, 1, 0, 0.0f, 0}, {"packet16/no-ia", FR_TRACE_PACKET16, 0, 4, 0, 1, 0, 0, 0.0f, 0},
-    {"auto", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0, 0.0f, 0},
+    {"packet16", FR_TRACE_PACKET16, 0, 4, 0, 1, 1, 0, 0.0f, 0, 0},  {"packet8", FR_TRACE_PACKET8, 0, 4, 0, 1, 1, 0, 0.0f, 0, 0},
+    {"hybrid16", FR_TRACE_HYBRID16, 7, 4, 0, 1, 1, 0, 0.0f, 0, 0},  {"hybrid16/t3", FR_TRACE_HYBRID16, 3, 4, 0, 1, 1, 0, 0.0f, 3, 0},
+    {"hybrid16/t16", FR_TRACE_HYBRID16, 16, 4, 0, 1, 1, 0, 0.0f, 16, 0}, {"packet16/bvh8", FR_TRACE_PACKET16, 0, 8, 0, 1, 1, 0, 0.0f, 0, 0},
+    {"hybrid16/bvh8", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 0, 0.0f, 0, 0}, {"packet16/mailbox", FR_TRACE_PACKET16, 0, 4, 1, 1, 1, 0, 0.0f, 0, 0},
+    {"packet16/no-aa", FR_TRACE_PACKET16, 0, 4, 0, 0, 1, 0, 0.0f, 0, 0}, {"packet16/no-ia", FR_TRACE_PACKET16, 0, 4, 0, 1, 0, 0, 0.0f, 0, 0},
+    {"auto", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0, 0.0f, 0, 0},
     /* auto with every group a packet, and with the packet/stream split
        inside the camera and shadow packets too */
-    {"auto/packets", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0, 2.0f, 0},
-    {"auto/split", FR_TRACE_AUTO, 7, 8, 0, 1, 1, 0, 0.1f, 0},
-    {"raystream", FR_TRACE_RAYSTREAM, 7, 4, 0, 1, 1, 0, 0.0f, 0},
+    {"auto/packets", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0, 2.0f, 0, 0},
+    {"auto/split", FR_TRACE_AUTO, 7, 8, 0, 1, 1, 0, 0.1f, 0, 0},
+    {"raystream", FR_TRACE_RAYSTREAM, 7, 4, 0, 1, 1, 0, 0.0f, 0, 0},
     /* prefetching, which these small scenes leave off by default */
-    {"hybrid16/bvh8/prefetch", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 1, 0.0f, 0},
+    {"hybrid16/bvh8/prefetch", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 1, 0.0f, 0, 0},
+    /* every leaf one triangle against all the packet's rays */
+    {"packet16/bvh8/no-quad", FR_TRACE_PACKET16, 0, 8, 0, 1, 1, 0, 0.0f, 0, 1},
+    {"packet8/no-quad", FR_TRACE_PACKET8, 0, 4, 0, 1, 1, 0, 0.0f, 0, 1},
 };
 #define NCONFIGS (sizeof configs / sizeof configs[0])
 
@@ -89,6 +93,7 @@ static void set_config(fr_scene *s, const config *c) {
   o.mailbox = c->mailbox;
   o.axis_aligned = c->axis_aligned;
   o.ia_cull = c->ia;
+  o.quad_leaves = !c->no_quad;
   o.prefetch = c->prefetch ? 1 : -1;
   if (c->spread > 0.0f) o.stream_spread = c->spread;
   if (c->coherent > 0) o.coherent_threshold = c->coherent;
@@ -172,17 +177,23 @@ static void check_scene(vec3 center, float size, uint64_t seed) {
           }
           /* all lanes valid, packet kernel only: the stream ran the very
            * packet the packet call did (its rays loaded and its answers
-           * stored as whole records), so even the triangle must match */
-          if (valid == 0xFFFFu && configs[c].threshold == 0 && configs[c].mode != FR_TRACE_AUTO &&
-              configs[c].mode != FR_TRACE_RAYSTREAM && hs[i].prim != h16.prim[i])
+           * stored as whole records), so even the triangle must match.
+           * (In packet8 mode the call is still one packet of 16, which
+           * takes quad leaves at other counts of active rays.) */
+          const int same_packet = valid == 0xFFFFu && configs[c].threshold == 0 &&
+                                  (configs[c].mode == FR_TRACE_PACKET16 ||
+                                   (configs[c].mode == FR_TRACE_PACKET8 && configs[c].no_quad));
+          if (same_packet && hs[i].prim != h16.prim[i])
             fail_msg("%s stream isa %d packet %d ray %d: prim %u vs the packet's %u", configs[c].name, isa, p, i,
                      hs[i].prim, h16.prim[i]);
           if (((valid >> i) & 1) && hs[i].prim == h16.prim[i]) {
             /* the stream's gathered rays and scattered answers: every field
              * as the packet call's (u, v only where both ran the packet
-             * kernel: a hybrid's single-ray phase, which depends on the
-             * packet's other rays, gives the watertight test's u, v) */
-            int same_kernel = configs[c].threshold == 0 && configs[c].mode != FR_TRACE_AUTO;
+             * kernel on the same lanes: a hybrid's single-ray phase and
+             * the quad leaves, which depend on the packet's other rays,
+             * give the watertight test's u, v) */
+            const int same_kernel = same_packet || (configs[c].threshold == 0 && configs[c].no_quad &&
+                                                    configs[c].mode != FR_TRACE_AUTO && configs[c].mode != FR_TRACE_RAYSTREAM);
             float a[6] = {h16.t[i], h16.ng_x[i], h16.ng_y[i], h16.ng_z[i], h16.u[i], h16.v[i]};
             float b[6] = {hs[i].t, hs[i].ng[0], hs[i].ng[1], hs[i].ng[2], hs[i].u, hs[i].v};
             if (memcmp(a, b, (same_kernel ? 6 : 4) * sizeof(float)))
@@ -245,7 +256,7 @@ static void test_leaf_against_scalar(void **st) {
       if (!fr_isa_supported((fr_isa)isa)) continue;
       fr_set_isa((fr_isa)isa);
       for (int aa = 0; aa < 2; aa++) {
-        config c = {"leaf", FR_TRACE_PACKET16, 0, 4, 0, aa, 1, 0, 0.0f, 0};
+        config c = {"leaf", FR_TRACE_PACKET16, 0, 4, 0, aa, 1, 0, 0.0f, 0, 1}; /* every leaf by Shevtsov's test */
         set_config(s, &c);
         fr_tri_shevtsov use = rec;
         if (!aa) use.axis_aligned = 0;

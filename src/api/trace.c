@@ -17,6 +17,7 @@ void fr_trace_options_default(fr_trace_options *o) {
   o->mailbox = 0;
   o->axis_aligned = 1;
   o->ia_cull = 1;
+  o->quad_leaves = 1;
   o->prefetch = -1;
   o->stream_spread = FR_STREAM_SPREAD_DEFAULT;
   /* 2 against the MIC paper's 7 for auto's coherent packets: 2 threads,
@@ -34,6 +35,7 @@ fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o) {
     return fr_fail(FR_ERR_ARG, "hybrid threshold %d (0..16)", o->hybrid_threshold);
   if (o->packet_bvh_width != 4 && o->packet_bvh_width != 8)
     return fr_fail(FR_ERR_ARG, "packet BVH width %d (4 or 8)", o->packet_bvh_width);
+  if (o->quad_leaves != 0 && o->quad_leaves != 1) return fr_fail(FR_ERR_ARG, "quad leaves %d (0 or 1)", o->quad_leaves);
   if (o->prefetch < -1 || o->prefetch > 1) return fr_fail(FR_ERR_ARG, "prefetch %d (-1, 0 or 1)", o->prefetch);
   if (!(o->stream_spread >= 0.0f && o->stream_spread <= 2.0f))
     return fr_fail(FR_ERR_ARG, "stream spread %g (0..2)", (double)o->stream_spread);
@@ -69,6 +71,7 @@ static const fr_packet_fns *packet_fns(const fr_scene *s, int size, int threshol
   po->mailbox = s->trace.mailbox;
   po->axis_aligned = s->trace.axis_aligned;
   po->ia_cull = s->trace.ia_cull;
+  po->quad_leaves = s->trace.quad_leaves;
   po->single = w8 ? k->w8 : k->w4;
   if (size == 8) return w8 ? k->p8w8 : k->p8w4;
   return w8 ? k->p16w8 : k->p16w4;

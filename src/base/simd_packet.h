@@ -216,6 +216,43 @@ FR_INLINE void vp_scatter(float *base, const int32_t *idx, unsigned mask, vpf a)
 }
 #endif
 
+/* Lanes from lanes: vp_bcast4 gives lane i = p[i % 4] (p 16-byte aligned),
+ * vp_permute lane i = a[idx[i]] (idx: P aligned int32 in 0..P-1). */
+#if defined(FR_BUILD_ISA_AVX512) && P == 16
+FR_INLINE vpf vp_bcast4(const float *p) { vpf r = {_mm512_broadcast_f32x4(_mm_load_ps(p))}; return r; }
+FR_INLINE vpf vp_permute(vpf a, const int32_t *idx) {
+  vpf r = {_mm512_permutexvar_ps(_mm512_load_si512((const void *)idx), a.v)};
+  return r;
+}
+#elif defined(FR_BUILD_ISA_AVX512) /* P == 8 */
+FR_INLINE vpf vp_bcast4(const float *p) { vpf r = {_mm256_broadcast_ps((const __m128 *)p)}; return r; }
+FR_INLINE vpf vp_permute(vpf a, const int32_t *idx) {
+  vpf r = {_mm256_permutevar8x32_ps(a.v, _mm256_load_si256((const __m256i *)idx))};
+  return r;
+}
+#elif defined(FR_BUILD_ISA_AVX2) && P == 8
+FR_INLINE vpf vp_bcast4(const float *p) { vpf r; r.v[0] = _mm256_broadcast_ps((const __m128 *)p); return r; }
+FR_INLINE vpf vp_permute(vpf a, const int32_t *idx) {
+  vpf r;
+  r.v[0] = _mm256_permutevar8x32_ps(a.v[0], _mm256_load_si256((const __m256i *)idx));
+  return r;
+}
+#elif defined(FR_BUILD_ISA_AVX2) /* P == 16: two halves */
+FR_INLINE vpf vp_bcast4(const float *p) { vpf r; r.v[0] = r.v[1] = _mm256_broadcast_ps((const __m128 *)p); return r; }
+FR_INLINE vpf vp_permute(vpf a, const int32_t *idx) {
+  vpf r;
+  for (int h = 0; h < 2; h++) {
+    const __m256i i = _mm256_load_si256((const __m256i *)(idx + 8 * h));
+    const __m256 from_hi = _mm256_castsi256_ps(_mm256_cmpgt_epi32(i, _mm256_set1_epi32(7)));
+    r.v[h] = _mm256_blendv_ps(_mm256_permutevar8x32_ps(a.v[0], i), _mm256_permutevar8x32_ps(a.v[1], i), from_hi);
+  }
+  return r;
+}
+#else
+FR_INLINE vpf vp_bcast4(const float *p) FR_VP_LANES(p[i & 3])
+FR_INLINE vpf vp_permute(vpf a, const int32_t *idx) FR_VP_LANES(a.f[idx[i]])
+#endif
+
 /* Structure-of-arrays to records: record i (nf = 7 or 8 floats, at dst +
  * nf * i) gets lane i of f[0..nf), for the P lanes. Whole 8-float rows are
  * transposed in registers and stored at once; storing lane by lane cost a

@@ -10,7 +10,8 @@
 
 /* Single-ray work (also the hybrid's single-ray phase) counts one test per
  * ray and box or triangle; packet work counts SIMD tests (pk_*) and the
- * active rays in them (pk_*_lanes). Multi-frusta work (mft_*): batches of 16
+ * active rays in them (pk_*_lanes), and quad tests (pk_quad_tests: up to
+ * four rays against a four-triangle block, trace/tri4_quad.h). Multi-frusta work (mft_*): batches of 16
  * frusta, SIMD box tests (one box, 16 frusta) and the active frusta in them,
  * triangles fetched by leaves, frustum-triangle pairs before and after the
  * corner-ray cull (each pair left is one 16-ray test), soft-shadow batches
@@ -23,7 +24,7 @@
 #define FR_COUNTER_FIELDS(X)                                                   \
   X(rays) X(nodes) X(box_tests) X(leaves) X(tri_tests)                         \
   X(packets) X(pk_nodes) X(pk_box_tests) X(pk_box_lanes) X(pk_tri_tests)       \
-  X(pk_tri_lanes) X(ia_culled) X(mailbox_hits) X(switches) X(switch_rays)    \
+  X(pk_tri_lanes) X(pk_quad_tests) X(ia_culled) X(mailbox_hits) X(switches) X(switch_rays)    \
   X(mft_batches) X(mft_nodes) X(mft_box_tests) X(mft_box_lanes) X(mft_tris)   \
   X(mft_tri_frusta) X(mft_tri_left) X(mft_ray_batches) X(mft_stream_batches) X(mft_cached_leaves)  \
   X(mft_stopped_batches)                                                     \

@@ -43,6 +43,7 @@ typedef struct fr_packet_opts {
   int mailbox;            /* inverse mailboxing: skip triangles this packet tested already */
   int axis_aligned;       /* Shevtsov's fast path for axis-aligned triangles */
   int ia_cull;            /* cull nodes for the whole packet by interval arithmetic first */
+  int quad_leaves;        /* leaves reached by a few rays: four rays by four triangles a test */
   const fr_trace_fns *single; /* the single-ray kernels of the same ISA and width */
 } fr_packet_opts;
 

@@ -103,9 +103,11 @@ static void report(const fr_workload *w0, const bench_run *r, const char *scene,
            (unsigned long long)c.mft_cached_leaves, (unsigned long long)c.mft_stopped_batches);
   if (fr_counters_enabled() && c.packets)
     printf("counters tracer=%s mode=%s workload=%s packets=%llu per_packet pk_nodes=%.2f pk_box_tests=%.2f "
-           "pk_tri_tests=%.2f ia_culled=%.2f mailbox_hits=%.2f switches=%.2f avg_active_box=%.2f avg_active_tri=%.2f\n",
+           "pk_tri_tests=%.2f pk_quad_tests=%.2f ia_culled=%.2f mailbox_hits=%.2f switches=%.2f avg_active_box=%.2f "
+           "avg_active_tri=%.2f\n",
            tracer, mode, fr_workload_name(w0->kind), (unsigned long long)c.packets, (double)c.pk_nodes / c.packets,
-           (double)c.pk_box_tests / c.packets, (double)c.pk_tri_tests / c.packets, (double)c.ia_culled / c.packets,
+           (double)c.pk_box_tests / c.packets, (double)c.pk_tri_tests / c.packets, (double)c.pk_quad_tests / c.packets,
+           (double)c.ia_culled / c.packets,
            (double)c.mailbox_hits / c.packets, (double)c.switches / c.packets,
            c.pk_box_tests ? (double)c.pk_box_lanes / c.pk_box_tests : 0.0,
            c.pk_tri_tests ? (double)c.pk_tri_lanes / c.pk_tri_tests : 0.0);
@@ -172,7 +174,7 @@ int cmd_bench(int argc, char **argv) {
         !strcmp(a, "--packet-width") || !strcmp(a, "--corner-rays") || !strcmp(a, "--shrink") || !strcmp(a, "--mft-leaf") ||
         !strcmp(a, "--corner-cost") || !strcmp(a, "--mft-fallback") ||
         !strcmp(a, "--light-sets") || !strcmp(a, "--prefetch") || !strcmp(a, "--stream-spread") ||
-        !strcmp(a, "--coherent-threshold")) {
+        !strcmp(a, "--coherent-threshold") || !strcmp(a, "--quad")) {
       if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
       const char *val = argv[++i];
       if (!strcmp(a, "--light-sets")) {
@@ -213,7 +215,8 @@ int cmd_bench(int argc, char **argv) {
       } else if (!strcmp(a, "--packet-width")) {
         if (!cli_parse_int(val, 4, 8, &topt.packet_bvh_width) || (topt.packet_bvh_width != 4 && topt.packet_bvh_width != 8))
           return cli_error(CLI_USAGE_ERROR, "--packet-width is 4 or 8, not '%s'", val);
-      } else if (parse_onoff(a, val, !strcmp(a, "--mailbox") ? &topt.mailbox : !strcmp(a, "--ia") ? &topt.ia_cull : &topt.axis_aligned))
+      } else if (parse_onoff(a, val, !strcmp(a, "--mailbox") ? &topt.mailbox : !strcmp(a, "--ia") ? &topt.ia_cull
+                                     : !strcmp(a, "--quad") ? &topt.quad_leaves : &topt.axis_aligned))
         return CLI_USAGE_ERROR;
       continue;
     }
