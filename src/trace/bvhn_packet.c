@@ -13,7 +13,9 @@
  *
  * Leaves test their triangles one at a time against all P rays with
  * Shevtsov's test on the precomputed 48-byte record (geom/tri_shevtsov.h),
- * with its axis-aligned fast path, after an inverse mailbox check.
+ * with its axis-aligned fast path, after an inverse mailbox check; a leaf
+ * reached by only a few active rays tests them four at a time against its
+ * four-triangle blocks instead (quad leaves, trace/tri4_quad.h).
  *
  * The hybrid: on each pop, if at most hybrid_threshold rays are still active
  * in the popped subtree, they finish it one by one with the single-ray kernel
@@ -671,7 +673,6 @@ static void intersect_rays_idx(const fr_bvhn *b, const fr_packet_opts *o, const 
   vp_scatter(f + 3, si, asked, h.prim);
   for (int a = 0; a < 3; a++) vp_scatter(f + 4 + a, si, asked, h.ng[a]);
 }
-
 
 static unsigned occluded_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in) {
   packet pk;
