@@ -47,6 +47,17 @@ static inline fr_wt_ray fr_wt_setup(vec3 d) {
   return w;
 }
 
+/* The three edge values in double, rounded once: for a ray through an edge
+ * or a vertex, where a float edge value came out exactly zero, their signs
+ * say which of the triangles that share it is hit. Every watertight test
+ * (this one, and the 4- and P-lane ones of the kernels) takes this path. */
+static inline void fr_wt_edges_exact(float ax, float ay, float bx, float by, float cx, float cy, float *e0, float *e1,
+                                     float *e2) {
+  *e0 = (float)((double)cx * by - (double)cy * bx);
+  *e1 = (float)((double)ax * cy - (double)ay * cx);
+  *e2 = (float)((double)bx * ay - (double)by * ax);
+}
+
 static inline int fr_tri_watertight(const fr_wt_ray *w, vec3 o, float tnear, float tfar, vec3 p0, vec3 p1, vec3 p2,
                                     float *t, float *u, float *v) {
   vec3 a = v3_sub(p0, o), b = v3_sub(p1, o), c = v3_sub(p2, o);
@@ -55,11 +66,7 @@ static inline int fr_tri_watertight(const fr_wt_ray *w, vec3 o, float tnear, flo
   float bx = v3_get(b, w->kx) - w->sx * bz, by = v3_get(b, w->ky) - w->sy * bz;
   float cx = v3_get(c, w->kx) - w->sx * cz, cy = v3_get(c, w->ky) - w->sy * cz;
   float e0 = cx * by - cy * bx, e1 = ax * cy - ay * cx, e2 = bx * ay - by * ax;
-  if (e0 == 0.0f || e1 == 0.0f || e2 == 0.0f) {
-    e0 = (float)((double)cx * by - (double)cy * bx);
-    e1 = (float)((double)ax * cy - (double)ay * cx);
-    e2 = (float)((double)bx * ay - (double)by * ax);
-  }
+  if (e0 == 0.0f || e1 == 0.0f || e2 == 0.0f) fr_wt_edges_exact(ax, ay, bx, by, cx, cy, &e0, &e1, &e2);
   if ((e0 < 0.0f || e1 < 0.0f || e2 < 0.0f) && (e0 > 0.0f || e1 > 0.0f || e2 > 0.0f)) return 0;
   float det = (e0 + e1) + e2;
   if (det == 0.0f || !(det == det)) return 0;

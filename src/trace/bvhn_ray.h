@@ -103,9 +103,7 @@ static __attribute__((noinline, cold)) tri4_edges exact_edges(tri4_edges e, vflo
   vf4_store(AX, ax); vf4_store(AY, ay); vf4_store(BX, bx); vf4_store(BY, by); vf4_store(CX, cx); vf4_store(CY, cy);
   for (int i = 0; i < 4; i++) {
     if (!((lanes >> i) & 1)) continue;
-    E0[i] = (float)((double)CX[i] * BY[i] - (double)CY[i] * BX[i]);
-    E1[i] = (float)((double)AX[i] * CY[i] - (double)AY[i] * CX[i]);
-    E2[i] = (float)((double)BX[i] * AY[i] - (double)BY[i] * AX[i]);
+    fr_wt_edges_exact(AX[i], AY[i], BX[i], BY[i], CX[i], CY[i], &E0[i], &E1[i], &E2[i]);
   }
   tri4_edges out = {vf4_load(E0), vf4_load(E1), vf4_load(E2)};
   return out;

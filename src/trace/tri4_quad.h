@@ -17,6 +17,7 @@
 #define FR_TRACE_TRI4_QUAD_H
 #include "accel/bvhn.h"
 #include "base/simd_packet.h"
+#include "geom/tri_watertight.h"
 
 enum { QUAD_RAYS = P / 4 }; /* rays per test */
 
@@ -92,9 +93,7 @@ static __attribute__((noinline, cold)) void quad_exact_edges(vpf *e, const vpf *
   for (int k = 0; k < 6; k++) vp_store(V[k], v[k]);
   for (int i = 0; i < P; i++) {
     if (!((lanes >> i) & 1)) continue;
-    E[0][i] = (float)((double)V[4][i] * V[3][i] - (double)V[5][i] * V[2][i]);
-    E[1][i] = (float)((double)V[0][i] * V[5][i] - (double)V[1][i] * V[4][i]);
-    E[2][i] = (float)((double)V[2][i] * V[1][i] - (double)V[3][i] * V[0][i]);
+    fr_wt_edges_exact(V[0][i], V[1][i], V[2][i], V[3][i], V[4][i], V[5][i], &E[0][i], &E[1][i], &E[2][i]);
   }
   for (int k = 0; k < 3; k++) e[k] = vp_load(E[k]);
 }
