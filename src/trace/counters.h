@@ -11,15 +11,16 @@
 /* Single-ray work (also the hybrid's single-ray phase) counts one test per
  * ray and box or triangle; packet work counts SIMD tests (pk_*) and the
  * active rays in them (pk_*_lanes), and quad tests (pk_quad_tests: up to
- * four rays against a four-triangle block, trace/tri4_quad.h). Multi-frusta work (mft_*): batches of 16
- * frusta, SIMD box tests (one box, 16 frusta) and the active frusta in them,
- * triangles fetched by leaves, frustum-triangle pairs before and after the
- * corner-ray cull (each pair left is one 16-ray test), soft-shadow batches
- * traced as rays instead (render/workload.c). Large packets
- * (lp_*): packets, stack entries popped, boxes culled for the whole packet,
- * 16-ray box tests, leaves, prims (triangles and spheres) reached, triangles culled for the
- * whole packet, 16-ray triangle tests. Spheres: single-ray box and sphere
- * tests in the sphere tree (sp_*), spheres culled for a whole large packet,
+ * four rays against a four-triangle block, trace/tri4_quad.h).
+ * Multi-frusta work (mft_*): batches of 16 frusta, SIMD box tests (one
+ * box, 16 frusta) and the active frusta in them, triangles fetched by
+ * leaves, frustum-triangle pairs before and after the corner-ray cull
+ * (each pair left is one 16-ray test), soft-shadow batches traced as rays
+ * instead (render/workload.c). Large packets (lp_*): packets, stack entries
+ * popped, boxes culled for the whole packet, 16-ray box tests, leaves,
+ * prims (triangles and spheres) reached, triangles culled for the whole
+ * packet, 16-ray triangle tests. Spheres: single-ray box and sphere tests
+ * in the sphere tree (sp_*), spheres culled for a whole large packet,
  * 16-ray sphere tests. */
 #define FR_COUNTER_FIELDS(X)                                                   \
   X(rays) X(nodes) X(box_tests) X(leaves) X(tri_tests)                         \
