@@ -229,10 +229,11 @@ typedef struct fr_trace_options {
   int ia_cull;            /* interval-arithmetic culling of nodes for whole packets (default on) */
   int quad_leaves;        /* packet leaves reached by only a few active rays test four of them against
                              four triangles at once, with the single-ray kernel's watertight test
-                             (default on, see README) */
+                             (default on, see docs/performance-log.md) */
   int prefetch;           /* rays and packets prefetch the children they defer: 1 on, 0 off, -1
                              (default) on for rays when the BVH and triangles exceed 64 MB, for
-                             packets when the BVH and their triangle records exceed 32 MB (see README) */
+                             packets when the BVH and their triangle records exceed 32 MB (see
+                             docs/performance-log.md) */
   float stream_spread;    /* FR_TRACE_AUTO: a group of 16 goes as a packet when its unit directions
                              lie within this distance of its first ray's (probed at 3 rays), else
                              in a ray stream; 0..2: 0 streams every group, 2 none (default

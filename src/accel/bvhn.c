@@ -105,7 +105,7 @@ static uint32_t *node_children(conv *c, uint32_t i) { return (uint32_t *)(node_f
  * other light: from below, dragon soft16 took 11.7 node visits per ray
  * with it and 8.8 with a factor-2 step. Unrounded, the rank gained most on
  * hairball and lost 9% on dragon; steps of 2 lost least on dragon and
- * gained least on hairball (README, Performance, session 45). */
+ * gained least on hairball (docs/performance-log.md, session 45). */
 static int occlusion_rank(const conv *c, int32_t bi) {
   const fr_build_node *n = &c->t->nodes[bi];
   double a = c->area[n->first + n->count] - c->area[n->first], h = aabb_half_area(n->box);

@@ -74,7 +74,7 @@ typedef struct fr_bvhn {
    * records: on by default (fr_bvhn_packet_prefetch_auto) above
    * FR_BVHN_PACKET_PREFETCH_BYTES of nodes and records. Dragon (55 MB of
    * them, 48 MB of nodes and blocks) gained 6% on primary packet16 with
-   * it, where single rays lose (README, Performance, "Packets prefetch on
+   * it, where single rays lose (docs/performance-log.md, "Packets prefetch on
    * a lower bound"). */
   int packet_prefetch;
 } fr_bvhn;

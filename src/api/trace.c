@@ -24,7 +24,7 @@ void fr_trace_options_default(fr_trace_options *o) {
    * 1024x1024, two pairs each, primary +2-5% on conference and dragon, +11%
    * on hairball; shadow +2-5.5% on all four scenes; specular8, diffuse8 and
    * Whitted within 1.5%. (At 512x512 dragon's primary packets lose
-   * coherence sooner and 7 read 4-10% faster; README, Performance.) */
+   * coherence sooner and 7 read 4-10% faster; docs/performance-log.md.) */
   o->coherent_threshold = 2;
 }
 
@@ -205,7 +205,9 @@ static const uint32_t identity_idx[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 
 /* Whether a packet of these rays pays: their unit directions lie within
  * chord length spread of the first ray's. A packet's rays then visit nearly
  * the same nodes; past that, lanes die early and a ray stream, which tests
- * each ray alone but shares the node fetches, does better (README, "auto").
+ * each ray alone but shares the node fetches, does better
+ * (docs/performance-log.md, "`auto` chooses packets or ray streams per
+ * group").
  * Three rays spread over the group stand for it: a primary ray takes only
  * ~36 ns of a core here (55 Mrays/s on 2 threads), and normalizing all 16
  * directions cost 6% of conference primary (1024x1024, two pairs). No

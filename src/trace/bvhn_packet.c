@@ -22,8 +22,8 @@
  * of the same ISA and width, and the packet goes on with the next pop. A
  * packet whose rays share a direction octant uses uniform_threshold instead:
  * its few remaining rays still visit nearly the same nodes, and the MIC
- * paper's 7 left such packets 3-10% behind plain packets (README,
- * Performance, "The hybrid's threshold for one-octant packets").
+ * paper's 7 left such packets 3-10% behind plain packets (docs/
+ * performance-log.md, "The hybrid's threshold for one-octant packets").
  *
  * Compiled once per ISA, packet size (FR_PACKET) and BVH width (FR_WIDTH).
  */
@@ -418,7 +418,7 @@ static void finish(const fr_bvhn *b, const packet *pk, const uint32_t *best, vpf
  * answers and a reduction per ray, up to QUAD_CLOSEST_MOST: at 8,
  * conference primary 0.965x and diffuse8 0.977x against none, at 4 within
  * 1.5% of none on conference and kitchen and +1-6% on dragon and hairball
- * (README, Performance). quad_wanted says whether to, setting q up at the
+ * (docs/performance-log.md). quad_wanted says whether to, setting q up at the
  * packet's first such leaf; q->ok is -1 until then. */
 enum { QUAD_ANY_MOST = 8, QUAD_CLOSEST_MOST = 4 };
 FR_INLINE int quad_wanted(const fr_packet_opts *o, int most, quad_rays *q, const packet *pk, unsigned valid,

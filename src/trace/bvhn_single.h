@@ -108,7 +108,7 @@ FR_INLINE int any_hit(const fr_bvhn *b, const ray_pre *rp, uint32_t root, const 
        * the collapse's own order, going to slot 0 first measured up to 2x
        * slower (kitchen ao16). Nearest-first measured +21% on hairball
        * soft16 but -30% on kitchen ao16, -18% on dragon soft16 and -9% on
-       * hairball shadow (README, Performance, sessions 37 and 45). */
+       * hairball shadow (docs/performance-log.md, sessions 37 and 45). */
       {
         int last = 31 - __builtin_clz((unsigned)mask);
         ref = n->child[last];

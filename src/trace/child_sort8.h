@@ -45,7 +45,7 @@ static inline int32_t fr_child_key(float d, int slot) {
  * conditional moves. It runs about as many instructions as
  * the network but gets the nearest child, whose node load comes next, some
  * 20 cycles sooner than the six dependent layers; single-ray diffuse8 gained
- * 1.04x on four scenes (README, Performance). */
+ * 1.04x on four scenes (docs/performance-log.md). */
 FR_INLINE uint32_t fr_child_sort2(const uint32_t *child, int i0, int i1, __m256 dist, void *out) {
   float d[8] __attribute__((aligned(32)));
   _mm256_store_ps(d, dist);

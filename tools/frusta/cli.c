@@ -180,7 +180,7 @@ void cli_whitted_default(cli_whitted *o) {
   memset(o, 0, sizeof *o);
   o->depth = 4;
   o->lp.traversal = FR_LP_RANGED;
-  o->lp.cull = FR_CULL_OFF; /* measured: the culls cost more than they save (README) */
+  o->lp.cull = FR_CULL_OFF; /* measured: the culls cost more than they save (docs/performance-log.md) */
   o->packet = 16;
 }
 

@@ -142,7 +142,7 @@ int cmd_render(int argc, char **argv) {
   w.image = calloc((size_t)v.width * (size_t)v.height * 3, sizeof(float));
   if (!w.image) { fr_whitted_mats_free(&mats); fr_scene_release(s); return cli_error(1, "out of memory for a %dx%d image", v.width, v.height); }
   /* Whitted: camera rays by multi-frusta tracing and the rest as streams
-   * (the fastest measured, see README), or with --mft off or any of
+   * (the fastest measured, see docs/performance-log.md), or with --mft off or any of
    * --packet, --traversal, --cull: large packets of --packet x --packet */
   fr_lp_tracer lpc = {s, cli_lp_scene(s), wo.lp, wo.packet};
   fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
@@ -152,7 +152,7 @@ int cmd_render(int argc, char **argv) {
   }
   /* multi-frusta tracing does not see spheres: such scenes go the packet
    * way. Camera rays are traced as frusta by default for every shade (1.5-2.8x
-   * packets on the shared scenes, README "Multi-frusta triangle tests
+   * packets on the shared scenes, docs/performance-log.md "Multi-frusta triangle tests
    * without branches"); the rest as streams (auto). */
   const int use_mft = mft != 0 && !fr_scene_sphere_count(s) && !(w.kind == FR_WL_WHITTED && wo.large_flags);
   fr_tracer t = use_mft ? fr_tracer_mft(&mctx) : w.kind != FR_WL_WHITTED ? fr_tracer_frusta(s) : fr_tracer_lp(&lpc);
