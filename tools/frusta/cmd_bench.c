@@ -268,9 +268,13 @@ int cmd_bench(int argc, char **argv) {
   const fr_wide_stats *ws = st.single_width == 4 ? &st.bvh4 : &st.bvh8;
   /* packets traverse the packet BVH and test its Shevtsov records */
   const fr_wide_stats *wp = topt.packet_bvh_width == 4 ? &st.bvh4 : &st.bvh8;
-  int prefetch = topt.prefetch >= 0 ? topt.prefetch : fr_bvhn_prefetch_auto(st.single_width == 4 ? &s->bvh4 : &s->bvh8);
-  int packet_prefetch =
-      topt.prefetch >= 0 ? topt.prefetch : fr_bvhn_packet_prefetch_auto(topt.packet_bvh_width == 4 ? &s->bvh4 : &s->bvh8);
+  /* the prefetch switches as the scene applies them (fr_scene_apply_prefetch) */
+  if (fr_scene_set_trace_options(s, &topt) != FR_OK) {
+    fr_scene_release(s);
+    return cli_error(1, "%s", fr_last_error());
+  }
+  const int prefetch = (st.single_width == 4 ? &s->bvh4 : &s->bvh8)->prefetch;
+  const int packet_prefetch = (topt.packet_bvh_width == 4 ? &s->bvh4 : &s->bvh8)->packet_prefetch;
   printf("build_seconds=%.3f tracer=frusta scene=%s tris=%zu threads=%d isa=%s bvh_width=%d sah=%.2f bytes_per_tri=%.1f "
          "prefetch=%s packet_bvh_width=%d packet_bytes_per_tri=%.1f packet_prefetch=%s\n",
          st.build_seconds, s->name, tris, threads, fr_isa_name(fr_get_isa()), st.single_width, ws->sah,
