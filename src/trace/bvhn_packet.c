@@ -22,8 +22,9 @@
  * of the same ISA and width, and the packet goes on with the next pop. A
  * packet whose rays share a direction octant uses uniform_threshold instead:
  * its few remaining rays still visit nearly the same nodes, and the MIC
- * paper's 7 left such packets 3-10% behind plain packets (docs/
- * performance-log.md, "The hybrid's threshold for one-octant packets").
+ * paper's 7 left such packets 3-10% behind plain packets
+ * (docs/performance-log.md, "The hybrid's threshold for one-octant
+ * packets").
  *
  * Compiled once per ISA, packet size (FR_PACKET) and BVH width (FR_WIDTH).
  */
