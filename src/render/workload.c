@@ -114,6 +114,16 @@ void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, 
  * early that rule no longer paid (without it, 3 pairs: dragon 1.012x,
  * kitchen 1.002x) and is gone. */
 
+/* Set bits of a 16-bit mask. This file is built for every CPU, without
+ * -mpopcnt, where __builtin_popcount is a call into libgcc: one per shadow
+ * frustum was about 1.5% of conference soft16's multi-frusta samples. */
+static inline int bits16(unsigned x) {
+  x = x - ((x >> 1) & 0x5555u);
+  x = (x & 0x3333u) + ((x >> 2) & 0x3333u);
+  x = (x + (x >> 4)) & 0x0F0Fu;
+  return (int)((x + (x >> 8)) & 0x1Fu);
+}
+
 /* Soft shadows: pixels 16 j .. 16 j + 15 with a primary hit are the frusta of
  * batch j: origin p, rays p + t (c + s e1 + q e2 - p) for the samples of the
  * pixel's interleaved set, t in (eps / |light centre - p|, 1 - 1e-4). Returns
@@ -146,7 +156,7 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
       b.set[f] = (uint8_t)fr_mft_light_set(B->px[i], B->py[i]);
       b.valid |= 1u << f;
     }
-    rays += 16u * (uint64_t)__builtin_popcount(b.valid);
+    rays += 16u * (uint64_t)bits16(b.valid);
     uint16_t occ[FR_MFT_FRUSTA] = {0};
     if (!as_rays) {
       /* The batch stops as soon as the rule below is sure to send the rest
@@ -156,7 +166,7 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
        * fallen-back tiles took a quarter of soft16's shadow time, at up to
        * 7 times their rays' cost as streams; stopping them gained dragon
        * soft16 1.09x, 4/4 interleaved pairs, kitchen 1.00x). */
-      const unsigned nf = (unsigned)__builtin_popcount(b.valid);
+      const unsigned nf = (unsigned)bits16(b.valid);
       fr_mft_budget budget = {0, 0, 0, 0};
       if (!w->mft_no_fallback) {
         budget.nodes = SOFT_FRUSTA_MAX_NODES * nf + 1;
@@ -168,7 +178,7 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
       if (!budget.stopped) {
         for (unsigned v = b.valid; v; v &= v - 1) {
           int f = __builtin_ctz(v);
-          lit[16 * j + f] = (float)(16 - __builtin_popcount(occ[f])) / 16.0f;
+          lit[16 * j + f] = (float)(16 - bits16(occ[f])) / 16.0f;
         }
         continue;
       }
