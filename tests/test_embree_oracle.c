@@ -107,7 +107,7 @@ static void check_scene(const char *path) {
   if (e) fail_msg("%s: %s", path, fr_last_error());
   assert_int_equal(fr_scene_commit(s), FR_OK);
   ebr_scene *eb;
-  ebr_options o = {2, 1, 1}; /* robust */
+  ebr_options o = {.threads = 2, .quality = 1, .robust = 1}; /* robust */
   assert_int_equal(ebr_create(s, o, &eb), FR_OK);
   size_t cap = 4 * SIDE * SIDE;
   fr_ray *rays = malloc(cap * sizeof *rays);

@@ -305,7 +305,7 @@ int cmd_bench(int argc, char **argv) {
   }
   ebr_scene *e = NULL;
   if (esel) {
-    ebr_options o = {threads, 2, 0}; /* high quality, not robust: Embree's fastest tracing */
+    ebr_options o = {.threads = threads, .quality = 2}; /* high quality, not robust: Embree's fastest tracing */
     if (ebr_create(s, o, &e)) {
       fr_bvh2_free(&shallow);
       fr_whitted_mats_free(&mats);

@@ -10,6 +10,7 @@
 #include "cli.h"
 #include "commands.h"
 #include "embree_tracer.h"
+#include "embree_tree.h"
 #include "render/whitted.h"
 #include "render/workload.h"
 #include "trace/counters.h"
@@ -126,12 +127,22 @@ int cmd_stats(int argc, char **argv) {
                q == 2 ? "high" : "medium", sah, sahb, sec, st.bvh4.sah / sah, st.bvh4.sah_blocks / sahb);
     }
     ebr_scene *e;
-    ebr_options o = {threads, 2, 0};
+    ebr_options o = {.threads = threads, .quality = 2};
     if (ebr_create(s, o, &e) == FR_OK) {
       printf("embree_scene quality=high build_seconds=%.3f bytes=%zu bytes_per_tri=%.1f build_ratio_frusta_over_embree=%.2f\n",
              ebr_build_seconds(e), ebr_bytes(e), (double)ebr_bytes(e) / (double)nt, st.build_seconds / ebr_build_seconds(e));
       ebr_release(e);
     }
+    /* Embree's tree, by its own statistics: the same SAH as sah_blocks */
+    ebr_tree t;
+    if (ebr_tree_stats(s, threads, &t) == FR_OK)
+      printf("embree_tree accel=%s builder=%s depth=%d inner=%zu leaves=%zu sah_blocks=%.2f node_sah=%.2f leaf_sah=%.2f "
+             "node_fill=%.2f/%d block_fill=%.2f/%d one_block_leaves=%.3f frusta_bvh%d_over_embree sah_blocks=%.3f\n",
+             t.accel, t.builder, t.depth, t.inner, t.leaves, t.sah, t.node_sah, t.leaf_sah, t.node_fill, t.width,
+             t.block_fill, t.block_size, t.one_block, t.width == 4 ? 4 : 8,
+             (t.width == 4 ? st.bvh4.sah_blocks : st.bvh8.sah_blocks) / t.sah);
+    else
+      printf("embree_tree unavailable\n");
   }
   fr_scene_release(s);
   return 0;

@@ -58,7 +58,7 @@ int cmd_trace(int argc, char **argv) {
   const size_t chunk = 4096; /* a multiple of 16: packets never straddle chunks */
   ebr_scene *e = NULL;
   if (use_embree) {
-    ebr_options o = {0, 2, 1}; /* robust: Embree's watertight mode */
+    ebr_options o = {.threads = 0, .quality = 2, .robust = 1}; /* robust: Embree's watertight mode */
     if (ebr_create(s, o, &e)) { free(rays); fr_scene_release(s); return cli_error(1, "embree: cannot build the scene"); }
   }
   int rc = 0;

@@ -38,7 +38,7 @@ fr_error ebr_create(const fr_scene *s, ebr_options opt, ebr_scene **out) {
   ebr_scene *e = calloc(1, sizeof *e);
   if (!e) return FR_ERR_NOMEM;
   char cfg[64];
-  snprintf(cfg, sizeof cfg, "threads=%d", opt.threads > 0 ? opt.threads : 0);
+  snprintf(cfg, sizeof cfg, "threads=%d,verbose=%d", opt.threads > 0 ? opt.threads : 0, opt.verbose);
   e->dev = rtcNewDevice(cfg);
   if (!e->dev) { free(e); return FR_ERR_UNSUPPORTED; }
   rtcSetDeviceMemoryMonitorFunction(e->dev, memory_monitor, e);

@@ -14,6 +14,7 @@ typedef struct ebr_options {
   int threads;
   int quality;   /* 0 low, 1 medium, 2 high (spatial splits) */
   int robust;    /* RTC_SCENE_FLAG_ROBUST: watertight, slower */
+  int verbose;   /* Embree's device verbosity: 2 prints the tree's statistics on stdout at commit */
 } ebr_options;
 
 fr_error ebr_create(const fr_scene *s, ebr_options opt, ebr_scene **out);
