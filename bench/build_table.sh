@@ -22,10 +22,11 @@ awk '
               if (!(s in seen)) { seen[s] = 1; order[++ns] = s } }
   /^bvh8 / { kv($0); fm[s] = v["bytes_per_tri"] }
   /^embree_builder width=4 quality=high/ { split($NF, p, "="); sah[s] = p[2] } # the last field: frusta / Embree
+  /^embree_tree accel/ { split($NF, p, "="); tree[s] = p[2] } # frusta BVH8 / the BVH8 Embree traces
   /^embree_scene/ { kv($0); if (!(s in eb) || v["build_seconds"] + 0 < eb[s]) eb[s] = v["build_seconds"] + 0; em[s] = v["bytes_per_tri"] }
   END {
-    print "| scene | frusta commit s (BVH2, multi-frusta cut, BVH8) | Embree commit s (high quality) | frusta / Embree | frusta BVH4 SAH / Embree high-quality BVH4 SAH (leaf blocks) | frusta bytes/tri (BVH8 + triangles) | Embree bytes/tri |"
-    print "|---|---:|---:|---:|---:|---:|---:|"
+    print "| scene | frusta commit s (BVH2, multi-frusta cut, BVH8) | Embree commit s (high quality) | frusta / Embree | frusta BVH4 SAH / Embree high-quality BVH4 SAH (leaf blocks) | frusta BVH8 SAH / SAH of the BVH8 Embree traces | frusta bytes/tri (BVH8 + triangles) | Embree bytes/tri |"
+    print "|---|---:|---:|---:|---:|---:|---:|---:|"
     for (i = 1; i <= ns; i++) { s = order[i]
-      printf "| %s | %.3f | %.3f | %.2f | %s | %s | %s |\n", s, fb[s], eb[s], fb[s] / eb[s], sah[s], fm[s], em[s] }
+      printf "| %s | %.3f | %.3f | %.2f | %s | %s | %s | %s |\n", s, fb[s], eb[s], fb[s] / eb[s], sah[s], tree[s], fm[s], em[s] }
   }' "$RAW"
