@@ -151,10 +151,16 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
       vec3 p = hit_point(&B->prim_ray[i], h), st = v3_sub(w->view.area_c, p);
       b.org[0][f] = p.x; b.org[1][f] = p.y; b.org[2][f] = p.z;
       b.start[0][f] = st.x; b.start[1][f] = st.y; b.start[2][f] = st.z;
-      b.tnear[f] = w->eps / v3_len(v3_sub(centre, p));
       b.tfar[f] = 1.0f - 1e-4f;
       b.set[f] = (uint8_t)fr_mft_light_set(B->px[i], B->py[i]);
       b.valid |= 1u << f;
+    }
+    /* tnear for all 16 lanes in a loop the compiler vectorizes (the same
+     * operations as eps / v3_len(centre - p)); lanes without a hit are
+     * never read */
+    for (int f = 0; f < 16; f++) {
+      const float dx = centre.x - b.org[0][f], dy = centre.y - b.org[1][f], dz = centre.z - b.org[2][f];
+      b.tnear[f] = w->eps / sqrtf(dx * dx + dy * dy + dz * dz);
     }
     rays += 16u * (uint64_t)bits16(b.valid);
     uint16_t occ[FR_MFT_FRUSTA] = {0};
@@ -176,10 +182,9 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
       as_rays = as_streams = !w->mft_no_fallback && fetched > SOFT_FRUSTA_MAX_TRIS * nf &&
                              budget.visited > SOFT_FRUSTA_MAX_NODES * nf;
       if (!budget.stopped) {
-        for (unsigned v = b.valid; v; v &= v - 1) {
-          int f = __builtin_ctz(v);
-          lit[16 * j + f] = (float)(16 - bits16(occ[f])) / 16.0f;
-        }
+        float open[FR_MFT_FRUSTA]; /* all lanes at once, vectorized */
+        for (int f = 0; f < FR_MFT_FRUSTA; f++) open[f] = (float)(16 - bits16(occ[f])) / 16.0f;
+        for (unsigned v = b.valid; v; v &= v - 1) lit[16 * j + __builtin_ctz(v)] = open[__builtin_ctz(v)];
         continue;
       }
       FR_COUNT(mft_stopped_batches, 1);
