@@ -11,7 +11,6 @@
 #include <cmocka.h>
 #include <math.h>
 #include <string.h>
-#include "api/scene.h"
 #include "embree_tree.h"
 
 static const char *LOG =

@@ -67,7 +67,7 @@ fr_error ebr_tree_parse(const char *log, ebr_tree *out) {
       out->one_block = v / 100.0, got |= 16;
   }
   if (got != 31) return FR_ERR_UNSUPPORTED;
-  /* BVH<W><prim<B>>: the fill shares as counts */
+  /* the fill shares as counts: BVH8<triangle4> is 8 wide, blocks of 4 */
   if (sscanf(out->accel, "BVH%d", &out->width) != 1 || out->width < 2) return FR_ERR_UNSUPPORTED;
   const char *lt = strchr(out->accel, '<');
   size_t k = lt ? strcspn(lt, "0123456789") : 0;
