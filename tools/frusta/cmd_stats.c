@@ -133,7 +133,9 @@ int cmd_stats(int argc, char **argv) {
              ebr_build_seconds(e), ebr_bytes(e), (double)ebr_bytes(e) / (double)nt, st.build_seconds / ebr_build_seconds(e));
       ebr_release(e);
     }
-    /* Embree's tree, by its own statistics: the same SAH as sah_blocks */
+    /* Embree's tree, by its own statistics: the same SAH as sah_blocks. A
+     * commit of its own: the log's tree walk runs inside rtcCommitScene and
+     * would count in the build time above. */
     ebr_tree t;
     if (ebr_tree_stats(s, threads, &t) == FR_OK)
       printf("embree_tree accel=%s builder=%s depth=%d inner=%zu leaves=%zu sah_blocks=%.2f node_sah=%.2f leaf_sah=%.2f "
