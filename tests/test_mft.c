@@ -518,6 +518,44 @@ static void shared_scene_one(const char *path, void *ctx) {
   print_message("%s: %ld disagreements so far (+%ld)\n", path, tl->disagree, tl->disagree - before);
 }
 
+/* The binary trees' leaves are cut by SAH (accel/bvh2.c): a room's
+ * ceiling and wall, four large triangles, make two flat leaves rather than
+ * one leaf as large as the room, which every shadow frustum in it would
+ * enter; a tetrahedron's four faces, whose boxes overlap, stay one leaf. */
+static void bvh2_leaves_by_sah(void **state) {
+  (void)state;
+  scene_data sd = {malloc(4 * 9 * sizeof(float)), malloc(4 * 3 * sizeof(uint32_t)), 0, 0};
+  add_tri(&sd, v3(0, 10, 0), v3(10, 10, 0), v3(10, 10, 10)); /* ceiling */
+  add_tri(&sd, v3(0, 10, 0), v3(10, 10, 10), v3(0, 10, 10));
+  add_tri(&sd, v3(0, 0, 0), v3(0, 10, 0), v3(0, 10, 10)); /* wall */
+  add_tri(&sd, v3(0, 0, 0), v3(0, 10, 10), v3(0, 0, 10));
+  fr_scene *s = commit_scene(&sd);
+  const fr_bvh2 *b = &s->bvh2;
+  assert_false(b->root & FR_BVH2_LEAF);
+  const fr_bvh2_node *n = &b->nodes[b->root];
+  int flat_y = 0, flat_x = 0;
+  for (int k = 0; k < 2; k++) {
+    assert_true(n->child[k] & FR_BVH2_LEAF);
+    assert_int_equal(FR_BVH2_LEAF_COUNT(n->child[k]), 2);
+    flat_y += n->lo_y[k] == 10.0f && n->hi_y[k] == 10.0f;
+    flat_x += n->lo_x[k] == 0.0f && n->hi_x[k] == 0.0f;
+  }
+  assert_int_equal(flat_y, 1);
+  assert_int_equal(flat_x, 1);
+  fr_scene_release(s);
+  sd.nv = sd.nt = 0;
+  const vec3 o = v3(0, 0, 0), x = v3(1, 0, 0), y = v3(0, 1, 0), z = v3(0, 0, 1);
+  add_tri(&sd, o, y, x);
+  add_tri(&sd, o, x, z);
+  add_tri(&sd, o, z, y);
+  add_tri(&sd, x, y, z);
+  s = commit_scene(&sd);
+  assert_true(s->bvh2.root & FR_BVH2_LEAF);
+  assert_int_equal(FR_BVH2_LEAF_COUNT(s->bvh2.root), 4);
+  fr_scene_release(s);
+  free_scene(&sd);
+}
+
 static void shared_scenes(void **state) {
   (void)state;
   tally tl = {0};
@@ -650,6 +688,7 @@ static void soft_fallback(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(light_sets_are_nets),
+      cmocka_unit_test(bvh2_leaves_by_sah),
       cmocka_unit_test(random_scenes),
       cmocka_unit_test(rays_frusta),
       cmocka_unit_test(builtin_scene),

@@ -1,13 +1,48 @@
 #include "bvh2.h"
+#include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "base/alloc.h"
 #include "base/error.h"
 
-typedef struct conv { const fr_build_tree *t; fr_bvh2 *b; uint32_t max_leaf; } conv;
+typedef struct conv { const fr_build_tree *t; fr_bvh2 *b; const uint8_t *leaf; } conv;
+
+/* Where a triangle tree's leaves are cut, by SAH: a node visit costs 1 per
+ * unit of its box's half area, a leaf LEAF_COST plus TRI_COST per
+ * triangle, and a subtree of at most max_leaf triangles becomes a leaf only
+ * where that costs no more than its nodes. Until session 50 every such
+ * subtree became a leaf: conference's room box (ceiling and one wall, four
+ * triangles in all) was then one leaf whose box held every hit point, and
+ * 12,793 of its 16,240 shadow batches at 512x512 fetched it. Interleaved,
+ * 2 threads, 1024x1024, mft, 3 pairs each: soft16 conference 1.129x,
+ * kitchen 1.084x (3/3 each), sibenik 1.011x, dragon 1.037x; primary
+ * conference 1.056x (3/3), sibenik 1.067x, kitchen 0.982x, dragon 1.049x;
+ * Whitted museum 1.073x, kitchen 1.024x (3/3 each), spd_rings 0.981x.
+ * TRI_COST 0.3 and 0.8 against 0.5, soft16: conference 1.014x and 0.978x,
+ * kitchen 0.953x and 0.950x, dragon 1.022x and 0.954x (3 pairs each; 1.5
+ * had cost dragon a quarter). TRI_COST 0 is the old rule. */
+#define LEAF_COST 1.0f
+#define TRI_COST 0.5f
+
+/* Marks leaf[bi] for the subtrees at bi that become leaves; returns the
+ * subtree's cost. by_sah 0: every subtree of at most max_leaf (the sphere
+ * tree, whose kernels were tuned on that). */
+static float plan_leaves(const fr_build_tree *t, int32_t bi, uint32_t max_leaf, int by_sah, uint8_t *leaf) {
+  const fr_build_node *n = &t->nodes[bi];
+  const float a = aabb_half_area(n->box);
+  const float as_leaf = n->count <= max_leaf ? (LEAF_COST + TRI_COST * (float)n->count) * a : INFINITY;
+  if (n->left < 0 || (!by_sah && n->count <= max_leaf)) {
+    leaf[bi] = 1;
+    return as_leaf;
+  }
+  const float split = a + plan_leaves(t, n->left, max_leaf, by_sah, leaf) + plan_leaves(t, n->right, max_leaf, by_sah, leaf);
+  leaf[bi] = as_leaf <= split;
+  return leaf[bi] ? as_leaf : split;
+}
 
 static uint32_t convert(conv *c, int32_t bi) {
   const fr_build_node *n = &c->t->nodes[bi];
-  if (n->count <= c->max_leaf) {
+  if (c->leaf[bi]) {
     c->b->nleaves++;
     return FR_BVH2_LEAF | (n->count << FR_BVH2_COUNT_SHIFT) | n->first;
   }
@@ -25,25 +60,32 @@ static uint32_t convert(conv *c, int32_t bi) {
   return self;
 }
 
-/* inner nodes of the tree at bi with leaves of up to max_leaf */
-static size_t count_inner(const fr_build_tree *t, int32_t bi, uint32_t max_leaf) {
+/* inner nodes of the tree at bi with the leaves marked in leaf */
+static size_t count_inner(const fr_build_tree *t, int32_t bi, const uint8_t *leaf) {
   const fr_build_node *n = &t->nodes[bi];
-  if (n->count <= max_leaf) return 0;
-  return 1 + count_inner(t, n->left, max_leaf) + count_inner(t, n->right, max_leaf);
+  if (leaf[bi]) return 0;
+  return 1 + count_inner(t, n->left, leaf) + count_inner(t, n->right, leaf);
 }
 
 /* out's nodes, root and bounds from the build tree; a leaf is a range of
  * the build's leaf order (out's prims and tris), whatever its size */
-static fr_error make_nodes(const fr_build_tree *t, int max_leaf, fr_bvh2 *out) {
-  size_t inner = count_inner(t, 0, (uint32_t)max_leaf);
+static fr_error make_nodes(const fr_build_tree *t, int max_leaf, int by_sah, fr_bvh2 *out) {
+  uint8_t *leaf = malloc(t->nnodes);
+  if (!leaf) return fr_fail(FR_ERR_NOMEM, "BVH2: out of memory");
+  plan_leaves(t, 0, (uint32_t)max_leaf, by_sah, leaf);
+  size_t inner = count_inner(t, 0, leaf);
   if (!inner) inner = 1; /* the root a leaf: no node is used, but keep an array */
   out->nodes = fr_alloc_aligned(fr_mul_size(inner, sizeof(fr_bvh2_node)), 64);
-  if (!out->nodes) return fr_fail(FR_ERR_NOMEM, "BVH2: out of memory");
+  if (!out->nodes) {
+    free(leaf);
+    return fr_fail(FR_ERR_NOMEM, "BVH2: out of memory");
+  }
   memset(out->nodes, 0, inner * sizeof(fr_bvh2_node));
   out->max_leaf = max_leaf;
   out->bounds = t->nodes[0].box;
-  conv c = {t, out, (uint32_t)max_leaf};
+  conv c = {t, out, leaf};
   out->root = convert(&c, 0);
+  free(leaf);
   return FR_OK;
 }
 
@@ -73,7 +115,7 @@ fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_le
     }
     r->pad = 0;
   }
-  fr_error e = make_nodes(t, max_leaf, out);
+  fr_error e = make_nodes(t, max_leaf, m != NULL, out);
   if (e) fr_bvh2_free(out);
   return e;
 }
@@ -85,7 +127,7 @@ fr_error fr_bvh2_shallow(const fr_build_tree *t, const fr_bvh2 *full, int max_le
   out->tris = full->tris;
   out->nprims = full->nprims;
   out->borrowed = 1;
-  fr_error e = make_nodes(t, max_leaf, out);
+  fr_error e = make_nodes(t, max_leaf, full->tris != NULL, out);
   if (e) fr_bvh2_free(out);
   return e;
 }

@@ -67,9 +67,10 @@ typedef struct fr_bvh2 {
   int borrowed;      /* prims and tris belong to another tree (fr_bvh2_shallow) */
 } fr_bvh2;
 
-/* Leaves are cut where a subtree has at most max_leaf triangles (4: the
- * regular tree; more: the shallow tree the frusta kernels may prefer).
- * Without a mesh (m NULL) only the nodes and prims are made. */
+/* Leaves hold at most max_leaf triangles (4: the regular tree; more: the
+ * shallow tree the frusta kernels may prefer), cut where the SAH says a
+ * subtree costs no more as a leaf (bvh2.c). Without a mesh (m NULL) only
+ * the nodes and prims are made, every subtree of at most max_leaf a leaf. */
 fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_leaf, fr_bvh2 *out);
 /* The tree of the same build with leaves of up to max_leaf triangles,
  * sharing full's prims and triangles (full, made from t, must outlive it):
