@@ -8,34 +8,42 @@
 typedef struct conv { const fr_build_tree *t; fr_bvh2 *b; const uint8_t *leaf; } conv;
 
 /* Where a triangle tree's leaves are cut, by SAH: a node visit costs 1 per
- * unit of its box's half area, a leaf LEAF_COST plus TRI_COST per
- * triangle, and a subtree of at most max_leaf triangles becomes a leaf only
- * where that costs no more than its nodes. Until session 50 every such
- * subtree became a leaf: conference's room box (ceiling and one wall, four
- * triangles in all) was then one leaf whose box held every hit point, and
- * 12,793 of its 16,240 shadow batches at 512x512 fetched it. Interleaved,
- * 2 threads, 1024x1024, mft, 3 pairs each: soft16 conference 1.129x,
- * kitchen 1.084x (3/3 each), sibenik 1.011x, dragon 1.037x; primary
- * conference 1.056x (3/3), sibenik 1.067x, kitchen 0.982x, dragon 1.049x;
- * Whitted museum 1.073x, kitchen 1.024x (3/3 each), spd_rings 0.981x.
- * TRI_COST 0.3 and 0.8 against 0.5, soft16: conference 1.014x and 0.978x,
- * kitchen 0.953x and 0.950x, dragon 1.022x and 0.954x (3 pairs each; 1.5
- * had cost dragon a quarter). TRI_COST 0 is the old rule. */
+ * unit of its box's half area, a leaf LEAF_COST plus a cost per triangle,
+ * and a subtree of at most max_leaf triangles becomes a leaf only where
+ * that costs no more than its nodes. Until session 50 every such subtree
+ * became a leaf (a cost of 0 per triangle): conference's room box (ceiling
+ * and one wall, four triangles) was then one leaf whose box held every hit
+ * point, and 12,793 of its 16,240 shadow batches at 512x512 fetched it.
+ *
+ * TRI_COST cuts the shadow frusta's tree. Against 0.3 and 0.8, soft16 mft
+ * (3 interleaved pairs each, both trees cut alike): conference 0.986x
+ * and 1.022x, kitchen 1.049x and 1.053x, dragon 0.978x and 1.048x; 1.5
+ * had cost dragon a quarter.
+ * SHALLOW_TRI_COST cuts the camera frusta's shallow tree (fr_bvh2_shallow),
+ * where a larger leaf pays; primary mft against 0.5: dragon 1.171x (3/3),
+ * conference 0.972x, kitchen 0.986x, sibenik 0.959x; 0 against 0.5: dragon
+ * 1.143x, conference 0.941x; 0.1 against 0.2: dragon 0.972x, conference
+ * 0.956x. Both against the old rule, mft, 2 threads, 1024x1024, 3 pairs
+ * each: soft16 conference 1.151x, kitchen 1.093x, sibenik 1.015x (3/3
+ * each), dragon 0.983x; primary sibenik 1.047x (3/3), conference 1.011x,
+ * kitchen 1.013x, dragon 0.978x; Whitted kitchen 1.052x (3/3), museum
+ * 1.049x, spd_rings 0.980x (bench/results/session50-bvh2-sah-leaves.txt). */
 #define LEAF_COST 1.0f
 #define TRI_COST 0.5f
+#define SHALLOW_TRI_COST 0.2f
 
 /* Marks leaf[bi] for the subtrees at bi that become leaves; returns the
  * subtree's cost. by_sah 0: every subtree of at most max_leaf (the sphere
  * tree, whose kernels were tuned on that). */
-static float plan_leaves(const fr_build_tree *t, int32_t bi, uint32_t max_leaf, int by_sah, uint8_t *leaf) {
+static float plan_leaves(const fr_build_tree *t, int32_t bi, uint32_t max_leaf, float tri_cost, int by_sah, uint8_t *leaf) {
   const fr_build_node *n = &t->nodes[bi];
   const float a = aabb_half_area(n->box);
-  const float as_leaf = n->count <= max_leaf ? (LEAF_COST + TRI_COST * (float)n->count) * a : INFINITY;
+  const float as_leaf = n->count <= max_leaf ? (LEAF_COST + tri_cost * (float)n->count) * a : INFINITY;
   if (n->left < 0 || (!by_sah && n->count <= max_leaf)) {
     leaf[bi] = 1;
     return as_leaf;
   }
-  const float split = a + plan_leaves(t, n->left, max_leaf, by_sah, leaf) + plan_leaves(t, n->right, max_leaf, by_sah, leaf);
+  const float split = a + plan_leaves(t, n->left, max_leaf, tri_cost, by_sah, leaf) + plan_leaves(t, n->right, max_leaf, tri_cost, by_sah, leaf);
   leaf[bi] = as_leaf <= split;
   return leaf[bi] ? as_leaf : split;
 }
@@ -69,10 +77,10 @@ static size_t count_inner(const fr_build_tree *t, int32_t bi, const uint8_t *lea
 
 /* out's nodes, root and bounds from the build tree; a leaf is a range of
  * the build's leaf order (out's prims and tris), whatever its size */
-static fr_error make_nodes(const fr_build_tree *t, int max_leaf, int by_sah, fr_bvh2 *out) {
+static fr_error make_nodes(const fr_build_tree *t, int max_leaf, float tri_cost, int by_sah, fr_bvh2 *out) {
   uint8_t *leaf = malloc(t->nnodes);
   if (!leaf) return fr_fail(FR_ERR_NOMEM, "BVH2: out of memory");
-  plan_leaves(t, 0, (uint32_t)max_leaf, by_sah, leaf);
+  plan_leaves(t, 0, (uint32_t)max_leaf, tri_cost, by_sah, leaf);
   size_t inner = count_inner(t, 0, leaf);
   if (!inner) inner = 1; /* the root a leaf: no node is used, but keep an array */
   out->nodes = fr_alloc_aligned(fr_mul_size(inner, sizeof(fr_bvh2_node)), 64);
@@ -115,7 +123,7 @@ fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_le
     }
     r->pad = 0;
   }
-  fr_error e = make_nodes(t, max_leaf, m != NULL, out);
+  fr_error e = make_nodes(t, max_leaf, TRI_COST, m != NULL, out);
   if (e) fr_bvh2_free(out);
   return e;
 }
@@ -127,7 +135,7 @@ fr_error fr_bvh2_shallow(const fr_build_tree *t, const fr_bvh2 *full, int max_le
   out->tris = full->tris;
   out->nprims = full->nprims;
   out->borrowed = 1;
-  fr_error e = make_nodes(t, max_leaf, full->tris != NULL, out);
+  fr_error e = make_nodes(t, max_leaf, SHALLOW_TRI_COST, full->tris != NULL, out);
   if (e) fr_bvh2_free(out);
   return e;
 }
