@@ -44,7 +44,8 @@ static float plan_leaves(const fr_build_tree *t, int32_t bi, uint32_t max_leaf, 
     return as_leaf;
   }
   const float split = a + plan_leaves(t, n->left, max_leaf, tri_cost, by_sah, leaf) + plan_leaves(t, n->right, max_leaf, tri_cost, by_sah, leaf);
-  leaf[bi] = as_leaf <= split;
+  /* the count too: with boxes too large for a float area both are inf */
+  leaf[bi] = n->count <= max_leaf && as_leaf <= split;
   return leaf[bi] ? as_leaf : split;
 }
 
