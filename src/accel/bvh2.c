@@ -33,17 +33,18 @@ typedef struct conv { const fr_build_tree *t; fr_bvh2 *b; const uint8_t *leaf; }
 #define SHALLOW_TRI_COST 0.2f
 
 /* Marks leaf[bi] for the subtrees at bi that become leaves; returns the
- * subtree's cost. by_sah 0: every subtree of at most max_leaf (the sphere
- * tree, whose kernels were tuned on that). */
-static float plan_leaves(const fr_build_tree *t, int32_t bi, uint32_t max_leaf, float tri_cost, int by_sah, uint8_t *leaf) {
+ * subtree's cost. A tri_cost of 0 makes every subtree of at most max_leaf
+ * a leaf (its nodes cost at least its own visit): the sphere tree's rule,
+ * whose kernels were tuned on it. */
+static float plan_leaves(const fr_build_tree *t, int32_t bi, uint32_t max_leaf, float tri_cost, uint8_t *leaf) {
   const fr_build_node *n = &t->nodes[bi];
   const float a = aabb_half_area(n->box);
   const float as_leaf = n->count <= max_leaf ? (LEAF_COST + tri_cost * (float)n->count) * a : INFINITY;
-  if (n->left < 0 || (!by_sah && n->count <= max_leaf)) {
+  if (n->left < 0) {
     leaf[bi] = 1;
     return as_leaf;
   }
-  const float split = a + plan_leaves(t, n->left, max_leaf, tri_cost, by_sah, leaf) + plan_leaves(t, n->right, max_leaf, tri_cost, by_sah, leaf);
+  const float split = a + plan_leaves(t, n->left, max_leaf, tri_cost, leaf) + plan_leaves(t, n->right, max_leaf, tri_cost, leaf);
   /* the count too: with boxes too large for a float area both are inf */
   leaf[bi] = n->count <= max_leaf && as_leaf <= split;
   return leaf[bi] ? as_leaf : split;
@@ -78,10 +79,10 @@ static size_t count_inner(const fr_build_tree *t, int32_t bi, const uint8_t *lea
 
 /* out's nodes, root and bounds from the build tree; a leaf is a range of
  * the build's leaf order (out's prims and tris), whatever its size */
-static fr_error make_nodes(const fr_build_tree *t, int max_leaf, float tri_cost, int by_sah, fr_bvh2 *out) {
+static fr_error make_nodes(const fr_build_tree *t, int max_leaf, float tri_cost, fr_bvh2 *out) {
   uint8_t *leaf = malloc(t->nnodes);
   if (!leaf) return fr_fail(FR_ERR_NOMEM, "BVH2: out of memory");
-  plan_leaves(t, 0, (uint32_t)max_leaf, tri_cost, by_sah, leaf);
+  plan_leaves(t, 0, (uint32_t)max_leaf, tri_cost, leaf);
   size_t inner = count_inner(t, 0, leaf);
   if (!inner) inner = 1; /* the root a leaf: no node is used, but keep an array */
   out->nodes = fr_alloc_aligned(fr_mul_size(inner, sizeof(fr_bvh2_node)), 64);
@@ -124,7 +125,7 @@ fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_le
     }
     r->pad = 0;
   }
-  fr_error e = make_nodes(t, max_leaf, TRI_COST, m != NULL, out);
+  fr_error e = make_nodes(t, max_leaf, m ? TRI_COST : 0.0f, out);
   if (e) fr_bvh2_free(out);
   return e;
 }
@@ -136,7 +137,7 @@ fr_error fr_bvh2_shallow(const fr_build_tree *t, const fr_bvh2 *full, int max_le
   out->tris = full->tris;
   out->nprims = full->nprims;
   out->borrowed = 1;
-  fr_error e = make_nodes(t, max_leaf, SHALLOW_TRI_COST, full->tris != NULL, out);
+  fr_error e = make_nodes(t, max_leaf, full->tris ? SHALLOW_TRI_COST : 0.0f, out);
   if (e) fr_bvh2_free(out);
   return e;
 }
