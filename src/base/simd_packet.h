@@ -367,15 +367,22 @@ FR_INLINE void vp_store_records4(float *dst, const vpf f[4]) {
   }
 }
 FR_INLINE void vp_store_records(float *dst, const vpf *f, int nf) {
-  const __m256i seven = _mm256_setr_epi32(-1, -1, -1, -1, -1, -1, -1, 0);
   for (int h = 0; h < P / 8; h++) {
     __m256 r[8];
     for (int k = 0; k < 8; k++) r[k] = k < nf ? fr_vp_half(f[k], h) : _mm256_setzero_ps();
     fr_transpose8(r);
+    /* Records shorter than 8 are written 8 floats at a time in order, each
+     * spilling into the next record, which overwrites it; only the last one
+     * is masked. VEX masked stores are slow on AMD (vmaskmovps took half of
+     * dragon's primary-ray expand step), EVEX ones are not. */
     for (int i = 0; i < 8; i++) {
       float *rec = dst + nf * (8 * h + i);
-      if (nf == 8) _mm256_storeu_ps(rec, r[i]);
-      else _mm256_maskstore_ps(rec, seven, r[i]);
+      if (nf == 8 || 8 * h + i < P - 1) _mm256_storeu_ps(rec, r[i]);
+#if defined(FR_BUILD_ISA_AVX512)
+      else _mm256_mask_storeu_ps(rec, (__mmask8)((1u << nf) - 1u), r[i]);
+#else
+      else _mm256_maskstore_ps(rec, _mm256_cmpgt_epi32(_mm256_set1_epi32(nf), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)), r[i]);
+#endif
     }
   }
 }
