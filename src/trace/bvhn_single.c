@@ -9,21 +9,19 @@
 #include "trace/bvhn_single.h"
 #include "trace/kernels.h"
 
+static __attribute__((noinline)) int intersect_subtree(const fr_bvhn *b, uint32_t ref, const fr_ray *ray, fr_subtree_hit *best) {
+  ray_pre r;
+  ray_setup(&r, ray);
+  return closest(b, &r, ref, ray->tfar, best);
+}
+
 static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
   fr_hit_miss(hit);
   FR_COUNT(rays, 1);
   if (fr_ray_invalid(ray)) return;
-  ray_pre r;
-  ray_setup(&r, ray);
   fr_subtree_hit best = {0.0f, 0.0f, 0.0f, 0};
-  if (closest(b, &r, b->root, ray->tfar, &best))
+  if (intersect_subtree(b, b->root, ray, &best))
     fr_hit_finish(b, &best, v3_load(ray->org), v3_load(ray->dir), ray->tnear, ray->tfar, hit);
-}
-
-static int intersect_subtree(const fr_bvhn *b, uint32_t ref, const fr_ray *ray, fr_subtree_hit *best) {
-  ray_pre r;
-  ray_setup(&r, ray);
-  return closest(b, &r, ref, ray->tfar, best);
 }
 
 static int occluded1(const fr_bvhn *b, const fr_ray *ray) {
