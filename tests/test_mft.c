@@ -171,6 +171,31 @@ static void check_expand(const fr_mft_fns *fns, const fr_mft_batch *b, const fr_
     }
 }
 
+/* Camera frusta share one origin, and the kernel then makes a leaf's cross
+ * products once for all of them (leaf_edges_shared); moving one frustum's
+ * origin away sends the batch down the per-frustum path instead. The moved
+ * frustum reaches no box (tfar tiny), so the traversal is the same, and
+ * every other frustum must get the same answers bit for bit. */
+static void check_shared_origin(const fr_scene *s, const fr_mft_fns *fns, const fr_mft_opts *o, const fr_mft_batch *b,
+                                const fr_mft_sets *T, const fr_mft_hits *h) {
+  static fr_mft_hits g;
+  fr_mft_batch moved = *b;
+  const int f = 31 - __builtin_clz(b->valid | 1u);
+  for (int a = 0; a < 3; a++) moved.org[a][f] = b->org[a][f] + 1e3f * (1.0f + fabsf(b->org[a][f]));
+  moved.tnear[f] = 0.0f;
+  moved.tfar[f] = 1e-6f;
+  memset(&g, 0xAB, sizeof g);
+  fns->intersect(&s->bvh2_mft, o, &moved, T, &g);
+  for (int e = 0; e < 16; e++) {
+    if (e == f) continue;
+    assert_memory_equal(g.t[e], h->t[e], sizeof g.t[e]);
+    assert_memory_equal(g.u[e], h->u[e], sizeof g.u[e]);
+    assert_memory_equal(g.v[e], h->v[e], sizeof g.v[e]);
+    assert_memory_equal(g.prim[e], h->prim[e], sizeof g.prim[e]);
+  }
+  for (int k = 0; k < 16; k++) assert_int_equal(g.prim[f][k], FR_INVALID_ID);
+}
+
 static void check_camera(const fr_scene *s, const fr_camera *cam, int x0, int y0, tally *tl) {
   mesh_ref m = scene_mesh(s);
   fr_mft_sets T;
@@ -186,6 +211,7 @@ static void check_camera(const fr_scene *s, const fr_camera *cam, int x0, int y0
       memset(&h, 0xAB, sizeof h);
       isa_fns[i]->intersect(&s->bvh2_mft, &o, &b, &T, &h);
       check_expand(isa_fns[i], &b, &T, &h);
+      check_shared_origin(s, isa_fns[i], &o, &b, &T, &h);
       if (!first) {
         assert_memory_equal(&h, &ref, sizeof h);
         continue;

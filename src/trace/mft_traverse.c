@@ -24,6 +24,7 @@
  * smaller vertex, accurate for tiny far triangles and watertight.
  */
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 #include "base/simd.h"
 #include "base/simd_packet.h"
@@ -76,6 +77,11 @@ typedef struct frusta {
   float rd[16][3][16] __attribute__((aligned(64)));
   unsigned rd_ready;
   unsigned cull_seen, cull_gone; /* frustum-triangle pairs the corner-ray cull saw and removed */
+  /* whether every valid frustum starts at origin[] (a pinhole camera's): a
+   * leaf's cross products are then the same for all frusta
+   * (leaf_edges_shared) */
+  int shared_origin;
+  float origin[3];
   const fr_mft_set *set[16];
 } frusta;
 
@@ -165,6 +171,15 @@ static void frusta_setup(frusta *F, const fr_mft_batch *B, const fr_mft_sets *T,
     F->tfar[f] = lane_valid ? B->tfar[f] : 0.0f;
     F->set[f] = &T->set[lane_valid ? B->set[f] % FR_MFT_SETS : 0];
   }
+  /* invalid lanes start at 0 but are never tested: only the valid agree,
+   * bit for bit (-0 and 0 would round some zero products differently) */
+  const int f0 = valid ? __builtin_ctz(valid) : 0;
+  F->shared_origin = 1;
+  for (int a = 0; a < 3; a++) {
+    F->origin[a] = F->o[a][f0];
+    for (int f = 0; f < 16; f++)
+      F->shared_origin &= !((valid >> f) & 1) || !memcmp(&F->o[a][f], &F->origin[a], sizeof(float));
+  }
   ray_box R;
   for (int f = 0; f < 16; f++) ray_box_of(F, f, 0xFFFFu, &R, 1);
   frusta_bounds(F, T, 0xFFFFu, &R, 1);
@@ -212,18 +227,13 @@ typedef struct tri_frusta {
   float det[16] __attribute__((aligned(64)));
   float n[3]; /* the triangle's normal (fr_bvh2_tri_normal) */
 } tri_frusta;
+/* ray_hits reads a lane's edges and det from one pointer: e + 16 (3 i + a), det at e + 16 * 9 */
+_Static_assert(offsetof(tri_frusta, det) == 9 * 16 * sizeof(float), "det follows the edges");
 
-/* The frusta of m that may hit triangle r; fills X. */
-FR_INLINE unsigned tri_cull(const frusta *F, const fr_bvh2_tri *r, unsigned m, int corner_rays, tri_frusta *X) {
-  vpf o[3] = {vp_load(F->o[0]), vp_load(F->o[1]), vp_load(F->o[2])};
-  vpf E[3][3], det;
-  fr_bvh2_tri_normal(r, X->n);
-  fr_tri_edges16(r, X->n, o, E, &det);
-  for (int i = 0; i < 3; i++)
-    for (int a = 0; a < 3; a++) vp_store(X->e[i][a], E[i][a]);
-  vpf nx = vp(X->n[0]), ny = vp(X->n[1]), nz = vp(X->n[2]);
-  vp_store(X->det, det);
-  if (!corner_rays) return m;
+/* The corner-ray cull: the frusta of m that may hit the triangle of edges E,
+ * det and normal n (lane f seen from frustum f's origin). */
+FR_INLINE unsigned corner_cull(const frusta *F, const vpf E[3][3], vpf det, const float n[3], unsigned m) {
+  vpf nx = vp(n[0]), ny = vp(n[1]), nz = vp(n[2]);
   vpf sg = vp_and(det, vp(-0.0f)), zero = vp(0.0f), guard = vp_load(F->guard);
   unsigned cull = 0;
   for (int i = 0; i < 3; i++) {
@@ -241,28 +251,115 @@ FR_INLINE unsigned tri_cull(const frusta *F, const fr_bvh2_tri *r, unsigned m, i
     vpf g = dot3_bound(vp_load(F->corner[j][0]), vp_load(F->corner[j][1]), vp_load(F->corner[j][2]), nx, ny, nz);
     gmax = vp_max(gmax, vp_xor(g, sg));
   }
-  gmax = vp_add(gmax, vp_mul(guard, vp(fabsf(X->n[0]) + fabsf(X->n[1]) + fabsf(X->n[2]))));
+  gmax = vp_add(gmax, vp_mul(guard, vp(fabsf(n[0]) + fabsf(n[1]) + fabsf(n[2]))));
   cull |= vpm_bits(vp_le(gmax, zero));
   cull |= vpm_bits(vp_lt(vp_mul(gmax, vp_load(F->tfar)), vp_mul(vp_abs(det), vp(1.0f - 0x1p-18f))));
   return m & ~cull;
 }
 
-/* tri_cull for a leaf's triangle, counted (the paper's Table 1) */
-FR_INLINE unsigned leaf_tri_cull(frusta *F, const fr_bvh2_tri *r, unsigned m, const fr_mft_opts *opt,
-                                  tri_frusta *X) {
+/* The frusta of m that may hit triangle r (all of m without corner_rays);
+ * fills X. */
+FR_INLINE unsigned tri_cull(const frusta *F, const fr_bvh2_tri *r, unsigned m, int corner_rays, tri_frusta *X) {
+  vpf o[3] = {vp_load(F->o[0]), vp_load(F->o[1]), vp_load(F->o[2])};
+  vpf E[3][3], det;
+  fr_bvh2_tri_normal(r, X->n);
+  fr_tri_edges16(r, X->n, o, E, &det);
+  for (int i = 0; i < 3; i++)
+    for (int a = 0; a < 3; a++) vp_store(X->e[i][a], E[i][a]);
+  vp_store(X->det, det);
+  return corner_rays ? corner_cull(F, E, det, X->n, m) : m;
+}
+
+/* Whether the corner-ray cull runs for a triangle met by n frusta: where
+ * the share of frusta it removed so far in this batch, times n, exceeds
+ * its cost in 16-ray tests. */
+FR_INLINE int cull_pays(const frusta *F, const fr_mft_opts *opt, int n) {
+  return opt->corner_rays && (float)F->cull_gone * (float)n >= opt->corner_cost * (float)F->cull_seen;
+}
+
+/* The cull's bookkeeping: what it saw and removed, and the paper's Table 1. */
+FR_INLINE unsigned cull_counted(frusta *F, int culled, unsigned m, unsigned left) {
   const int n = __builtin_popcount(m);
   FR_COUNT(mft_tris, 1);
   FR_COUNT(mft_tri_frusta, n);
-  /* cull where the share of frusta it removed so far in this batch, times
-   * the n frusta here, exceeds its cost in 16-ray tests */
-  int cull = opt->corner_rays && (float)F->cull_gone * (float)n >= opt->corner_cost * (float)F->cull_seen;
-  unsigned left = tri_cull(F, r, m, cull, X);
-  if (cull) {
+  if (culled) {
     F->cull_seen += (unsigned)n;
     F->cull_gone += (unsigned)(n - __builtin_popcount(left));
   }
   FR_COUNT(mft_tri_left, __builtin_popcount(left));
   return left;
+}
+
+/* tri_cull for a leaf's triangle, where it pays */
+FR_INLINE unsigned leaf_tri_cull(frusta *F, const fr_bvh2_tri *r, unsigned m, const fr_mft_opts *opt,
+                                  tri_frusta *X) {
+  const int cull = cull_pays(F, opt, __builtin_popcount(m));
+  return cull_counted(F, cull, m, tri_cull(F, r, m, cull, X));
+}
+
+/* A leaf's triangles seen from the frusta's shared origin: lane k of L
+ * holds triangle k's cross products and det (fr_tri_edges16's operations
+ * on the same values, so the same bits it gives every frustum) and nrm its
+ * normal (fr_bvh2_tri_normal's). One pass for the whole leaf instead of one
+ * per triangle, each computing the same value in all 16 lanes. */
+typedef struct leaf_edges {
+  tri_frusta t; /* e[i][a][k], det[k] */
+  float nrm[3][16] __attribute__((aligned(64)));
+} leaf_edges;
+
+FR_INLINE void leaf_edges_shared(const frusta *F, const fr_bvh2_tri *r, uint32_t count, leaf_edges *L) {
+  float v[9][16] __attribute__((aligned(64)));
+  unsigned flip[3] = {0, 0, 0};
+  for (uint32_t k = 0; k < 16; k++) { /* lanes past count repeat the last triangle */
+    const fr_bvh2_tri *q = &r[k < count ? k : count - 1];
+    for (int a = 0; a < 3; a++) { v[a][k] = q->v0[a]; v[3 + a][k] = q->v1[a]; v[6 + a][k] = q->v2[a]; }
+    for (int i = 0; i < 3; i++) flip[i] |= ((q->edge_flip >> i) & 1u) << k;
+  }
+  vpf V0[3], V1[3], V2[3], A[3], B[3], C[3], n[3];
+  for (int a = 0; a < 3; a++) {
+    V0[a] = vp_load(v[a]); V1[a] = vp_load(v[3 + a]); V2[a] = vp_load(v[6 + a]);
+    const vpf o = vp(F->origin[a]);
+    A[a] = vp_sub(V0[a], o); B[a] = vp_sub(V1[a], o); C[a] = vp_sub(V2[a], o);
+  }
+  { /* v3_cross(v1 - v0, v2 - v0) */
+    vpf e1[3], e2[3];
+    for (int a = 0; a < 3; a++) { e1[a] = vp_sub(V1[a], V0[a]); e2[a] = vp_sub(V2[a], V0[a]); }
+    n[0] = vp_sub(vp_mul(e1[1], e2[2]), vp_mul(e1[2], e2[1]));
+    n[1] = vp_sub(vp_mul(e1[2], e2[0]), vp_mul(e1[0], e2[2]));
+    n[2] = vp_sub(vp_mul(e1[0], e2[1]), vp_mul(e1[1], e2[0]));
+  }
+  for (int a = 0; a < 3; a++) vp_store(L->nrm[a], n[a]);
+  vp_store(L->t.det, fr_dot3v(A[0], A[1], A[2], n[0], n[1], n[2]));
+  const vpf *ends[3][2] = {{V1, V2}, {V2, V0}, {V0, V1}};
+  const vpf *from[3][2] = {{B, C}, {C, A}, {A, B}};
+  for (int i = 0; i < 3; i++) {
+    const vpm fl = vpm_bits_to(flip[i]);
+    vpf p[3], d[3], po[3];
+    for (int a = 0; a < 3; a++) {
+      p[a] = vp_select(fl, ends[i][1][a], ends[i][0][a]);
+      d[a] = vp_sub(vp_select(fl, ends[i][0][a], ends[i][1][a]), p[a]);
+      po[a] = vp_select(fl, from[i][1][a], from[i][0][a]);
+    }
+    const vpf sg = vp_select(fl, vp(-0.0f), vp(0.0f));
+    vp_store(L->t.e[i][0], vp_xor(vp_sub(vp_mul(po[1], d[2]), vp_mul(po[2], d[1])), sg));
+    vp_store(L->t.e[i][1], vp_xor(vp_sub(vp_mul(po[2], d[0]), vp_mul(po[0], d[2])), sg));
+    vp_store(L->t.e[i][2], vp_xor(vp_sub(vp_mul(po[0], d[1]), vp_mul(po[1], d[0])), sg));
+  }
+}
+
+/* leaf_tri_cull for triangle k of a leaf_edges_shared leaf; n gets its normal */
+FR_INLINE unsigned leaf_tri_cull_shared(frusta *F, const leaf_edges *L, uint32_t k, unsigned m,
+                                         const fr_mft_opts *opt, float n[3]) {
+  for (int a = 0; a < 3; a++) n[a] = L->nrm[a][k];
+  const int cull = cull_pays(F, opt, __builtin_popcount(m));
+  unsigned left = m;
+  if (cull) {
+    vpf E[3][3];
+    for (int i = 0; i < 3; i++)
+      for (int a = 0; a < 3; a++) E[i][a] = vp(L->t.e[i][a][k]);
+    left = corner_cull(F, E, vp(L->t.det[k]), n, m);
+  }
+  return cull_counted(F, cull, m, left);
 }
 
 /* Frustum f's 16 ray directions, made from its start vector and deltas. */
@@ -274,21 +371,22 @@ FR_INLINE frustum_dirs dirs_of(const frusta *F, int f) {
   return d;
 }
 
-/* Frustum f's 16 rays (directions D) against the triangle of X: the rays
- * of `rays` that hit it in (tnear, tcur), *t their distances and w the edge
- * values. No branches: where a triangle covers a few of a frustum's rays,
+/* Frustum f's 16 rays (directions D) against a triangle, its edges and det
+ * as seen from f's origin at e (a lane of a tri_frusta) and its normal n:
+ * the rays of `rays` that hit it in (tnear, tcur), *t their distances and w
+ * the edge values. No branches: where a triangle covers a few of a frustum's rays,
  * whether any of them hits is a coin toss, and early exits after the edge
  * test mispredicted on about half the tests (primary mft 1.27x on
  * conference, kitchen and sibenik, 1.10x on dragon without them). */
-FR_INLINE unsigned ray_hits(const frusta *F, const frustum_dirs *D, const tri_frusta *X, int f, vpf tcur, unsigned rays,
-                            vpf w[3], vpf *t) {
+FR_INLINE unsigned ray_hits(const frusta *F, const frustum_dirs *D, const float *e, const float n[3], int f, vpf tcur,
+                            unsigned rays, vpf w[3], vpf *t) {
   const vpf dx = D->x, dy = D->y, dz = D->z;
   vpf E[3][3];
   for (int i = 0; i < 3; i++)
-    for (int a = 0; a < 3; a++) E[i][a] = vp(X->e[i][a][f]);
-  const vpf det = vp(X->det[f]);
+    for (int a = 0; a < 3; a++) E[i][a] = vp(e[16 * (3 * i + a)]);
+  const vpf det = vp(e[16 * 9]);
   unsigned m = fr_tri_edges16_inside(dx, dy, dz, E, det, rays, w);
-  *t = vp_div(det, dot3(dx, dy, dz, vp(X->n[0]), vp(X->n[1]), vp(X->n[2])));
+  *t = vp_div(det, dot3(dx, dy, dz, vp(n[0]), vp(n[1]), vp(n[2])));
   return m & vpm_bits(vpm_and(vp_gt(*t, vp(F->tnear[f])), vp_lt(*t, tcur)));
 }
 
@@ -297,10 +395,10 @@ typedef struct frustum_hits { vpf t, u, v, prim; } frustum_hits;
 
 /* ray_hits for closest hits: the rays hit take the triangle's t, u, v and
  * id in h. */
-FR_INLINE unsigned ray_test_closest(const frusta *F, const frustum_dirs *D, const tri_frusta *X, const fr_bvh2_tri *r,
-                                    int f, unsigned rays, frustum_hits *h) {
+FR_INLINE unsigned ray_test_closest(const frusta *F, const frustum_dirs *D, const float *e, const float n[3],
+                                    const fr_bvh2_tri *r, int f, unsigned rays, frustum_hits *h) {
   vpf w[3], t;
-  const unsigned m = ray_hits(F, D, X, f, h->t, rays, w, &t);
+  const unsigned m = ray_hits(F, D, e, n, f, h->t, rays, w, &t);
   const vpf inv = vp_div(vp(1.0f), vp_add(vp_add(w[0], w[1]), w[2]));
   const vpm hm = vpm_bits_to(m);
   h->t = vp_select(hm, t, h->t);
@@ -419,7 +517,7 @@ FR_INLINE unsigned occlude_leaf(frusta *F, const fr_bvh2 *b, const fr_mft_opts *
     /* no branch on the hits, for the same reason as ray_hits */
     for (uint32_t k = 0; k < count; k++) {
       vpf w[3], t;
-      const unsigned hit = (left[k] >> f) & 1 ? ray_hits(F, &D, &X[k], f, tf, live, w, &t) : 0u;
+      const unsigned hit = (left[k] >> f) & 1 ? ray_hits(F, &D, &X[k].e[0][0][f], X[k].n, f, tf, live, w, &t) : 0u;
       hits |= hit;
       live &= ~hit;
     }
@@ -541,6 +639,8 @@ static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr
                               fr_mft_hits *H) {
   frusta F;
   tri_frusta X[FR_BVH2_MAX_LEAF]; /* a leaf's triangles' edges for all frusta */
+  leaf_edges L;                   /* ... or for the shared origin */
+  float nk[FR_BVH2_MAX_LEAF][3];
   unsigned valid = B->valid & 0xFFFFu;
   /* t starts at tfar: a hit must come nearer (reset to +inf for misses at the end) */
   for (int f = 0; f < 16; f++)
@@ -576,7 +676,24 @@ static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr
        * hit): a frustum's directions and nearest hits stay in registers
        * across the leaf instead of being made and reloaded per test. */
       unsigned left[FR_BVH2_MAX_LEAF], any = 0;
-      for (uint32_t k = 0; k < count; k++) any |= left[k] = leaf_tri_cull(&F, &b->tris[first + k], m, opt, &X[k]);
+      const float *edges[FR_BVH2_MAX_LEAF], *nrm[FR_BVH2_MAX_LEAF];
+      int step; /* from frustum f's edges to frustum f + 1's: the same (shared origin) or the next lane */
+      if (F.shared_origin) {
+        leaf_edges_shared(&F, &b->tris[first], count, &L);
+        for (uint32_t k = 0; k < count; k++) {
+          any |= left[k] = leaf_tri_cull_shared(&F, &L, k, m, opt, nk[k]);
+          edges[k] = &L.t.e[0][0][k];
+          nrm[k] = nk[k];
+        }
+        step = 0;
+      } else {
+        for (uint32_t k = 0; k < count; k++) {
+          any |= left[k] = leaf_tri_cull(&F, &b->tris[first + k], m, opt, &X[k]);
+          edges[k] = &X[k].e[0][0][0];
+          nrm[k] = X[k].n;
+        }
+        step = 1;
+      }
       for (; any; any &= any - 1) {
         const int f = __builtin_ctz(any);
         const frustum_dirs D = dirs_of(&F, f);
@@ -585,7 +702,8 @@ static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr
         frustum_hits h = {vp_load(H->t[f]), vp_load(H->u[f]), vp_load(H->v[f]), vp_load(ids.f)};
         unsigned hits = 0;
         for (uint32_t k = 0; k < count; k++)
-          if ((left[k] >> f) & 1) hits |= ray_test_closest(&F, &D, &X[k], &b->tris[first + k], f, rays[f], &h);
+          if ((left[k] >> f) & 1)
+            hits |= ray_test_closest(&F, &D, edges[k] + step * f, nrm[k], &b->tris[first + k], f, rays[f], &h);
         if (hits) {
           vp_store(H->t[f], h.t);
           vp_store(H->u[f], h.u);
