@@ -266,6 +266,10 @@ FR_INLINE void vp_load_records8_at(const float *src, size_t stride, vpf f[8]) {
   for (int i = 0; i < P; i++)
     for (int k = 0; k < 8; k++) memcpy(&f[k].f[i], src + stride * (size_t)i + k, sizeof(float));
 }
+FR_INLINE void vp_load_records8_rows(const float *src, size_t stride, int n, vpf f[8]) {
+  for (int i = 0; i < P; i++)
+    for (int k = 0; k < 8; k++) memcpy(&f[k].f[i], src + stride * (size_t)(i < n ? i : n - 1) + k, sizeof(float));
+}
 FR_INLINE void vp_load_records4(const float *src, vpf f[4]) {
   for (int i = 0; i < P; i++)
     for (int k = 0; k < 4; k++) memcpy(&f[k].f[i], src + 4 * i + k, sizeof(float));
@@ -323,6 +327,23 @@ FR_INLINE void vp_load_records8_at(const float *src, size_t stride, vpf f[8]) {
   for (int h = 0; h < P / 8; h++) {
     __m256 row[8];
     for (int i = 0; i < 8; i++) row[i] = _mm256_loadu_ps(src + stride * (size_t)(8 * h + i));
+    fr_transpose8(row);
+    for (int k = 0; k < 8; k++) r[k][h] = row[k];
+  }
+  for (int k = 0; k < 8; k++) f[k] = fr_vp_from_halves(r[k]);
+}
+/* The same for records 0..n-1 only, 1 <= n <= P: lanes past n repeat
+ * record n - 1, so nothing after the n records is read (and with n <= 8
+ * only one half is loaded and transposed). */
+FR_INLINE void vp_load_records8_rows(const float *src, size_t stride, int n, vpf f[8]) {
+  __m256 r[8][P / 8];
+  for (int h = 0; h < P / 8; h++) {
+    __m256 row[8];
+    if (h && n <= 8) {
+      for (int k = 0; k < 8; k++) r[k][h] = r[k][0];
+      continue;
+    }
+    for (int i = 0; i < 8; i++) row[i] = _mm256_loadu_ps(src + stride * (size_t)(8 * h + i < n ? 8 * h + i : n - 1));
     fr_transpose8(row);
     for (int k = 0; k < 8; k++) r[k][h] = row[k];
   }

@@ -308,16 +308,19 @@ typedef struct leaf_edges {
 } leaf_edges;
 
 FR_INLINE void leaf_edges_shared(const frusta *F, const fr_bvh2_tri *r, uint32_t count, leaf_edges *L) {
-  float v[9][16] __attribute__((aligned(64)));
+  /* fields 0-7 and 4-11 of the 12-float records (lanes past count repeat
+   * the last triangle): v0, v1, v2 */
+  _Static_assert(sizeof(fr_bvh2_tri) == 12 * sizeof(float) && offsetof(fr_bvh2_tri, v2) == 6 * sizeof(float),
+                 "records of 12 floats, vertices first");
+  vpf lo[8], hi[8];
+  vp_load_records8_rows((const float *)r, 12, (int)count, lo);
+  vp_load_records8_rows((const float *)r + 4, 12, (int)count, hi);
   unsigned flip[3] = {0, 0, 0};
-  for (uint32_t k = 0; k < 16; k++) { /* lanes past count repeat the last triangle */
-    const fr_bvh2_tri *q = &r[k < count ? k : count - 1];
-    for (int a = 0; a < 3; a++) { v[a][k] = q->v0[a]; v[3 + a][k] = q->v1[a]; v[6 + a][k] = q->v2[a]; }
-    for (int i = 0; i < 3; i++) flip[i] |= ((q->edge_flip >> i) & 1u) << k;
-  }
-  vpf V0[3], V1[3], V2[3], A[3], B[3], C[3], n[3];
+  for (uint32_t k = 0; k < count; k++)
+    for (int i = 0; i < 3; i++) flip[i] |= ((r[k].edge_flip >> i) & 1u) << k;
+  vpf V0[3] = {lo[0], lo[1], lo[2]}, V1[3] = {lo[3], lo[4], lo[5]}, V2[3] = {lo[6], lo[7], hi[4]};
+  vpf A[3], B[3], C[3], n[3];
   for (int a = 0; a < 3; a++) {
-    V0[a] = vp_load(v[a]); V1[a] = vp_load(v[3 + a]); V2[a] = vp_load(v[6 + a]);
     const vpf o = vp(F->origin[a]);
     A[a] = vp_sub(V0[a], o); B[a] = vp_sub(V1[a], o); C[a] = vp_sub(V2[a], o);
   }
