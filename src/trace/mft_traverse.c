@@ -393,20 +393,24 @@ FR_INLINE unsigned ray_hits(const frusta *F, const frustum_dirs *D, const float 
   return m & vpm_bits(vpm_and(vp_gt(*t, vp(F->tnear[f])), vp_lt(*t, tcur)));
 }
 
-/* A closest-hit frustum's answers in registers (prim as float bit patterns). */
-typedef struct frustum_hits { vpf t, u, v, prim; } frustum_hits;
+/* A closest-hit frustum's answers in registers (prim as float bit
+ * patterns). u and v hold the edge values w1 and w2, and ws their sum with
+ * w0: the barycentrics w1 / ws and w2 / ws are made once at the end of the
+ * batch (one division per ray instead of one per ray test; the same
+ * operations, so the same bits). */
+typedef struct frustum_hits { vpf t, u, v, ws, prim; } frustum_hits;
 
-/* ray_hits for closest hits: the rays hit take the triangle's t, u, v and
- * id in h. */
+/* ray_hits for closest hits: the rays hit take the triangle's t, edge
+ * values and id in h. */
 FR_INLINE unsigned ray_test_closest(const frusta *F, const frustum_dirs *D, const float *e, const float n[3],
                                     const fr_bvh2_tri *r, int f, unsigned rays, frustum_hits *h) {
   vpf w[3], t;
   const unsigned m = ray_hits(F, D, e, n, f, h->t, rays, w, &t);
-  const vpf inv = vp_div(vp(1.0f), vp_add(vp_add(w[0], w[1]), w[2]));
   const vpm hm = vpm_bits_to(m);
   h->t = vp_select(hm, t, h->t);
-  h->u = vp_select(hm, vp_mul(w[1], inv), h->u);
-  h->v = vp_select(hm, vp_mul(w[2], inv), h->v);
+  h->u = vp_select(hm, w[1], h->u);
+  h->v = vp_select(hm, w[2], h->v);
+  h->ws = vp_select(hm, vp_add(vp_add(w[0], w[1]), w[2]), h->ws);
   h->prim = vp_select(hm, vp_id(r->prim), h->prim);
   return m;
 }
@@ -644,19 +648,21 @@ static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr
   tri_frusta X[FR_BVH2_MAX_LEAF]; /* a leaf's triangles' edges for all frusta */
   leaf_edges L;                   /* ... or for the shared origin */
   float nk[FR_BVH2_MAX_LEAF][3];
+  float ws[16][16] __attribute__((aligned(64))); /* the hits' edge value sums (frustum_hits) */
   unsigned valid = B->valid & 0xFFFFu;
   /* t starts at tfar: a hit must come nearer (reset to +inf for misses at the end) */
   for (int f = 0; f < 16; f++)
     for (int k = 0; k < 16; k++) {
       H->t[f][k] = (valid >> f) & 1 ? B->tfar[f] : INFINITY;
       H->u[f][k] = H->v[f][k] = 0.0f;
+      ws[f][k] = 1.0f;
       H->prim[f][k] = FR_INVALID_ID;
     }
   FR_COUNT(mft_batches, 1);
   FR_COUNT(rays, 16 * __builtin_popcount(valid));
   if (!valid || !b->nodes) return 0;
   frusta_setup(&F, B, T, valid);
-  unsigned fetched = 0;
+  unsigned fetched = 0, found = 0;
   entry stack[STACK];
   int sp = 0;
   stack[sp++] = (entry){b->root, valid, NULL, 0};
@@ -702,7 +708,7 @@ static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr
         const frustum_dirs D = dirs_of(&F, f);
         lane_ids ids;
         memcpy(ids.u, H->prim[f], sizeof ids.u);
-        frustum_hits h = {vp_load(H->t[f]), vp_load(H->u[f]), vp_load(H->v[f]), vp_load(ids.f)};
+        frustum_hits h = {vp_load(H->t[f]), vp_load(H->u[f]), vp_load(H->v[f]), vp_load(ws[f]), vp_load(ids.f)};
         unsigned hits = 0;
         for (uint32_t k = 0; k < count; k++)
           if ((left[k] >> f) & 1)
@@ -711,11 +717,13 @@ static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr
           vp_store(H->t[f], h.t);
           vp_store(H->u[f], h.u);
           vp_store(H->v[f], h.v);
+          vp_store(ws[f], h.ws);
           vp_store(ids.f, h.prim);
           memcpy(H->prim[f], ids.u, sizeof ids.u);
           changed |= 1u << f;
         }
       }
+      found |= changed;
       /* the frusta with hits now end at their farthest ray's hit (open until all rays hit) */
       for (; changed; changed &= changed - 1) {
         int f = __builtin_ctz(changed);
@@ -723,6 +731,12 @@ static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr
       }
       break;
     }
+  }
+  for (; found; found &= found - 1) { /* misses keep 0 = 0 * (1 / 1) */
+    const int f = __builtin_ctz(found);
+    const vpf inv = vp_div(vp(1.0f), vp_load(ws[f]));
+    vp_store(H->u[f], vp_mul(vp_load(H->u[f]), inv));
+    vp_store(H->v[f], vp_mul(vp_load(H->v[f]), inv));
   }
   for (int f = 0; f < 16; f++)
     for (int k = 0; k < 16; k++)
