@@ -687,7 +687,7 @@ static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr
       unsigned left[FR_BVH2_MAX_LEAF], any = 0;
       const float *edges[FR_BVH2_MAX_LEAF], *nrm[FR_BVH2_MAX_LEAF];
       int step; /* from frustum f's edges to frustum f + 1's: the same (shared origin) or the next lane */
-      if (F.shared_origin) {
+      if (F.shared_origin && count) { /* leaf_edges_shared repeats row count - 1 */
         leaf_edges_shared(&F, &b->tris[first], count, &L);
         for (uint32_t k = 0; k < count; k++) {
           any |= left[k] = leaf_tri_cull_shared(&F, &L, k, m, opt, nk[k]);
