@@ -306,6 +306,29 @@ static void rays_batch(fr_rng *r, const mesh_ref *m, vec3 light, float eps, fr_r
   }
 }
 
+/* The same for shadow frusta from one point (a point light's, as
+ * Whitted's): the shared-origin leaves give the same occlusion bits as the
+ * per-frustum path, at every ISA level, cull and shrink setting. */
+static void check_shared_origin_occluded(const fr_scene *s, const fr_mft_batch *b, const fr_mft_sets *T) {
+  fr_mft_batch moved = *b;
+  const int f = 31 - __builtin_clz(b->valid | 1u);
+  for (int a = 0; a < 3; a++) moved.org[a][f] = b->org[a][f] + 1e3f * (1.0f + fabsf(b->org[a][f]));
+  moved.tnear[f] = 0.0f;
+  moved.tfar[f] = 1e-6f;
+  for (int i = 0; i < 3; i++) {
+    if (!fr_isa_supported(isas[i])) continue;
+    for (int opts = 0; opts < 3; opts++) {
+      fr_mft_opts o = fr_mft_opts_default();
+      if (opts == 1) o.corner_cost = 0.0f;           /* the cull on every triangle */
+      if (opts == 2) o.shrink = FR_MFT_SHRINK_CORNERS; /* corner rays alone */
+      uint16_t a[16], g[16];
+      isa_fns[i]->occluded(&s->bvh2, &o, b, T, a, NULL, NULL);
+      isa_fns[i]->occluded(&s->bvh2, &o, &moved, T, g, NULL, NULL);
+      for (int e = 0; e < 16; e++) assert_int_equal(g[e], e == f ? 0 : a[e]);
+    }
+  }
+}
+
 static void rays_frusta(void **state) {
   (void)state;
   fr_rng r = fr_rng_seed(29, 5);
@@ -359,6 +382,7 @@ static void rays_frusta(void **state) {
         }
       }
       check_shadows(s, &b, &T, &tl);
+      check_shared_origin_occluded(s, &b, &T);
       /* a budget of 3 nodes stops the batch: what it says occluded is */
       uint16_t full[16], part[16];
       fr_mft_budget all = {0, 0, 0, 0};

@@ -365,6 +365,47 @@ FR_INLINE unsigned leaf_tri_cull_shared(frusta *F, const leaf_edges *L, uint32_t
   return cull_counted(F, cull, m, left);
 }
 
+/* A leaf's per-triangle scratch: the cross products for every frustum, or
+ * once for a shared origin. */
+typedef struct leaf_scratch {
+  tri_frusta X[FR_BVH2_MAX_LEAF];
+  leaf_edges L;
+  float nk[FR_BVH2_MAX_LEAF][3];
+} leaf_scratch;
+
+/* What a leaf's culls leave for the ray tests: triangle k's frusta, where
+ * frustum f finds its cross products and det (edges[k] + step * f) and its
+ * normal. */
+typedef struct leaf_tris {
+  unsigned left[FR_BVH2_MAX_LEAF];
+  const float *edges[FR_BVH2_MAX_LEAF], *nrm[FR_BVH2_MAX_LEAF];
+  int step;
+} leaf_tris;
+
+/* Every triangle's cull (first, count) against the frusta m; returns the
+ * frusta any triangle is left to. */
+FR_INLINE unsigned leaf_culls(frusta *F, const fr_bvh2 *b, uint32_t first, uint32_t count, unsigned m,
+                              const fr_mft_opts *opt, leaf_scratch *S, leaf_tris *T) {
+  unsigned any = 0;
+  if (F->shared_origin && count) { /* leaf_edges_shared repeats row count - 1 */
+    leaf_edges_shared(F, &b->tris[first], count, &S->L);
+    for (uint32_t k = 0; k < count; k++) {
+      any |= T->left[k] = leaf_tri_cull_shared(F, &S->L, k, m, opt, S->nk[k]);
+      T->edges[k] = &S->L.t.e[0][0][k];
+      T->nrm[k] = S->nk[k];
+    }
+    T->step = 0;
+    return any;
+  }
+  for (uint32_t k = 0; k < count; k++) {
+    any |= T->left[k] = leaf_tri_cull(F, &b->tris[first + k], m, opt, &S->X[k]);
+    T->edges[k] = &S->X[k].e[0][0][0];
+    T->nrm[k] = S->X[k].n;
+  }
+  T->step = 1;
+  return any;
+}
+
 /* Frustum f's 16 ray directions, made from its start vector and deltas. */
 typedef struct frustum_dirs { vpf x, y, z; } frustum_dirs;
 FR_INLINE frustum_dirs dirs_of(const frusta *F, int f) {
@@ -512,10 +553,9 @@ FR_INLINE unsigned occlude_leaf(frusta *F, const fr_bvh2 *b, const fr_mft_opts *
                                 uint32_t ref, unsigned m, const unsigned rays[16], unsigned active[16],
                                 uint16_t occ[16], unsigned *alive, int eager) {
   const uint32_t first = FR_BVH2_LEAF_FIRST(ref), count = FR_BVH2_LEAF_COUNT(ref);
-  tri_frusta X[FR_BVH2_MAX_LEAF]; /* the triangles' edges for all frusta */
-  uint32_t left[FR_BVH2_MAX_LEAF];
-  unsigned any = 0, shrink = 0, occluded = 0;
-  for (uint32_t k = 0; k < count; k++) any |= left[k] = leaf_tri_cull(F, &b->tris[first + k], m, opt, &X[k]);
+  leaf_scratch S;
+  leaf_tris L;
+  unsigned any = leaf_culls(F, b, first, count, m, opt, &S, &L), shrink = 0, occluded = 0;
   for (; any; any &= any - 1) {
     const int f = __builtin_ctz(any);
     const frustum_dirs D = dirs_of(F, f);
@@ -524,7 +564,7 @@ FR_INLINE unsigned occlude_leaf(frusta *F, const fr_bvh2 *b, const fr_mft_opts *
     /* no branch on the hits, for the same reason as ray_hits */
     for (uint32_t k = 0; k < count; k++) {
       vpf w[3], t;
-      const unsigned hit = (left[k] >> f) & 1 ? ray_hits(F, &D, &X[k].e[0][0][f], X[k].n, f, tf, live, w, &t) : 0u;
+      const unsigned hit = (L.left[k] >> f) & 1 ? ray_hits(F, &D, L.edges[k] + L.step * f, L.nrm[k], f, tf, live, w, &t) : 0u;
       hits |= hit;
       live &= ~hit;
     }
@@ -645,9 +685,8 @@ out:
 static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B, const fr_mft_sets *T,
                               fr_mft_hits *H) {
   frusta F;
-  tri_frusta X[FR_BVH2_MAX_LEAF]; /* a leaf's triangles' edges for all frusta */
-  leaf_edges L;                   /* ... or for the shared origin */
-  float nk[FR_BVH2_MAX_LEAF][3];
+  leaf_scratch S;
+  leaf_tris L;
   float ws[16][16] __attribute__((aligned(64))); /* the hits' edge value sums (frustum_hits) */
   unsigned valid = B->valid & 0xFFFFu;
   /* t starts at tfar: a hit must come nearer (reset to +inf for misses at the end) */
@@ -684,25 +723,7 @@ static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr
        * same order as triangle by triangle, and keeps the same nearest
        * hit): a frustum's directions and nearest hits stay in registers
        * across the leaf instead of being made and reloaded per test. */
-      unsigned left[FR_BVH2_MAX_LEAF], any = 0;
-      const float *edges[FR_BVH2_MAX_LEAF], *nrm[FR_BVH2_MAX_LEAF];
-      int step; /* from frustum f's edges to frustum f + 1's: the same (shared origin) or the next lane */
-      if (F.shared_origin && count) { /* leaf_edges_shared repeats row count - 1 */
-        leaf_edges_shared(&F, &b->tris[first], count, &L);
-        for (uint32_t k = 0; k < count; k++) {
-          any |= left[k] = leaf_tri_cull_shared(&F, &L, k, m, opt, nk[k]);
-          edges[k] = &L.t.e[0][0][k];
-          nrm[k] = nk[k];
-        }
-        step = 0;
-      } else {
-        for (uint32_t k = 0; k < count; k++) {
-          any |= left[k] = leaf_tri_cull(&F, &b->tris[first + k], m, opt, &X[k]);
-          edges[k] = &X[k].e[0][0][0];
-          nrm[k] = X[k].n;
-        }
-        step = 1;
-      }
+      unsigned any = leaf_culls(&F, b, first, count, m, opt, &S, &L);
       for (; any; any &= any - 1) {
         const int f = __builtin_ctz(any);
         const frustum_dirs D = dirs_of(&F, f);
@@ -711,8 +732,8 @@ static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr
         frustum_hits h = {vp_load(H->t[f]), vp_load(H->u[f]), vp_load(H->v[f]), vp_load(ws[f]), vp_load(ids.f)};
         unsigned hits = 0;
         for (uint32_t k = 0; k < count; k++)
-          if ((left[k] >> f) & 1)
-            hits |= ray_test_closest(&F, &D, edges[k] + step * f, nrm[k], &b->tris[first + k], f, rays[f], &h);
+          if ((L.left[k] >> f) & 1)
+            hits |= ray_test_closest(&F, &D, L.edges[k] + L.step * f, L.nrm[k], &b->tris[first + k], f, rays[f], &h);
         if (hits) {
           vp_store(H->t[f], h.t);
           vp_store(H->u[f], h.u);
