@@ -5,6 +5,8 @@
  * path; degenerate triangles never hit; nothing returns NaN.
  */
 #include <string.h>
+#include <sys/mman.h>
+#include <unistd.h>
 #include "accel/bvhn.h"
 #include "geom/tri_moller.h"
 #include "geom/tri_shevtsov.h"
@@ -195,37 +197,57 @@ static void test_add_where(void **st) {
   print_message("masked adds: %d lane sets\n", tested);
 }
 
-typedef void (*load_records_fn)(const float *, size_t, float (*)[16], float (*)[16], float *);
-void fr_test_load_records_scalar(const float *src, size_t stride, float (*out8)[16], float (*out4)[16], float *back4);
-void fr_test_load_records_avx2(const float *src, size_t stride, float (*out8)[16], float (*out4)[16], float *back4);
-void fr_test_load_records_avx512(const float *src, size_t stride, float (*out8)[16], float (*out4)[16], float *back4);
+typedef void (*load_records_fn)(const float *, size_t, int, float (*)[16], float (*)[16], float *);
+void fr_test_load_records_scalar(const float *src, size_t stride, int n, float (*out8)[16], float (*out4)[16], float *back4);
+void fr_test_load_records_avx2(const float *src, size_t stride, int n, float (*out8)[16], float (*out4)[16], float *back4);
+void fr_test_load_records_avx512(const float *src, size_t stride, int n, float (*out8)[16], float (*out4)[16], float *back4);
 
 /* The transposing record loads (and the 4-float store) on every level move bits: field k of record
  * i lands in lane i of output k, NaNs and all, at the strides the Whitted
- * shading (12) and the packets (8) use. */
+ * shading (12) and the packets (8) use. Loads of the first n records only
+ * (the multi-frusta leaves') repeat record n - 1 in the lanes past it and
+ * read nothing after the n records: they end right before a page that
+ * cannot be read. */
 static void test_load_records(void **st) {
   (void)st;
   const struct { fr_isa isa; load_records_fn fn; } levels[] = {{FR_ISA_SCALAR, fr_test_load_records_scalar},
                                                                {FR_ISA_AVX2, fr_test_load_records_avx2},
                                                                {FR_ISA_AVX512, fr_test_load_records_avx512}};
+  const size_t page = (size_t)sysconf(_SC_PAGESIZE);
+  char *map = mmap(NULL, 2 * page, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  assert_true(map != MAP_FAILED);
+  assert_int_equal(mprotect(map + page, page, PROT_NONE), 0);
   uint32_t src[12 * 16];
   for (size_t i = 0; i < sizeof src / sizeof src[0]; i++) src[i] = 0x7FC00000u + (uint32_t)i; /* distinct NaNs */
+  static const int ns[] = {16, 15, 9, 8, 5, 1};
   int tested = 0;
   for (size_t l = 0; l < sizeof levels / sizeof levels[0]; l++) {
     if (!fr_isa_supported(levels[l].isa)) continue;
-    for (size_t stride = 8; stride <= 12; stride += 4) {
-      float out8[8][16], out4[4][16], back4[64];
-      levels[l].fn((const float *)src, stride, out8, out4, back4);
-      assert_memory_equal(back4, src, sizeof back4);
-      for (int i = 0; i < 16; i++) {
-        for (int k = 0; k < 8; k++) assert_memory_equal(&out8[k][i], &src[stride * (size_t)i + (size_t)k], 4);
-        for (int k = 0; k < 4; k++) assert_memory_equal(&out4[k][i], &src[4 * i + k], 4);
+    for (size_t stride = 8; stride <= 12; stride += 4)
+      for (size_t j = 0; j < sizeof ns / sizeof ns[0]; j++) {
+        const int n = ns[j];
+        /* the last record's 8 floats end at the unreadable page (all 16
+         * records: the 4-float loads read 64 floats from the start too) */
+        const size_t bytes = (stride * (size_t)(n - 1) + 8) * sizeof(float);
+        float *at = (float *)(map + page - bytes);
+        memcpy(at, src, bytes);
+        float out8[8][16], out4[4][16], back4[64];
+        levels[l].fn(at, stride, n, out8, out4, back4);
+        for (int i = 0; i < 16; i++) {
+          const size_t rec = (size_t)(i < n ? i : n - 1);
+          for (int k = 0; k < 8; k++) assert_memory_equal(&out8[k][i], &src[stride * rec + (size_t)k], 4);
+        }
+        if (n == 16) {
+          assert_memory_equal(back4, src, sizeof back4);
+          for (int i = 0; i < 16; i++)
+            for (int k = 0; k < 4; k++) assert_memory_equal(&out4[k][i], &src[4 * i + k], 4);
+        }
+        tested++;
       }
-      tested++;
-    }
   }
-  assert_true(tested >= 2);
-  print_message("record loads: %d level/stride pairs\n", tested);
+  munmap(map, 2 * page);
+  assert_true(tested >= 2 * 6);
+  print_message("record loads: %d level/stride/row-count cases\n", tested);
 }
 
 typedef int (*tri4_pair_fn)(const fr_tri4 *, const fr_ray *, const fr_ray *, int *);

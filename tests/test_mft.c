@@ -176,14 +176,20 @@ static void check_expand(const fr_mft_fns *fns, const fr_mft_batch *b, const fr_
  * origin away sends the batch down the per-frustum path instead. The moved
  * frustum reaches no box (tfar tiny), so the traversal is the same, and
  * every other frustum must get the same answers bit for bit. */
+static int move_last_frustum(const fr_mft_batch *b, fr_mft_batch *moved) {
+  *moved = *b;
+  const int f = 31 - __builtin_clz(b->valid | 1u);
+  for (int a = 0; a < 3; a++) moved->org[a][f] = b->org[a][f] + 1e3f * (1.0f + fabsf(b->org[a][f]));
+  moved->tnear[f] = 0.0f;
+  moved->tfar[f] = 1e-6f;
+  return f;
+}
+
 static void check_shared_origin(const fr_scene *s, const fr_mft_fns *fns, const fr_mft_opts *o, const fr_mft_batch *b,
                                 const fr_mft_sets *T, const fr_mft_hits *h) {
   static fr_mft_hits g;
-  fr_mft_batch moved = *b;
-  const int f = 31 - __builtin_clz(b->valid | 1u);
-  for (int a = 0; a < 3; a++) moved.org[a][f] = b->org[a][f] + 1e3f * (1.0f + fabsf(b->org[a][f]));
-  moved.tnear[f] = 0.0f;
-  moved.tfar[f] = 1e-6f;
+  fr_mft_batch moved;
+  const int f = move_last_frustum(b, &moved);
   memset(&g, 0xAB, sizeof g);
   fns->intersect(&s->bvh2_mft, o, &moved, T, &g);
   for (int e = 0; e < 16; e++) {
@@ -310,11 +316,8 @@ static void rays_batch(fr_rng *r, const mesh_ref *m, vec3 light, float eps, fr_r
  * Whitted's): the shared-origin leaves give the same occlusion bits as the
  * per-frustum path, at every ISA level, cull and shrink setting. */
 static void check_shared_origin_occluded(const fr_scene *s, const fr_mft_batch *b, const fr_mft_sets *T) {
-  fr_mft_batch moved = *b;
-  const int f = 31 - __builtin_clz(b->valid | 1u);
-  for (int a = 0; a < 3; a++) moved.org[a][f] = b->org[a][f] + 1e3f * (1.0f + fabsf(b->org[a][f]));
-  moved.tnear[f] = 0.0f;
-  moved.tfar[f] = 1e-6f;
+  fr_mft_batch moved;
+  const int f = move_last_frustum(b, &moved);
   for (int i = 0; i < 3; i++) {
     if (!fr_isa_supported(isas[i])) continue;
     for (int opts = 0; opts < 3; opts++) {
