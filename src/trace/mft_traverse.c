@@ -324,12 +324,10 @@ FR_INLINE void leaf_edges_shared(const frusta *F, const fr_bvh2_tri *r, uint32_t
     const vpf o = vp(F->origin[a]);
     A[a] = vp_sub(V0[a], o); B[a] = vp_sub(V1[a], o); C[a] = vp_sub(V2[a], o);
   }
-  { /* v3_cross(v1 - v0, v2 - v0) */
+  { /* fr_bvh2_tri_normal: (v1 - v0) x (v2 - v0) */
     vpf e1[3], e2[3];
     for (int a = 0; a < 3; a++) { e1[a] = vp_sub(V1[a], V0[a]); e2[a] = vp_sub(V2[a], V0[a]); }
-    n[0] = vp_sub(vp_mul(e1[1], e2[2]), vp_mul(e1[2], e2[1]));
-    n[1] = vp_sub(vp_mul(e1[2], e2[0]), vp_mul(e1[0], e2[2]));
-    n[2] = vp_sub(vp_mul(e1[0], e2[1]), vp_mul(e1[1], e2[0]));
+    fr_cross3v(e1, e2, n);
   }
   for (int a = 0; a < 3; a++) vp_store(L->nrm[a], n[a]);
   vp_store(L->t.det, fr_dot3v(A[0], A[1], A[2], n[0], n[1], n[2]));
@@ -337,16 +335,15 @@ FR_INLINE void leaf_edges_shared(const frusta *F, const fr_bvh2_tri *r, uint32_t
   const vpf *from[3][2] = {{B, C}, {C, A}, {A, B}};
   for (int i = 0; i < 3; i++) {
     const vpm fl = vpm_bits_to(flip[i]);
-    vpf p[3], d[3], po[3];
-    for (int a = 0; a < 3; a++) {
-      p[a] = vp_select(fl, ends[i][1][a], ends[i][0][a]);
-      d[a] = vp_sub(vp_select(fl, ends[i][0][a], ends[i][1][a]), p[a]);
+    vpf d[3], po[3], c[3];
+    for (int a = 0; a < 3; a++) { /* fr_tri_edges16's edge from its smaller vertex p to q, lane by lane */
+      const vpf p = vp_select(fl, ends[i][1][a], ends[i][0][a]);
+      d[a] = vp_sub(vp_select(fl, ends[i][0][a], ends[i][1][a]), p);
       po[a] = vp_select(fl, from[i][1][a], from[i][0][a]);
     }
+    fr_cross3v(po, d, c);
     const vpf sg = vp_select(fl, vp(-0.0f), vp(0.0f));
-    vp_store(L->t.e[i][0], vp_xor(vp_sub(vp_mul(po[1], d[2]), vp_mul(po[2], d[1])), sg));
-    vp_store(L->t.e[i][1], vp_xor(vp_sub(vp_mul(po[2], d[0]), vp_mul(po[0], d[2])), sg));
-    vp_store(L->t.e[i][2], vp_xor(vp_sub(vp_mul(po[0], d[1]), vp_mul(po[1], d[0])), sg));
+    for (int a = 0; a < 3; a++) vp_store(L->t.e[i][a], vp_xor(c[a], sg));
   }
 }
 

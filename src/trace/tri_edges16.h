@@ -23,6 +23,14 @@ FR_INLINE vpf fr_dot3v(vpf ax, vpf ay, vpf az, vpf bx, vpf by, vpf bz) {
   return vp_add(vp_add(vp_mul(ax, bx), vp_mul(ay, by)), vp_mul(az, bz));
 }
 
+/* c = a x b with v3_cross's operations, so lane by lane the same bits
+ * (fr_bvh2_tri_normal's normal, and the edge products below) */
+FR_INLINE void fr_cross3v(const vpf a[3], const vpf b[3], vpf c[3]) {
+  c[0] = vp_sub(vp_mul(a[1], b[2]), vp_mul(a[2], b[1]));
+  c[1] = vp_sub(vp_mul(a[2], b[0]), vp_mul(a[0], b[2]));
+  c[2] = vp_sub(vp_mul(a[0], b[1]), vp_mul(a[1], b[0]));
+}
+
 FR_INLINE void fr_tri_edges16(const fr_bvh2_tri *r, const float n[3], const vpf o[3], vpf E[3][3], vpf *det) {
   vpf A[3], B[3], C[3];
   for (int a = 0; a < 3; a++) {
@@ -37,11 +45,10 @@ FR_INLINE void fr_tri_edges16(const fr_bvh2_tri *r, const float n[3], const vpf 
     int flip = (r->edge_flip >> i) & 1;
     const float *p = ends[i][flip], *q = ends[i][!flip];
     const vpf *po = from[i][flip];
-    vpf dx = vp(q[0] - p[0]), dy = vp(q[1] - p[1]), dz = vp(q[2] - p[2]);
-    vpf sg = vp(flip ? -0.0f : 0.0f);
-    E[i][0] = vp_xor(vp_sub(vp_mul(po[1], dz), vp_mul(po[2], dy)), sg);
-    E[i][1] = vp_xor(vp_sub(vp_mul(po[2], dx), vp_mul(po[0], dz)), sg);
-    E[i][2] = vp_xor(vp_sub(vp_mul(po[0], dy), vp_mul(po[1], dx)), sg);
+    const vpf d[3] = {vp(q[0] - p[0]), vp(q[1] - p[1]), vp(q[2] - p[2])}, sg = vp(flip ? -0.0f : 0.0f);
+    vpf c[3];
+    fr_cross3v(po, d, c);
+    for (int a = 0; a < 3; a++) E[i][a] = vp_xor(c[a], sg);
   }
 }
 
