@@ -171,11 +171,8 @@ static void check_expand(const fr_mft_fns *fns, const fr_mft_batch *b, const fr_
     }
 }
 
-/* Camera frusta share one origin, and the kernel then makes a leaf's cross
- * products once for all of them (leaf_edges_shared); moving one frustum's
- * origin away sends the batch down the per-frustum path instead. The moved
- * frustum reaches no box (tfar tiny), so the traversal is the same, and
- * every other frustum must get the same answers bit for bit. */
+/* b with its last valid frustum moved far away and made too short to reach
+ * any box; returns that frustum. */
 static int move_last_frustum(const fr_mft_batch *b, fr_mft_batch *moved) {
   *moved = *b;
   const int f = 31 - __builtin_clz(b->valid | 1u);
@@ -185,6 +182,11 @@ static int move_last_frustum(const fr_mft_batch *b, fr_mft_batch *moved) {
   return f;
 }
 
+/* Camera frusta share one origin, and the kernel then makes a leaf's cross
+ * products once for all of them (leaf_edges_shared); moving one frustum's
+ * origin away sends the batch down the per-frustum path instead. The moved
+ * frustum reaches no box, so the traversal is the same, and every other
+ * frustum must get the same answers bit for bit. */
 static void check_shared_origin(const fr_scene *s, const fr_mft_fns *fns, const fr_mft_opts *o, const fr_mft_batch *b,
                                 const fr_mft_sets *T, const fr_mft_hits *h) {
   static fr_mft_hits g;
