@@ -1,4 +1,5 @@
 #include "kernels.h"
+#include <cpuid.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,8 +10,11 @@ static _Atomic(const fr_kernels *) active;
 /* The AVX2 and AVX-512 kernels are also compiled with BMI, BMI2, LZCNT and
  * POPCNT (CMakeLists.txt), so the compiler may use them anywhere there. */
 static int bit_ops_supported(void) {
-  return __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("lzcnt") &&
-         __builtin_cpu_supports("popcnt");
+  /* LZCNT by CPUID (leaf 0x80000001, ECX bit 5): clang's
+   * __builtin_cpu_supports knows no "lzcnt" (clang 14 rejects it) */
+  unsigned a, b, c, d;
+  int lzcnt = __get_cpuid(0x80000001u, &a, &b, &c, &d) && (c >> 5 & 1u);
+  return __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2") && lzcnt && __builtin_cpu_supports("popcnt");
 }
 
 int fr_isa_supported(fr_isa isa) {

@@ -518,8 +518,8 @@ FR_INLINE int visit_node(const frusta *F, const fr_bvh2 *b, uint32_t ref, unsign
   FR_COUNT(mft_box_lanes, 2 * __builtin_popcount(m));
   vpf tn0, tn1;
   unsigned h0 = box_test(F, n, 0, m, &tn0), h1 = box_test(F, n, 1, m, &tn1);
-  if (h0 && MFT_PREFETCH_TRIS) fr_bvh2_prefetch(b, n->child[0], MFT_PREFETCH_TRIS);
-  if (h1 && MFT_PREFETCH_TRIS) fr_bvh2_prefetch(b, n->child[1], MFT_PREFETCH_TRIS);
+  if (h0 && MFT_PREFETCH_TRIS > 0) fr_bvh2_prefetch(b, n->child[0], MFT_PREFETCH_TRIS);
+  if (h1 && MFT_PREFETCH_TRIS > 0) fr_bvh2_prefetch(b, n->child[1], MFT_PREFETCH_TRIS);
   /* nearer first: the child more of the frusta in both enter first. No
    * branch on which children were hit: the far one is always written and
    * pushed only when both were (soft16 sibenik 1.016x, kitchen primary
