@@ -48,7 +48,7 @@ static void make_shadow_batch(fr_rng *r, const mesh_ref *m, vec3 lc, float eps, 
   }
 }
 
-typedef struct tally { long rays, disagree, excused, cache_filled; } tally;
+typedef struct tally { long rays, disagree, excused, cache_filled, plane_rays; } tally;
 
 /* The same rays as 16 packets of 16 (one per frustum), traced as pure packets. */
 static void packet16_occluded(fr_scene *s, const fr_mft_batch *b, const fr_mft_sets *T, uint16_t occ[16]) {
@@ -89,6 +89,16 @@ static void check_shadows_vs(const fr_scene *s, const fr_mft_batch *b, const fr_
         fr_mft_budget none = {0, 0, ~0u, -1};
         isa_fns[i]->occluded(&s->bvh2_mft, &o, b, T, occ, &none, NULL);
         assert_true(none.visited != ~0u && none.stopped == 0);
+        /* the shadow tree with the scene's planar occluders tested first
+         * (accel/plane_occluders.h) gives the same bits as without them */
+        if (s->bvh2.planes) {
+          uint16_t occ_p[16], occ_b[16];
+          fr_bvh2 bare = s->bvh2;
+          bare.planes = NULL;
+          isa_fns[i]->occluded(&s->bvh2, &o, b, T, occ_p, NULL, NULL);
+          isa_fns[i]->occluded(&bare, &o, b, T, occ_b, NULL, NULL);
+          assert_memory_equal(occ_p, occ_b, sizeof occ_p);
+        }
         /* occluders cached from the previous batch, and from this batch
          * itself (its best leaves then occlude rays before any traversal),
          * change no answer */
@@ -117,6 +127,13 @@ static void check_shadows_vs(const fr_scene *s, const fr_mft_batch *b, const fr_
               r.tfar = b->tfar[f];
               int single = fr_occluded1(s, &r), mft = (occ[f] >> k) & 1;
               tl->rays++;
+              /* a ray a planar occluder claims is occluded, without excuse */
+              for (size_t q = 0; q < s->planes.n; q++)
+                if (fr_plane_occluder_hit(&s->planes.list[q], r.org, r.dir, r.tnear, r.tfar)) {
+                  tl->plane_rays++;
+                  assert_int_equal(single, 1);
+                  break;
+                }
               if (packet_occ && ((packet_occ[f] >> k) & 1) != mft && single == mft) {
                 tl->disagree++;
                 if (!ambiguous(&m, &r)) {
@@ -639,7 +656,8 @@ static void shared_scenes(void **state) {
   (void)state;
   tally tl = {0};
   int checked = for_each_shared_scene(shared_scene_one, &tl);
-  print_message("shared scenes: %ld rays, %ld disagreements (all at edges or range ends)\n", tl.rays, tl.disagree);
+  print_message("shared scenes: %ld rays, %ld disagreements (all at edges or range ends), %ld rays in planar occluders\n",
+                tl.rays, tl.disagree, tl.plane_rays);
   assert_true(checked >= 14);
   assert_true(tl.disagree * 1000 < tl.rays);
 }

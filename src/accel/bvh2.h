@@ -65,6 +65,9 @@ typedef struct fr_bvh2 {
   size_t nprims;
   int max_leaf;
   int borrowed;      /* prims and tris belong to another tree (fr_bvh2_shallow) */
+  /* the scene's planar occluders, which shadow frusta test before the tree
+   * (accel/plane_occluders.h); NULL: none. Not owned. */
+  const struct fr_plane_occluders *planes;
 } fr_bvh2;
 
 /* Leaves hold at most max_leaf triangles (4: the regular tree; more: the

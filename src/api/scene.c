@@ -132,6 +132,7 @@ void fr_scene_release(fr_scene *s) {
   fr_bvh2_free(&s->bvh2);
   fr_bvhn_free(&s->bvh4);
   fr_bvhn_free(&s->bvh8);
+  fr_plane_occluders_free(&s->planes);
   free(s);
 }
 
@@ -251,6 +252,16 @@ fr_error fr_scene_commit(fr_scene *s) {
     fr_bvh2_free(&s->bvh2_mft); fr_bvh2_free(&s->bvh2); fr_bvhn_free(&s->bvh4); fr_bvhn_free(&s->bvh8); fr_bvh2_free(&s->sphere_bvh);
     return e;
   }
+  /* FRUSTA_PLANES=off leaves them out, for measurements */
+  const char *pe = getenv("FRUSTA_PLANES");
+  if (!(pe && !strcmp(pe, "off"))) {
+    e = fr_plane_occluders_find(m, &s->planes);
+    if (e) {
+      fr_bvh2_free(&s->bvh2_mft); fr_bvh2_free(&s->bvh2); fr_bvhn_free(&s->bvh4); fr_bvhn_free(&s->bvh8); fr_bvh2_free(&s->sphere_bvh);
+      return e;
+    }
+  }
+  s->bvh2.planes = s->planes.n ? &s->planes : NULL;
   s->bounds = aabb_merge(s->bounds, s->sphere_bvh.bounds);
   s->build_seconds = fr_seconds() - t0;
   s->committed = 1;

@@ -29,6 +29,7 @@
 #include "base/simd.h"
 #include "base/simd_packet.h"
 #include "trace/counters.h"
+#include "accel/plane_occluders.h"
 #include "trace/mft.h"
 #include "trace/tri_edges16.h"
 
@@ -584,6 +585,60 @@ FR_INLINE unsigned occlude_leaf(frusta *F, const fr_bvh2 *b, const fr_mft_opts *
   return occluded;
 }
 
+/* The scene's planar occluders (accel/plane_occluders.h) against the
+ * frusta in *alive, before any traversal: a ray crossing one inside, by
+ * margins far above the rounding of this test and of the triangle tests, is
+ * occluded by one of its triangles, so it joins occ[f] as its traversal
+ * would have made it. A frustum whose corner rays do not all cross the
+ * plane is passed by (its rays are left to the traversal). Returns the rays
+ * occluded. */
+static unsigned occlude_planes(frusta *F, const fr_plane_occluders *planes, const fr_mft_opts *opt, const fr_mft_sets *T,
+                               unsigned active[16], uint16_t occ[16], unsigned *alive) {
+  unsigned shrink = 0, occluded = 0;
+  for (size_t i = 0; i < planes->n && *alive; i++) {
+    const fr_plane_occluder *p = &planes->list[i];
+    const int a = p->axis, u = (a + 1) % 3, v = (a + 2) % 3;
+    for (unsigned g = *alive; g; g &= g - 1) {
+      const int f = __builtin_ctz(g);
+      const float side = F->o[a][f] - p->c;
+      int cross = side != 0.0f;
+      for (int j = 0; j < 4; j++) cross &= (F->o[a][f] + F->tfar[f] * F->corner[j][a][f] - p->c) * side < 0.0f;
+      if (!cross) continue;
+      const frustum_dirs D = dirs_of(F, f);
+      const vpf da = a == 0 ? D.x : a == 1 ? D.y : D.z;
+      const vpf du = u == 0 ? D.x : u == 1 ? D.y : D.z, dv = v == 0 ? D.x : v == 1 ? D.y : D.z;
+      const vpf t = vp_div(vp(p->c - F->o[a][f]), da);
+      const float tf = F->tfar[f];
+      vpm in = vpm_and(vp_gt(t, vp(F->tnear[f] + FR_PLANE_T_MARGIN * tf)), vp_lt(t, vp(tf * (1.0f - FR_PLANE_T_MARGIN))));
+      const vpf ou = vp(F->o[u][f]), ov = vp(F->o[v][f]);
+      const vpf su = vp_mul(t, du), sv = vp_mul(t, dv);
+      const vpf pu = vp_add(ou, su), pv = vp_add(ov, sv);
+      /* the hit point's rounding, generously: 1e-5 of the magnitudes summed */
+      const vpf err = vp_mul(vp(1e-5f), vp_add(vp_add(vp_abs(ou), vp_abs(ov)), vp_add(vp_abs(su), vp_abs(sv))));
+      for (int k = 0; k < p->nedges; k++)
+        in = vpm_and(in, vp_le(vp_add(vp_add(vp_mul(vp(p->nu[k]), pu), vp_mul(vp(p->nv[k]), pv)), err), vp(p->e[k])));
+      const unsigned hits = active[f] & vpm_bits(in);
+      if (!hits) continue;
+      const unsigned bit = 1u << f;
+      occ[f] |= (uint16_t)hits;
+      active[f] &= ~hits;
+      occluded += (unsigned)__builtin_popcount(hits);
+      if (!active[f]) *alive &= ~bit;
+      else if (opt->shrink) shrink |= bit;
+    }
+  }
+  shrink &= *alive;
+  if (shrink) {
+    ray_box R;
+    memset(&R, 0, sizeof R);
+    const int intervals = opt->shrink == FR_MFT_SHRINK_ALL;
+    for (unsigned l = shrink; l; l &= l - 1) ray_box_of(F, __builtin_ctz(l), active[__builtin_ctz(l)], &R, intervals);
+    frusta_bounds(F, T, shrink, &R, intervals);
+  }
+  FR_COUNT(mft_plane_rays, occluded);
+  return occluded;
+}
+
 /* The leaves that occluded the most rays in a batch so far, most first. */
 typedef struct best_leaves { uint32_t ref[FR_MFT_OCCLUDERS]; unsigned rays[FR_MFT_OCCLUDERS]; unsigned n; } best_leaves;
 
@@ -625,6 +680,7 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
    * frustum is seldom finished by two leaves). Ranking leaves by the
    * frusta they finished first, or caching only those that finished one,
    * measured the same or worse. */
+  if (b->planes) occlude_planes(&F, b->planes, opt, T, active, occ, &alive);
   best_leaves best = {{0}, {0}, 0};
   uint32_t skip[FR_MFT_OCCLUDERS] = {0};
   const unsigned ncache = cache ? cache->n : 0;

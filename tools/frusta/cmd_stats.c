@@ -112,6 +112,15 @@ int cmd_stats(int argc, char **argv) {
   printf("scene=%s tris=%zu skipped_degenerate=%zu references=%zu threads=%d build_seconds=%.3f\n", s->name, nt,
          fr_scene_skipped_triangles(s), st.references, threads, st.build_seconds);
   printf("bvh2 inner=%zu leaves=%zu sah=%.2f leaf_fill=%.2f\n", st.bvh2_inner, st.bvh2_leaves, st.bvh2_sah, st.bvh2_leaf_fill);
+  /* the planar occluders shadow frusta test first (accel/plane_occluders.h) */
+  size_t ptris = 0;
+  double parea = 0.0;
+  for (size_t i = 0; i < s->planes.n; i++) { ptris += s->planes.list[i].tris; parea += s->planes.list[i].area; }
+  printf("plane_occluders n=%zu tris=%zu area=%.4g\n", s->planes.n, ptris, parea);
+  for (size_t i = 0; i < s->planes.n; i++) {
+    const fr_plane_occluder *o = &s->planes.list[i];
+    printf("plane_occluder axis=%c c=%g tris=%zu edges=%d area=%.4g\n", "xyz"[o->axis], (double)o->c, o->tris, o->nedges, o->area);
+  }
   const fr_wide_stats *w[2] = {&st.bvh4, &st.bvh8};
   for (int i = 0; i < 2; i++)
     printf("bvh%d inner=%zu leaves=%zu blocks=%zu sah=%.2f sah_blocks=%.2f node_fill=%.2f/%d leaf_fill=%.2f block_fill=%.2f/4 depth=%d node_bytes=%zu tri_bytes=%zu bytes_per_tri=%.1f packet_tri_bytes=%zu packet_bytes_per_tri=%.1f\n",

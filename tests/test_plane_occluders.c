@@ -1,0 +1,165 @@
+/*
+ * Planar occluders (accel/plane_occluders.h): which patches qualify, and
+ * that every ray one claims is occluded by the scene's own triangles (the
+ * single-ray kernel and a double-precision brute force), also far from the
+ * origin.
+ */
+#include <math.h>
+#include "accel/plane_occluders.h"
+#include "api/scene.h"
+#include "random_scene.h"
+#include "test_util.h"
+
+/* An n x n grid of quads over [x0, x0 + size] x [z0, z0 + size] at y = c,
+ * two triangles each, all wound the same way but for quad `flip`; quad
+ * `hole` left out; quads with i, j >= n - cut left out (an L). */
+static void add_grid(scene_data *sd, int n, float x0, float z0, float size, float c, int hole, int flip, int cut) {
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < n; j++) {
+      const int q = i * n + j;
+      if (q == hole || (i >= n - cut && j >= n - cut)) continue;
+      const float s = size / (float)n;
+      vec3 a = v3(x0 + s * (float)i, c, z0 + s * (float)j), b = v3(x0 + s * (float)(i + 1), c, z0 + s * (float)j);
+      vec3 d = v3(x0 + s * (float)i, c, z0 + s * (float)(j + 1)), e = v3(x0 + s * (float)(i + 1), c, z0 + s * (float)(j + 1));
+      if (q == flip) {
+        add_tri(sd, a, b, e);
+        add_tri(sd, a, e, d);
+      } else {
+        add_tri(sd, a, e, b);
+        add_tri(sd, a, d, e);
+      }
+    }
+}
+
+/* A fan of n triangles around (x0, c, z0): a convex n-gon of radius r. */
+static void add_disc(scene_data *sd, int n, float x0, float z0, float r, float c) {
+  for (int i = 0; i < n; i++) {
+    const double a0 = 2.0 * M_PI * i / n, a1 = 2.0 * M_PI * (i + 1) / n;
+    add_tri(sd, v3(x0, c, z0), v3(x0 + r * (float)cos(a1), c, z0 + r * (float)sin(a1)),
+            v3(x0 + r * (float)cos(a0), c, z0 + r * (float)sin(a0)));
+  }
+}
+
+static scene_data new_scene(void) {
+  scene_data sd = {malloc(4096 * 9 * sizeof(float)), malloc(4096 * 3 * sizeof(uint32_t)), 0, 0};
+  /* something else in the scene, off the plane */
+  add_tri(&sd, v3(-3, -1, -3), v3(-2, 2, -3), v3(-3, 1, -2));
+  return sd;
+}
+
+static size_t occluders_of(const scene_data *sd, fr_plane_occluders *out) {
+  fr_scene *s = commit_scene(sd);
+  size_t n = s->planes.n;
+  out->n = n;
+  out->list = NULL;
+  if (n) {
+    out->list = malloc(n * sizeof *out->list);
+    memcpy(out->list, s->planes.list, n * sizeof *out->list);
+  }
+  fr_scene_release(s);
+  return n;
+}
+
+/* Patches that cover their convex hull qualify; the others do not. */
+static void which_patches_qualify(void **state) {
+  (void)state;
+  fr_plane_occluders p;
+  struct { int hole, flip, cut, dup, n; size_t want; } cases[] = {
+      {-1, -1, 0, 0, 8, 1}, /* a full grid */
+      {27, -1, 0, 0, 8, 0}, /* a hole */
+      {-1, 27, 0, 0, 8, 0}, /* one quad wound the other way */
+      {-1, -1, 3, 0, 8, 0}, /* an L: its hull is larger */
+      {-1, -1, 0, 1, 8, 0}, /* a triangle twice */
+      {-1, -1, 0, 0, 5, 0}, /* 50 triangles: too few */
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    scene_data sd = new_scene();
+    add_grid(&sd, cases[k].n, 0.25f, -0.5f, 1.0f, 0.5f, cases[k].hole, cases[k].flip, cases[k].cut);
+    if (cases[k].dup) add_tri(&sd, v3(0.25f, 0.5f, -0.5f), v3(0.375f, 0.5f, -0.375f), v3(0.375f, 0.5f, -0.5f));
+    size_t n = occluders_of(&sd, &p);
+    if (n != cases[k].want) fail_msg("case %zu: %zu occluders, want %zu", k, n, cases[k].want);
+    if (n) {
+      assert_int_equal(p.list[0].axis, 1);
+      assert_true(p.list[0].c == 0.5f);
+      assert_int_equal(p.list[0].nedges, 4);
+      assert_true(fabs(p.list[0].area - 1.0) < 1e-6);
+      assert_int_equal(p.list[0].tris, 128);
+    }
+    fr_plane_occluders_free(&p);
+    free_scene(&sd);
+  }
+  /* a disc of 96 triangles: 16 of its hull's 96 vertices, inscribed */
+  scene_data sd = new_scene();
+  add_disc(&sd, 96, 1.0f, 2.0f, 0.5f, -0.25f);
+  assert_int_equal(occluders_of(&sd, &p), 1);
+  assert_int_equal(p.list[0].nedges, FR_PLANE_OCCLUDER_EDGES);
+  const double inscribed16 = 0.5 * 16 * 0.25 * sin(2.0 * M_PI / 16);
+  assert_true(fabs(p.list[0].area - inscribed16) < 1e-4);
+  fr_plane_occluders_free(&p);
+  free_scene(&sd);
+}
+
+/* Rays at a patch: every one an occluder claims is occluded in the scene,
+ * by the single-ray kernel and by brute force in double; most rays aimed
+ * at the middle are claimed (the margins are small). */
+static void check_rays(const scene_data *sd, vec3 centre, float size, long *claimed_out, long *rays_out) {
+  fr_scene *s = commit_scene(sd);
+  assert_int_equal(s->planes.n, 1);
+  const fr_plane_occluder *p = &s->planes.list[0];
+  fr_rng r = fr_rng_seed(11, 0);
+  long claimed = 0, rays = 0;
+  for (int i = 0; i < 20000; i++) {
+    /* from below to above the plane, aimed anywhere over twice the patch */
+    vec3 o = v3_add(centre, v3((fr_rng_float(&r) - 0.5f) * 4 * size, -size * (0.01f + fr_rng_float(&r)),
+                               (fr_rng_float(&r) - 0.5f) * 4 * size));
+    vec3 e = v3_add(centre, v3((fr_rng_float(&r) - 0.5f) * 2 * size, size * (0.01f + fr_rng_float(&r)),
+                               (fr_rng_float(&r) - 0.5f) * 2 * size));
+    if (i & 1) { vec3 t = o; o = e; e = t; }
+    fr_ray ray = {{o.x, o.y, o.z}, 0.0f, {e.x - o.x, e.y - o.y, e.z - o.z}, 1.0f};
+    /* ranges that end near the plane too */
+    if (i % 5 == 0) ray.tnear = fr_rng_float(&r);
+    if (i % 7 == 0) ray.tfar = fr_rng_float(&r);
+    if (ray.tnear > ray.tfar) continue;
+    rays++;
+    if (!fr_plane_occluder_hit(p, ray.org, ray.dir, ray.tnear, ray.tfar)) continue;
+    claimed++;
+    if (!fr_occluded1(s, &ray)) fail_msg("ray %d claimed by the occluder but not occluded", i);
+    uint32_t prim;
+    double margin;
+    if (!isfinite(brute_force(fr_scene_vertices(s), fr_scene_indices(s), fr_scene_triangle_count(s), &ray, &prim, &margin, 1)))
+      fail_msg("ray %d claimed by the occluder but brute force finds no hit", i);
+  }
+  fr_scene_release(s);
+  *claimed_out = claimed;
+  *rays_out = rays;
+}
+
+static void claimed_rays_are_occluded(void **state) {
+  (void)state;
+  const float offsets[] = {0.0f, 1000.0f, -30000.0f};
+  for (int k = 0; k < 3; k++) {
+    const float f = offsets[k];
+    scene_data sd = new_scene();
+    add_grid(&sd, 12, f + 0.25f, f - 0.5f, 1.0f, f + 0.5f, -1, -1, 0);
+    long claimed, rays;
+    check_rays(&sd, v3(f + 0.75f, f + 0.5f, f), 1.0f, &claimed, &rays);
+    print_message("grid at offset %g: %ld of %ld rays claimed\n", f, claimed, rays);
+    /* not vacuous; at 30000 the margins (1e-5 of the magnitudes) leave little */
+    if (fabsf(f) < 10000.0f) assert_true(claimed * 10 > rays);
+    free_scene(&sd);
+    sd = new_scene();
+    add_disc(&sd, 200, f + 1.0f, f + 2.0f, 0.5f, f - 0.25f);
+    check_rays(&sd, v3(f + 1.0f, f - 0.25f, f + 2.0f), 0.5f, &claimed, &rays);
+    print_message("disc at offset %g: %ld of %ld rays claimed\n", f, claimed, rays);
+    if (fabsf(f) < 10000.0f) assert_true(claimed * 10 > rays);
+    free_scene(&sd);
+  }
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(which_patches_qualify),
+      cmocka_unit_test(claimed_rays_are_occluded),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
