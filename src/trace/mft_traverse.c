@@ -595,15 +595,30 @@ FR_INLINE unsigned occlude_leaf(frusta *F, const fr_bvh2 *b, const fr_mft_opts *
 static unsigned occlude_planes(frusta *F, const fr_plane_occluders *planes, const fr_mft_opts *opt, const fr_mft_sets *T,
                                unsigned active[16], uint16_t occ[16], unsigned *alive) {
   unsigned shrink = 0, occluded = 0;
+  const vpf zero = vp(0.0f), tf16 = vp_load(F->tfar);
   for (size_t i = 0; i < planes->n && *alive; i++) {
     const fr_plane_occluder *p = &planes->list[i];
     const int a = p->axis, u = (a + 1) % 3, v = (a + 2) % 3;
-    for (unsigned g = *alive; g; g &= g - 1) {
+    /* All frusta at once (one by one this cost Whitted's thin point-light
+     * frusta 3% on kitchen): those whose four corner rays cross the plane
+     * within their range, and whose corner rays' crossings span a box that
+     * meets the polygon's. Only a filter: a frustum passed by is traced. */
+    const vpf c = vp(p->c), oa = vp_load(F->o[a]), ou16 = vp_load(F->o[u]), ov16 = vp_load(F->o[v]);
+    const vpf side = vp_sub(oa, c), toward = vp_sub(c, oa);
+    vpm cross = vpm_bits_to(0xFFFFu);
+    vpf ulo = vp(INFINITY), uhi = vp(-INFINITY), vlo = ulo, vhi = uhi;
+    for (int j = 0; j < 4; j++) {
+      const vpf ca = vp_load(F->corner[j][a]);
+      cross = vpm_and(cross, vp_lt(vp_mul(vp_sub(vp_add(oa, vp_mul(tf16, ca)), c), side), zero));
+      const vpf t = vp_div(toward, ca);
+      const vpf hu = vp_add(ou16, vp_mul(t, vp_load(F->corner[j][u]))), hv = vp_add(ov16, vp_mul(t, vp_load(F->corner[j][v])));
+      ulo = vp_min(ulo, hu); uhi = vp_max(uhi, hu);
+      vlo = vp_min(vlo, hv); vhi = vp_max(vhi, hv);
+    }
+    const vpm meets = vpm_and(vpm_and(vp_le(ulo, vp(p->hi[0])), vp_ge(uhi, vp(p->lo[0]))),
+                              vpm_and(vp_le(vlo, vp(p->hi[1])), vp_ge(vhi, vp(p->lo[1]))));
+    for (unsigned g = *alive & vpm_bits(vpm_and(cross, meets)); g; g &= g - 1) {
       const int f = __builtin_ctz(g);
-      const float side = F->o[a][f] - p->c;
-      int cross = side != 0.0f;
-      for (int j = 0; j < 4; j++) cross &= (F->o[a][f] + F->tfar[f] * F->corner[j][a][f] - p->c) * side < 0.0f;
-      if (!cross) continue;
       const frustum_dirs D = dirs_of(F, f);
       const vpf da = a == 0 ? D.x : a == 1 ? D.y : D.z;
       const vpf du = u == 0 ? D.x : u == 1 ? D.y : D.z, dv = v == 0 ? D.x : v == 1 ? D.y : D.z;
