@@ -22,6 +22,7 @@
  */
 #ifndef FR_ACCEL_PLANE_OCCLUDERS_H
 #define FR_ACCEL_PLANE_OCCLUDERS_H
+#include <math.h>
 #include <stddef.h>
 #include "frusta.h"
 #include "geom/mesh.h"
@@ -49,21 +50,29 @@ typedef struct fr_plane_occluders {
 fr_error fr_plane_occluders_find(const fr_mesh *m, fr_plane_occluders *out);
 void fr_plane_occluders_free(fr_plane_occluders *p);
 
-/* Relative margin on t: a crossing counts only inside
- * (tnear + FR_PLANE_T_MARGIN * tfar, tfar * (1 - FR_PLANE_T_MARGIN)). */
+/* Margins of a ray's crossing (relative): its origin off the plane by
+ * FR_PLANE_ORG_MARGIN of the magnitudes, t inside (tnear, tfar) by
+ * FR_PLANE_T_MARGIN of t, the point inside the polygon by
+ * FR_PLANE_POINT_MARGIN of the magnitudes that made it (besides the
+ * polygon's own margin). Each is far above the rounding of this test and of
+ * the triangle tests, so the traversal would report the same hit. */
+#define FR_PLANE_ORG_MARGIN 1e-5f
 #define FR_PLANE_T_MARGIN 1e-4f
+#define FR_PLANE_POINT_MARGIN 1e-5f
 
 /* Whether the ray o + t d, t in (tnear, tfar), crosses occluder p inside
- * by the margins (the scalar reference of the kernels' 16-ray test). */
+ * by the margins: the scalar reference of trace/plane_test.h. */
 static inline int fr_plane_occluder_hit(const fr_plane_occluder *p, const float o[3], const float d[3], float tnear,
                                         float tfar) {
   const int a = p->axis, u = (a + 1) % 3, v = (a + 2) % 3;
-  if (!(d[a] != 0.0f)) return 0;
-  const float t = (p->c - o[a]) / d[a];
-  if (!(t > tnear + FR_PLANE_T_MARGIN * tfar && t < tfar * (1.0f - FR_PLANE_T_MARGIN))) return 0;
-  const float pu = o[u] + t * d[u], pv = o[v] + t * d[v];
+  const float toward = p->c - o[a];
+  if (!(fabsf(toward) > FR_PLANE_ORG_MARGIN * (fabsf(o[a]) + fabsf(p->c)))) return 0;
+  const float t = toward / d[a];
+  if (!(t * (1.0f - FR_PLANE_T_MARGIN) > tnear && t * (1.0f + FR_PLANE_T_MARGIN) < tfar)) return 0;
+  const float su = t * d[u], sv = t * d[v], pu = o[u] + su, pv = o[v] + sv;
+  const float err = FR_PLANE_POINT_MARGIN * ((fabsf(o[u]) + fabsf(o[v])) + (fabsf(su) + fabsf(sv)));
   for (int i = 0; i < p->nedges; i++)
-    if (!(p->nu[i] * pu + p->nv[i] * pv <= p->e[i])) return 0;
+    if (!((p->nu[i] * pu + p->nv[i] * pv) + err <= p->e[i])) return 0;
   return 1;
 }
 #endif

@@ -261,7 +261,7 @@ fr_error fr_scene_commit(fr_scene *s) {
       return e;
     }
   }
-  s->bvh2.planes = s->planes.n ? &s->planes : NULL;
+  s->bvh2.planes = s->bvh8.planes = s->bvh4.planes = s->planes.n ? &s->planes : NULL;
   s->bounds = aabb_merge(s->bounds, s->sphere_bvh.bounds);
   s->build_seconds = fr_seconds() - t0;
   s->committed = 1;
@@ -282,6 +282,7 @@ fr_error fr_scene_need_bvh4(fr_scene *s) {
   e = fr_bvhn_from_build(&tree, &s->mesh, 4, &s->bvh4);
   fr_build_tree_free(&tree);
   if (e) return e;
+  s->bvh4.planes = s->planes.n ? &s->planes : NULL;
   fr_scene_apply_prefetch(s);
   return FR_OK;
 }

@@ -36,6 +36,7 @@
 #include "trace/bvhn_node.h"
 #include "trace/counters.h"
 #include "trace/kernels.h"
+#include "trace/plane_test.h"
 #include "trace/tri4_quad.h"
 
 typedef struct packet {
@@ -675,6 +676,29 @@ static void intersect_rays_idx(const fr_bvhn *b, const fr_packet_opts *o, const 
   for (int a = 0; a < 3; a++) vp_scatter(f + 4 + a, si, asked, h.ng[a]);
 }
 
+/* The rays of valid that a planar occluder of the scene occludes
+ * (accel/plane_occluders.h): shadow segments only (finite tfar), each
+ * tested only by occluders whose plane it crosses within its range. Rays
+ * without an end, hemisphere rays above all, cross most planes and seldom
+ * a polygon: testing them cost kitchen ao16 hybrid16 2.3% even with the
+ * polygons' boxes first. */
+static unsigned planes_occluded(const fr_plane_occluders *planes, const packet *pk, const pregs *R, vpf tfar,
+                                unsigned valid) {
+  valid &= vpm_bits(vp_lt(tfar, vp(INFINITY)));
+  if (!valid) return 0;
+  const vpf d[3] = {vp_load(pk->d[0]), vp_load(pk->d[1]), vp_load(pk->d[2])};
+  unsigned occ = 0;
+  for (size_t i = 0; i < planes->n; i++) {
+    const fr_plane_occluder *p = &planes->list[i];
+    const vpf c = vp(p->c), side = vp_sub(R->o[p->axis], c);
+    const vpf end = vp_sub(vp_add(R->o[p->axis], vp_mul(tfar, d[p->axis])), c);
+    if (!(valid & ~occ & vpm_bits(vp_lt(vp_mul(side, end), vp(0.0f))))) continue;
+    occ |= valid & fr_plane_hits(p, R->o, d, R->tnear, tfar);
+  }
+  FR_COUNT(pk_plane_rays, __builtin_popcount(occ));
+  return occ;
+}
+
 static unsigned occluded_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in) {
   packet pk;
   valid = packet_setup(&pk, valid, in);
@@ -696,7 +720,8 @@ static unsigned occluded_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigne
    * its rays hit its box and stay active until occluded. */
   stack_entry stack[STACK_SIZE];
   int sp = 0;
-  unsigned occ = 0;
+  unsigned occ = valid && b->planes ? planes_occluded(b->planes, &pk, &R, tfar, valid) : 0;
+  if (occ == valid) return occ;
   if (valid) stack[sp++] = (stack_entry){b->root, valid, 0, 0.0f, NULL};
   while (sp) {
     sp--;

@@ -29,8 +29,8 @@
 #include "base/simd.h"
 #include "base/simd_packet.h"
 #include "trace/counters.h"
-#include "accel/plane_occluders.h"
 #include "trace/mft.h"
+#include "trace/plane_test.h"
 #include "trace/tri_edges16.h"
 
 #if P != 16
@@ -620,19 +620,8 @@ static unsigned occlude_planes(frusta *F, const fr_plane_occluders *planes, cons
     for (unsigned g = *alive & vpm_bits(vpm_and(cross, meets)); g; g &= g - 1) {
       const int f = __builtin_ctz(g);
       const frustum_dirs D = dirs_of(F, f);
-      const vpf da = a == 0 ? D.x : a == 1 ? D.y : D.z;
-      const vpf du = u == 0 ? D.x : u == 1 ? D.y : D.z, dv = v == 0 ? D.x : v == 1 ? D.y : D.z;
-      const vpf t = vp_div(vp(p->c - F->o[a][f]), da);
-      const float tf = F->tfar[f];
-      vpm in = vpm_and(vp_gt(t, vp(F->tnear[f] + FR_PLANE_T_MARGIN * tf)), vp_lt(t, vp(tf * (1.0f - FR_PLANE_T_MARGIN))));
-      const vpf ou = vp(F->o[u][f]), ov = vp(F->o[v][f]);
-      const vpf su = vp_mul(t, du), sv = vp_mul(t, dv);
-      const vpf pu = vp_add(ou, su), pv = vp_add(ov, sv);
-      /* the hit point's rounding, generously: 1e-5 of the magnitudes summed */
-      const vpf err = vp_mul(vp(1e-5f), vp_add(vp_add(vp_abs(ou), vp_abs(ov)), vp_add(vp_abs(su), vp_abs(sv))));
-      for (int k = 0; k < p->nedges; k++)
-        in = vpm_and(in, vp_le(vp_add(vp_add(vp_mul(vp(p->nu[k]), pu), vp_mul(vp(p->nv[k]), pv)), err), vp(p->e[k])));
-      const unsigned hits = active[f] & vpm_bits(in);
+      const vpf o[3] = {vp(F->o[0][f]), vp(F->o[1][f]), vp(F->o[2][f])}, d[3] = {D.x, D.y, D.z};
+      const unsigned hits = active[f] & fr_plane_hits(p, o, d, vp(F->tnear[f]), vp(F->tfar[f]));
       if (!hits) continue;
       const unsigned bit = 1u << f;
       occ[f] |= (uint16_t)hits;
