@@ -70,9 +70,25 @@ static inline int fr_plane_occluder_hit(const fr_plane_occluder *p, const float 
   const float t = toward / d[a];
   if (!(t * (1.0f - FR_PLANE_T_MARGIN) > tnear && t * (1.0f + FR_PLANE_T_MARGIN) < tfar)) return 0;
   const float su = t * d[u], sv = t * d[v], pu = o[u] + su, pv = o[v] + sv;
+  if (!(pu >= p->lo[0] && pu <= p->hi[0] && pv >= p->lo[1] && pv <= p->hi[1])) return 0;
   const float err = FR_PLANE_POINT_MARGIN * ((fabsf(o[u]) + fabsf(o[v])) + (fabsf(su) + fabsf(sv)));
   for (int i = 0; i < p->nedges; i++)
     if (!((p->nu[i] * pu + p->nv[i] * pv) + err <= p->e[i])) return 0;
   return 1;
+}
+
+/* Whether any occluder of ps claims the ray: shadow segments only (finite
+ * tfar; see the packets' kernel for why), each occluder only if the ray
+ * crosses its plane within its range. The single-ray and ray-stream
+ * kernels' test. */
+static inline int fr_plane_occluders_hit(const fr_plane_occluders *ps, const float o[3], const float d[3],
+                                         float tnear, float tfar) {
+  if (!(tfar < INFINITY)) return 0;
+  for (size_t i = 0; i < ps->n; i++) {
+    const fr_plane_occluder *p = &ps->list[i];
+    const float side = o[p->axis] - p->c, end = o[p->axis] + tfar * d[p->axis] - p->c;
+    if (side * end < 0.0f && fr_plane_occluder_hit(p, o, d, tnear, tfar)) return 1;
+  }
+  return 0;
 }
 #endif

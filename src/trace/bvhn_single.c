@@ -6,6 +6,7 @@
  * (FR_WIDTH) through base/simd.h.
  */
 #include "base/simd.h"
+#include "accel/plane_occluders.h"
 #include "trace/bvhn_single.h"
 #include "trace/kernels.h"
 
@@ -27,6 +28,7 @@ static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
 static int occluded1(const fr_bvhn *b, const fr_ray *ray) {
   FR_COUNT(rays, 1);
   if (fr_ray_invalid(ray)) return 0;
+  if (b->planes && fr_plane_occluders_hit(b->planes, ray->org, ray->dir, ray->tnear, ray->tfar)) return 1;
   ray_pre r;
   ray_setup(&r, ray);
   return any_hit(b, &r, b->root, ray->tfar);
