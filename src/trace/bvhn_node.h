@@ -70,6 +70,23 @@ FR_INLINE void prefetch_ref(const fr_bvhn *b, uint32_t ref) {
   if ((ref & FR_BVHN_LEAF) && FR_BVHN_LEAF_BLOCKS(ref) > 1) __builtin_prefetch(p + 256);
 }
 
+/* The child a walk visits next, all its lines (a node's four, a leaf's
+ * blocks), as Embree's single-ray traversal does: its loads then start
+ * before the ordering and pushes of this node are done, and a leaf's later
+ * blocks do not wait for its first block's test. Hairball diffuse8 single
+ * rays 1.049x (6/6 interleaved pairs, 2 threads, 1024x1024), primary 1.005x;
+ * it rides on b->prefetch, so trees that fit in the caches never pay. */
+FR_INLINE void prefetch_next(const fr_bvhn *b, uint32_t ref) {
+  if (ref & FR_BVHN_LEAF) {
+    const char *p = (const char *)&b->tris[FR_BVHN_LEAF_FIRST(ref)];
+    const uint32_t bytes = (uint32_t)sizeof(fr_tri4) * FR_BVHN_LEAF_BLOCKS(ref);
+    for (uint32_t k = 0; k < bytes; k += 64) __builtin_prefetch(p + k);
+  } else {
+    const char *p = (const char *)((const node_t *)b->nodes + ref);
+    for (int k = 0; k < (int)sizeof(node_t); k += 64) __builtin_prefetch(p + k);
+  }
+}
+
 /* Entries a traversal can have pending: W - 1 per level, and the builder caps
  * the depth (FR_BUILD_MAX_DEPTH plus median splits of at most 2^27 triangles). */
 #define STACK_SIZE ((W - 1) * (FR_BUILD_MAX_DEPTH + 32) + 4)

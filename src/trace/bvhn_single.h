@@ -71,8 +71,10 @@ FR_INLINE int closest(const fr_bvhn *b, const ray_pre *rp, uint32_t root, float 
       if (!mask) goto next;
       int sp0 = sp;
       ref = order_children(n, mask, tn, stack, &sp);
-      if (b->prefetch)
+      if (b->prefetch) {
+        prefetch_next(b, ref);
         for (int i = sp0; i < sp; i++) prefetch_ref(b, stack[i].ref);
+      }
     }
     {
       const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
