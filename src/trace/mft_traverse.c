@@ -535,6 +535,17 @@ FR_INLINE int visit_node(const frusta *F, const fr_bvh2 *b, uint32_t ref, unsign
   return (h0 | h1) != 0;
 }
 
+/* The frusta in `shrink` shrink their bounds to their rays still active
+ * (the paper's "CR"), all at once. */
+FR_INLINE void shrink_to_active(frusta *F, const fr_mft_opts *opt, const fr_mft_sets *T, unsigned shrink,
+                              const unsigned active[16]) {
+  ray_box R;
+  memset(&R, 0, sizeof R);
+  const int intervals = opt->shrink == FR_MFT_SHRINK_ALL;
+  for (unsigned l = shrink; l; l &= l - 1) ray_box_of(F, __builtin_ctz(l), active[__builtin_ctz(l)], &R, intervals);
+  frusta_bounds(F, T, shrink, &R, intervals);
+}
+
 /* A shadow leaf's triangles (leaf reference ref) against the frusta m,
  * rays[f] the rays of frustum f among active[f] that may reach it: the
  * rays they hit join occ[f] and leave active[f], frusta left with none
@@ -575,13 +586,7 @@ FR_INLINE unsigned occlude_leaf(frusta *F, const fr_bvh2 *b, const fr_mft_opts *
     shrink |= hits && !done && eager ? bit : 0u;
   }
   /* the frusta whose rays this leaf occluded some of shrink, all at once */
-  if (shrink) {
-    ray_box R;
-    memset(&R, 0, sizeof R);
-    const int intervals = opt->shrink == FR_MFT_SHRINK_ALL;
-    for (unsigned l = shrink; l; l &= l - 1) ray_box_of(F, __builtin_ctz(l), active[__builtin_ctz(l)], &R, intervals);
-    frusta_bounds(F, T, shrink, &R, intervals);
-  }
+  if (shrink) shrink_to_active(F, opt, T, shrink, active);
   return occluded;
 }
 
@@ -632,13 +637,7 @@ static unsigned occlude_planes(frusta *F, const fr_plane_occluders *planes, cons
     }
   }
   shrink &= *alive;
-  if (shrink) {
-    ray_box R;
-    memset(&R, 0, sizeof R);
-    const int intervals = opt->shrink == FR_MFT_SHRINK_ALL;
-    for (unsigned l = shrink; l; l &= l - 1) ray_box_of(F, __builtin_ctz(l), active[__builtin_ctz(l)], &R, intervals);
-    frusta_bounds(F, T, shrink, &R, intervals);
-  }
+  if (shrink) shrink_to_active(F, opt, T, shrink, active);
   FR_COUNT(mft_plane_rays, occluded);
   return occluded;
 }
