@@ -156,7 +156,12 @@ static void check_rays(const scene_data *sd, vec3 centre, float size, long *clai
     /* the kernels test the occluders themselves: ask one without them */
     fr_bvhn bare = s->bvh8;
     bare.planes = NULL;
-    if (!fr_trace_w8_scalar.occluded1(&bare, &ray)) fail_msg("ray %d claimed by the occluder but not occluded", i);
+    if (!fr_trace_w8_scalar.occluded1(&bare, &ray)) {
+      uint32_t bp;
+      double bm, bt = brute_force(fr_scene_vertices(s), fr_scene_indices(s), fr_scene_triangle_count(s), &ray, &bp, &bm, 1);
+      fail_msg("ray %d claimed by the occluder but not occluded (o %g %g %g d %g %g %g t %g..%g; brute force t %g)", i,
+               ray.org[0], ray.org[1], ray.org[2], ray.dir[0], ray.dir[1], ray.dir[2], ray.tnear, ray.tfar, bt);
+    }
     uint32_t prim;
     double margin;
     if (!isfinite(brute_force(fr_scene_vertices(s), fr_scene_indices(s), fr_scene_triangle_count(s), &ray, &prim, &margin, 1)))
@@ -189,10 +194,28 @@ static void claimed_rays_are_occluded(void **state) {
   }
 }
 
+/* A grid of 131,072 triangles qualifies (the finder is sorts and linear
+ * passes); a disc of 2,000 segments is passed over (its hull has more
+ * vertices than the boundary check takes). */
+static void large_patches(void **state) {
+  (void)state;
+  scene_data sd = {malloc(140000 * 9 * sizeof(float)), malloc(140000 * 3 * sizeof(uint32_t)), 0, 0};
+  add_grid(&sd, 256, -5.0f, -5.0f, 10.0f, 1.0f, -1, -1, 0);
+  fr_plane_occluders p;
+  assert_int_equal(occluders_of(&sd, &p), 1);
+  assert_int_equal(p.list[0].tris, 2 * 256 * 256);
+  fr_plane_occluders_free(&p);
+  sd.nv = sd.nt = 0;
+  add_disc(&sd, 2000, 0.0f, 0.0f, 1.0f, 0.0f);
+  assert_int_equal(occluders_of(&sd, &p), 0);
+  free_scene(&sd);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(which_patches_qualify),
       cmocka_unit_test(claimed_rays_are_occluded),
+      cmocka_unit_test(large_patches),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

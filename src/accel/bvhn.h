@@ -77,8 +77,9 @@ typedef struct fr_bvhn {
    * it, where single rays lose (docs/performance-log.md, "Packets prefetch on
    * a lower bound"). */
   int packet_prefetch;
-  /* the scene's planar occluders, which the packets' any-hit kernel tests
-   * before the tree (accel/plane_occluders.h); NULL: none. Not owned. */
+  /* the scene's planar occluders, which the packets' and single rays'
+   * any-hit kernels test before the tree (accel/plane_occluders.h); NULL:
+   * none. Not owned. */
   const struct fr_plane_occluders *planes;
 } fr_bvhn;
 

@@ -10,6 +10,8 @@
 #include <string.h>
 #include "base/error.h"
 
+#define FR_PLANE_HULL_MAX 1024 /* hull vertices */
+
 /* A triangle of an axis plane: the plane as a sortable key, the triangle. */
 typedef struct plane_tri { int axis; float c; uint32_t tri; } plane_tri;
 
@@ -124,12 +126,17 @@ static int patch_occluder(const fr_mesh *m, int axis, float c, const uint32_t *t
     }
   qsort(es, 3 * n, sizeof *es, edge_cmp);
   size_t nh = hull_of(p, np, h);
-  if (nh < 3) goto done;
-  double diam = 0.0, mag = fabs((double)c);
+  /* the boundary check below is boundary edges times hull edges: finely
+   * curved outlines are passed over rather than slow to prove */
+  if (nh < 3 || nh > FR_PLANE_HULL_MAX) goto done;
+  /* the diameter, within a factor of 1.5: the diagonal of the hull's box */
+  double lo_u = INFINITY, hi_u = -INFINITY, lo_v = INFINITY, hi_v = -INFINITY, mag = fabs((double)c);
   for (size_t i = 0; i < nh; i++) {
+    lo_u = fmin(lo_u, h[i].u); hi_u = fmax(hi_u, h[i].u);
+    lo_v = fmin(lo_v, h[i].v); hi_v = fmax(hi_v, h[i].v);
     mag = fmax(mag, fmax(fabs(h[i].u), fabs(h[i].v)));
-    for (size_t j = i + 1; j < nh; j++) diam = fmax(diam, hypot(h[i].u - h[j].u, h[i].v - h[j].v));
   }
+  const double diam = hypot(hi_u - lo_u, hi_v - lo_v);
   /* Boundary vertices of an outline modelled to a few digits may sit a
    * little inside the hull (kitchen's table top: 2e-5 of 1.5 m); the
    * polygon kept is shrunk by ten times this */

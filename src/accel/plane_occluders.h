@@ -68,7 +68,8 @@ static inline int fr_plane_occluder_hit(const fr_plane_occluder *p, const float 
   const float toward = p->c - o[a];
   if (!(fabsf(toward) > FR_PLANE_ORG_MARGIN * (fabsf(o[a]) + fabsf(p->c)))) return 0;
   const float t = toward / d[a];
-  if (!(t * (1.0f - FR_PLANE_T_MARGIN) > tnear && t * (1.0f + FR_PLANE_T_MARGIN) < tfar)) return 0;
+  const float dt = FR_PLANE_T_MARGIN * fabsf(t);
+  if (!(t - dt > tnear && t + dt < tfar)) return 0;
   const float su = t * d[u], sv = t * d[v], pu = o[u] + su, pv = o[v] + sv;
   if (!(pu >= p->lo[0] && pu <= p->hi[0] && pv >= p->lo[1] && pv <= p->hi[1])) return 0;
   const float err = FR_PLANE_POINT_MARGIN * ((fabsf(o[u]) + fabsf(o[v])) + (fabsf(su) + fabsf(sv)));

@@ -15,7 +15,7 @@ struct fr_scene {
   fr_bvh2 bvh2;
   fr_bvh2 bvh2_mft;     /* the same with leaves of up to FR_MFT_LEAF, for camera frusta (shares bvh2's triangles) */
   fr_bvhn bvh4, bvh8;
-  fr_plane_occluders planes; /* for shadow frusta (accel/plane_occluders.h); bvh2.planes points here */
+  fr_plane_occluders planes; /* for occlusion queries (accel/plane_occluders.h); bvh2, bvh4 and bvh8 point here */
   int single_width;     /* 4 or 8: the BVH fr_intersect1 traverses */
   fr_trace_options trace; /* how packets and streams are traced */
   int committed;

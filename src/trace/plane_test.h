@@ -16,8 +16,8 @@ FR_INLINE unsigned fr_plane_hits(const fr_plane_occluder *p, const vpf o[3], con
   const vpf t = vp_div(toward, d[a]);
   /* the origin clearly off the plane, t inside the range by a margin of itself */
   vpm in = vp_gt(vp_abs(toward), vp_mul(vp(FR_PLANE_ORG_MARGIN), vp_add(vp_abs(o[a]), vp_abs(c))));
-  in = vpm_and(in, vpm_and(vp_gt(vp_mul(t, vp(1.0f - FR_PLANE_T_MARGIN)), tnear),
-                           vp_lt(vp_mul(t, vp(1.0f + FR_PLANE_T_MARGIN)), tfar)));
+  const vpf dt = vp_mul(vp(FR_PLANE_T_MARGIN), vp_abs(t));
+  in = vpm_and(in, vpm_and(vp_gt(vp_sub(t, dt), tnear), vp_lt(vp_add(t, dt), tfar)));
   const vpf su = vp_mul(t, d[u]), sv = vp_mul(t, d[v]);
   const vpf pu = vp_add(o[u], su), pv = vp_add(o[v], sv);
   /* most crossings miss the polygon's box: no edge tests then (they cost
