@@ -211,11 +211,66 @@ static void large_patches(void **state) {
   free_scene(&sd);
 }
 
+/* Ranges that start behind the origin (tnear < 0) find the flat patch
+ * behind it, through every entry point and mode: the box tests' widening
+ * narrowed negative exit distances, and single rays missed it. */
+static void ranges_behind_the_origin(void **state) {
+  (void)state;
+  scene_data sd = new_scene();
+  add_grid(&sd, 8, 0.25f, -0.5f, 1.0f, 0.5f, -1, -1, 0);
+  fr_scene *s = commit_scene(&sd);
+  const mesh_ref m = scene_mesh(s);
+  const fr_trace_mode modes[] = {FR_TRACE_SINGLE, FR_TRACE_PACKET16, FR_TRACE_HYBRID16, FR_TRACE_AUTO, FR_TRACE_RAYSTREAM};
+  fr_rng r = fr_rng_seed(5, 0);
+  enum { N = 64 };
+  fr_ray rays[N];
+  double want[N];
+  for (int i = 0; i < N; i++) {
+    /* above the patch, going up; the patch lies at t in (tnear, 0) */
+    const float x = 0.3f + 0.9f * fr_rng_float(&r), z = -0.45f + 0.9f * fr_rng_float(&r);
+    fr_ray ray = {{x, 0.5f + 0.5f * fr_rng_float(&r), z}, -3.0f, {0.1f * (fr_rng_float(&r) - 0.5f), 1.0f, 0.1f * (fr_rng_float(&r) - 0.5f)}, 2.0f};
+    uint32_t prim;
+    double margin;
+    want[i] = brute_force(m.pos, m.idx, m.nt, &ray, &prim, &margin, 1);
+    assert_true(want[i] < 0.0);
+    rays[i] = ray;
+  }
+  for (size_t k = 0; k < sizeof modes / sizeof modes[0]; k++) {
+    fr_trace_options o;
+    fr_trace_options_default(&o);
+    o.mode = modes[k];
+    assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+    fr_hit hits[N];
+    uint8_t occ[N];
+    fr_intersect_stream(s, rays, hits, N);
+    fr_occluded_stream(s, rays, occ, N);
+    for (int i = 0; i < N; i++) {
+      if (!occ[i] || fabs(hits[i].t - want[i]) > 1e-4) fail_msg("mode %zu ray %d: occ %d t %g, want %g", k, i, occ[i], hits[i].t, want[i]);
+      fr_hit h;
+      fr_intersect1(s, &rays[i], &h);
+      assert_true(fabs(h.t - want[i]) <= 1e-4 && fr_occluded1(s, &rays[i]));
+    }
+    fr_ray16 p;
+    for (int j = 0; j < 16; j++) {
+      p.org_x[j] = rays[j].org[0]; p.org_y[j] = rays[j].org[1]; p.org_z[j] = rays[j].org[2];
+      p.dir_x[j] = rays[j].dir[0]; p.dir_y[j] = rays[j].dir[1]; p.dir_z[j] = rays[j].dir[2];
+      p.tnear[j] = rays[j].tnear; p.tfar[j] = rays[j].tfar;
+    }
+    assert_int_equal(fr_occluded16(s, 0xFFFFu, &p), 0xFFFF);
+    fr_hit16 h16;
+    fr_intersect16(s, 0xFFFFu, &p, &h16);
+    for (int j = 0; j < 16; j++) assert_true(fabs(h16.t[j] - want[j]) <= 1e-4);
+  }
+  fr_scene_release(s);
+  free_scene(&sd);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(which_patches_qualify),
       cmocka_unit_test(claimed_rays_are_occluded),
       cmocka_unit_test(large_patches),
+      cmocka_unit_test(ranges_behind_the_origin),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

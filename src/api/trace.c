@@ -7,6 +7,7 @@
 #endif
 #include "base/error.h"
 #include "scene.h"
+#include "trace/bvh2_reference.h"
 #include "trace/kernels.h"
 #include "trace/sphere_traverse.h"
 
@@ -95,18 +96,44 @@ static fr_ray lane_ray(const fr_ray16 *r, int i) {
   return o;
 }
 
+/* Rays whose range starts behind the origin (tnear < 0) take the scalar
+ * reference traversal: the SIMD kernels' box tests widen an exit distance
+ * tf as tf * (1 + 2^-20), which narrows it when tf < 0, so they could miss
+ * a flat box behind the origin; widening by |tf| there cost single rays 2%
+ * on every ray (docs/performance-log.md, session 53). Such rays are rare. */
+static int behind(const fr_ray *r) { return r->tnear < 0.0f; }
+
+/* (a scene of spheres alone has no triangle tree) */
+static void intersect_behind(const fr_scene *s, const fr_ray *ray, fr_hit *hit) {
+  if (s->bvh2.nprims) fr_bvh2_intersect_reference(&s->bvh2, &s->mesh, ray, hit);
+  else fr_hit_miss(hit);
+}
+
+static int occluded_behind(const fr_scene *s, const fr_ray *ray) {
+  return s->bvh2.nprims && fr_bvh2_occluded_reference(&s->bvh2, &s->mesh, ray);
+}
+
 /* Tracing on an uncommitted scene finds nothing rather than crashing. */
 void fr_intersect1(const fr_scene *s, const fr_ray *ray, fr_hit *hit) {
   if (!s->committed) { fr_hit_miss(hit); return; }
   const fr_bvhn *b;
-  single_fns(s, &b)->intersect1(b, ray, hit);
+  if (behind(ray)) intersect_behind(s, ray, hit);
+  else single_fns(s, &b)->intersect1(b, ray, hit);
   if (has_spheres(s)) fr_spheres_intersect1(&s->sphere_bvh, fr_scene_sphere_base(s), ray, hit);
 }
 
 int fr_occluded1(const fr_scene *s, const fr_ray *ray) {
   if (!s->committed) return 0;
   const fr_bvhn *b;
-  return single_fns(s, &b)->occluded1(b, ray) || (has_spheres(s) && fr_spheres_occluded1(&s->sphere_bvh, ray));
+  return (behind(ray) ? occluded_behind(s, ray) : single_fns(s, &b)->occluded1(b, ray)) ||
+         (has_spheres(s) && fr_spheres_occluded1(&s->sphere_bvh, ray));
+}
+
+/* The lanes of valid whose range starts behind the origin. */
+static unsigned behind16(const fr_ray16 *r, unsigned valid) {
+  unsigned m = 0;
+  for (int i = 0; i < 16; i++) m |= (unsigned)(r->tnear[i] < 0.0f) << i;
+  return m & valid & 0xFFFF;
 }
 
 static void hit16_miss(unsigned valid, fr_hit16 *h) {
@@ -123,7 +150,16 @@ void fr_intersect16(const fr_scene *s, unsigned valid, const fr_ray16 *rays, fr_
   if (!s->committed) { hit16_miss(valid, hits); return; }
   fr_packet_opts po;
   const fr_bvhn *b;
-  packet_fns(s, 16, s->trace.hybrid_threshold, &po, &b)->intersect(b, &po, valid & 0xFFFF, rays, hits);
+  const unsigned back = behind16(rays, valid);
+  packet_fns(s, 16, s->trace.hybrid_threshold, &po, &b)->intersect(b, &po, valid & 0xFFFF & ~back, rays, hits);
+  for (unsigned m = back; m; m &= m - 1) {
+    int i = __builtin_ctz(m);
+    fr_ray r = lane_ray(rays, i);
+    fr_hit h;
+    intersect_behind(s, &r, &h);
+    hits->t[i] = h.t; hits->u[i] = h.u; hits->v[i] = h.v; hits->prim[i] = h.prim;
+    hits->ng_x[i] = h.ng[0]; hits->ng_y[i] = h.ng[1]; hits->ng_z[i] = h.ng[2];
+  }
   if (!has_spheres(s)) return;
   for (unsigned m = valid & 0xFFFF; m; m &= m - 1) {
     int i = __builtin_ctz(m);
@@ -139,7 +175,13 @@ unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays) 
   if (!s->committed) return 0;
   fr_packet_opts po;
   const fr_bvhn *b;
-  unsigned occ = packet_fns(s, 16, s->trace.hybrid_threshold, &po, &b)->occluded(b, &po, valid & 0xFFFF, rays);
+  const unsigned back = behind16(rays, valid);
+  unsigned occ = packet_fns(s, 16, s->trace.hybrid_threshold, &po, &b)->occluded(b, &po, valid & 0xFFFF & ~back, rays);
+  for (unsigned m = back; m; m &= m - 1) {
+    int i = __builtin_ctz(m);
+    fr_ray r = lane_ray(rays, i);
+    occ |= (unsigned)occluded_behind(s, &r) << i;
+  }
   if (has_spheres(s))
     for (unsigned m = valid & 0xFFFF & ~occ; m; m &= m - 1) {
       int i = __builtin_ctz(m);
@@ -345,20 +387,34 @@ static void triangles_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ
   }
 }
 
+/* A stream's rays behind the origin, traced again by the reference (the
+ * stream kernels saw them too: one pass over the stream afterwards keeps
+ * every stream path as it is). */
+static void stream_behind(const fr_scene *s, const fr_ray *rays, uint8_t *occ, fr_hit *hits, size_t n) {
+  for (size_t i = 0; i < n; i++) {
+    if (!behind(&rays[i])) continue;
+    if (hits) intersect_behind(s, &rays[i], &hits[i]);
+    else occ[i] = (uint8_t)occluded_behind(s, &rays[i]);
+  }
+}
+
 void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
   if (!s->committed) { for (size_t i = 0; i < n; i++) fr_hit_miss(&hits[i]); return; }
   triangles_stream(s, rays, NULL, hits, n);
+  stream_behind(s, rays, NULL, hits, n);
   if (has_spheres(s)) spheres_stream(s, rays, hits, n);
 }
 
 void fr_occluded_raystream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
   if (!s->committed) { memset(occ, 0, n); return; }
   octant_trace(s, rays, occ, NULL, n, -1.0f);
+  stream_behind(s, rays, occ, NULL, n);
   if (has_spheres(s)) spheres_occluded_stream(s, rays, occ, n);
 }
 
 void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
   if (!s->committed) { memset(occ, 0, n); return; }
   triangles_stream(s, rays, occ, NULL, n);
+  stream_behind(s, rays, occ, NULL, n);
   if (has_spheres(s)) spheres_occluded_stream(s, rays, occ, n);
 }

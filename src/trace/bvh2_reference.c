@@ -3,8 +3,9 @@
 #include "geom/tri_watertight.h"
 #include "trace/kernels.h"
 
-/* same widening as the SIMD kernels (see bvhn_single.c) */
-#define ROUND_UP (1.0f + 0x1p-20f)
+/* the SIMD kernels' widening (trace/bvhn_node.h), by |tf| so that it
+ * widens behind the origin too: the API sends rays with tnear < 0 here */
+#define WIDEN(tf) ((tf) + fabsf(tf) * 0x1p-20f)
 
 static int box_hit(const fr_bvh2_node *n, int k, vec3 o, vec3 rd, float tnear, float tfar) {
   float lo[3] = {n->lo_x[k], n->lo_y[k], n->lo_z[k]}, hi[3] = {n->hi_x[k], n->hi_y[k], n->hi_z[k]};
@@ -16,7 +17,7 @@ static int box_hit(const fr_bvh2_node *n, int k, vec3 o, vec3 rd, float tnear, f
     tn = t0 > tn ? t0 : tn;
     tf = t1 < tf ? t1 : tf;
   }
-  return tn <= tf * ROUND_UP;
+  return tn <= WIDEN(tf);
 }
 
 static vec3 vertex(const fr_mesh *m, uint32_t prim, int k) { return v3_load(m->pos + 3 * (size_t)m->idx[3 * (size_t)prim + k]); }

@@ -23,7 +23,8 @@ static float box_enter(const fr_bvh2_node *n, int k, const sray *r, float tnear,
     tn = t0 > tn ? t0 : tn;
     tf = t1 < tf ? t1 : tf;
   }
-  return tn <= tf * ROUND_UP ? tn : INFINITY;
+  /* widened by |tf|: ranges may start behind the origin */
+  return tn <= tf + fabsf(tf) * (ROUND_UP - 1.0f) ? tn : INFINITY;
 }
 
 void fr_spheres_hit(const fr_bvh2 *b, uint32_t prim_base, const fr_ray *ray, uint32_t li, float t, fr_hit *hit) {
