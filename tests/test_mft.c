@@ -49,7 +49,7 @@ static void make_shadow_batch(fr_rng *r, const mesh_ref *m, vec3 lc, float eps, 
   }
 }
 
-typedef struct tally { long rays, disagree, excused, cache_filled, plane_rays; } tally;
+typedef struct tally { long rays, disagree, excused, cache_filled, plane_rays, planes_only; } tally;
 
 /* The same rays as 16 packets of 16 (one per frustum), traced as pure packets. */
 static void packet16_occluded(fr_scene *s, const fr_mft_batch *b, const fr_mft_sets *T, uint16_t occ[16]) {
@@ -87,7 +87,7 @@ static void check_shadows_vs(const fr_scene *s, const fr_mft_batch *b, const fr_
         fr_mft_opts o = {corner != 0, shrink, corner == 2 ? fr_mft_opts_default().corner_cost : 0.0f};
         uint16_t occ[16];
         memset(occ, 0xAB, sizeof occ); /* poison: every frustum must be written */
-        fr_mft_budget none = {0, 0, ~0u, -1};
+        fr_mft_budget none = {0, 0, ~0u, -1, 0};
         isa_fns[i]->occluded(&s->bvh2_mft, &o, b, T, occ, &none, NULL);
         assert_true(none.visited != ~0u && none.stopped == 0);
         /* the shadow tree with the scene's planar occluders tested first
@@ -99,6 +99,16 @@ static void check_shadows_vs(const fr_scene *s, const fr_mft_batch *b, const fr_
           isa_fns[i]->occluded(&s->bvh2, &o, b, T, occ_p, NULL, NULL);
           isa_fns[i]->occluded(&bare, &o, b, T, occ_b, NULL, NULL);
           assert_memory_equal(occ_p, occ_b, sizeof occ_p);
+          /* the occluders alone (the fall-back's batches): a stopped batch
+           * whose bits are answers, some of the whole batch's */
+          uint16_t occ_o[16];
+          fr_mft_budget only = {0, 0, 0, 0, 1};
+          isa_fns[i]->occluded(&s->bvh2, &o, b, T, occ_o, &only, NULL);
+          assert_true(only.stopped);
+          for (int f = 0; f < 16; f++) {
+            assert_int_equal(occ_o[f] & ~occ_p[f], 0);
+            tl->planes_only += __builtin_popcount(occ_o[f]);
+          }
         }
         /* occluders cached from the previous batch, and from this batch
          * itself (its best leaves then occlude rays before any traversal),
@@ -411,12 +421,12 @@ static void rays_frusta(void **state) {
       check_shared_origin_occluded(s, &b, &T);
       /* a budget of 3 nodes stops the batch: what it says occluded is */
       uint16_t full[16], part[16];
-      fr_mft_budget all = {0, 0, 0, 0};
+      fr_mft_budget all = {0, 0, 0, 0, 0};
       const fr_mft_opts o = fr_mft_opts_default();
       const unsigned fetched = fr_mft_active()->occluded(&s->bvh2, &o, &b, &T, full, &all, NULL);
       assert_false(all.stopped);
       if (all.visited > 3) {
-        fr_mft_budget budget = {3, 0, 0, 0};
+        fr_mft_budget budget = {3, 0, 0, 0, 0};
         fr_mft_active()->occluded(&s->bvh2, &o, &b, &T, part, &budget, NULL);
         assert_true(budget.stopped);
         assert_int_equal(budget.visited, 3);
@@ -427,11 +437,11 @@ static void rays_frusta(void **state) {
        * spent both, and a budget the whole batch stays within changes
        * nothing */
       if (all.visited > 3 && fetched > 0) {
-        fr_mft_budget both = {3, fetched, 0, 0};
+        fr_mft_budget both = {3, fetched, 0, 0, 0};
         fr_mft_active()->occluded(&s->bvh2, &o, &b, &T, part, &both, NULL);
         assert_true(both.visited >= 3);
         for (int f = 0; f < 16; f++) assert_int_equal(part[f] & ~full[f], 0);
-        fr_mft_budget roomy = {all.visited + 1, fetched + 1, 0, 0};
+        fr_mft_budget roomy = {all.visited + 1, fetched + 1, 0, 0, 0};
         fr_mft_active()->occluded(&s->bvh2, &o, &b, &T, part, &roomy, NULL);
         assert_false(roomy.stopped);
         assert_int_equal(roomy.visited, all.visited);
@@ -660,8 +670,10 @@ static void shared_scenes(void **state) {
   (void)state;
   tally tl = {0};
   int checked = for_each_shared_scene(shared_scene_one, &tl);
-  print_message("shared scenes: %ld rays, %ld disagreements (all at edges or range ends), %ld rays in planar occluders\n",
-                tl.rays, tl.disagree, tl.plane_rays);
+  print_message("shared scenes: %ld rays, %ld disagreements (all at edges or range ends), %ld rays in planar occluders "
+                "(%ld bits from the occluders alone)\n",
+                tl.rays, tl.disagree, tl.plane_rays, tl.planes_only);
+  assert_true(tl.planes_only > 0); /* kitchen's table top */
   assert_true(checked >= 14);
   assert_true(tl.disagree * 1000 < tl.rays);
 }

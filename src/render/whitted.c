@@ -271,7 +271,7 @@ static void trace_shadow_frusta(const fr_workload *w, const fr_tracer *t, const 
     const size_t m = n - a < per ? n - a : per;
     const unsigned valid = fr_mft_active()->from_rays(&b, &T, rays + a, m);
     fr_mft_budget budget = {w->mft_no_fallback ? 0 : SHADOW_FRUSTA_MAX_NODES * (unsigned)__builtin_popcount(valid), 0, 0,
-                            0};
+                            0, 0};
     /* no occluder cache: point-light frusta are thin and end at their first
      * occluder anyway (museum and kitchen whitted measured the same) */
     if (valid) t->occluded_frusta(t->ctx, &b, &T, bits, &budget, NULL);

@@ -164,6 +164,7 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
     }
     rays += 16u * (uint64_t)bits16(b.valid);
     uint16_t occ[FR_MFT_FRUSTA] = {0};
+    const int framed = !as_rays; /* traced as frusta (planar occluders included) */
     if (!as_rays) {
       /* The batch stops as soon as the rule below is sure to send the rest
        * of the tile to ray streams, and its rays still open join them:
@@ -173,7 +174,7 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
        * 7 times their rays' cost as streams; stopping them gained dragon
        * soft16 1.09x, 4/4 interleaved pairs, kitchen 1.00x). */
       const unsigned nf = (unsigned)bits16(b.valid);
-      fr_mft_budget budget = {0, 0, 0, 0};
+      fr_mft_budget budget = {0, 0, 0, 0, 0};
       if (!w->mft_no_fallback) {
         budget.nodes = SOFT_FRUSTA_MAX_NODES * nf + 1;
         budget.tris = SOFT_FRUSTA_MAX_TRIS * nf + 1;
@@ -192,6 +193,12 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
     if (t->occluded_frusta && b.valid) FR_COUNT(mft_ray_batches, 1);
     if (as_streams && b.valid) FR_COUNT(mft_stream_batches, 1);
     if (as_streams) { /* frusta fell back: traced below, but for the rays they found occluded */
+      if (!framed && b.valid) {
+        /* the batches after the tile's verdict: the planar occluders still
+         * end the rays they cover, which the streams would trace */
+        fr_mft_budget planes = {0, 0, 0, 0, 1};
+        t->occluded_frusta(t->ctx, &b, T, occ, &planes, NULL);
+      }
       for (unsigned v = b.valid; v; v &= v - 1) by_rays[16 * j + __builtin_ctz(v)] = 1;
       B->held[nheld] = b;
       memcpy(B->held_occ[nheld], occ, sizeof occ);

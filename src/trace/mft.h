@@ -114,6 +114,10 @@ typedef struct fr_mft_budget {
   unsigned nodes, tris; /* in */
   unsigned visited;     /* out: the inner nodes visited */
   int stopped;          /* out: stopped over budget */
+  /* in: only the tree's planar occluders (accel/plane_occluders.h), no
+   * traversal; the batch then always stops. For batches whose rays go to
+   * ray streams anyway (soft shadows' fall-back), which do not test them. */
+  int planes_only;
 } fr_mft_budget;
 
 typedef struct fr_mft_fns {

@@ -658,6 +658,18 @@ static void best_leaves_add(best_leaves *L, uint32_t ref, unsigned rays) {
   L->rays[i] = rays;
 }
 
+/* fr_mft_budget.planes_only: the planar occluders alone. */
+static void occluded_planes_only(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B,
+                                 const fr_mft_sets *T, uint16_t occ[16]) {
+  const unsigned valid = B->valid & 0xFFFFu;
+  if (!valid || !b->planes) return;
+  frusta F;
+  frusta_setup(&F, B, T, valid);
+  unsigned active[16], alive = valid;
+  for (int f = 0; f < 16; f++) active[f] = (valid >> f) & 1 ? 0xFFFFu : 0;
+  occlude_planes(&F, b->planes, opt, T, active, occ, &alive);
+}
+
 static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B, const fr_mft_sets *T,
                              uint16_t occ[16], fr_mft_budget *budget, fr_mft_occluders *cache) {
   frusta F;
@@ -666,6 +678,11 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
   const int bounded = budget && (budget->nodes || budget->tris);
   for (int f = 0; f < 16; f++) occ[f] = 0;
   if (budget) budget->visited = 0, budget->stopped = 0;
+  if (budget && budget->planes_only) {
+    occluded_planes_only(b, opt, B, T, occ);
+    budget->stopped = 1;
+    return 0;
+  }
   FR_COUNT(mft_batches, 1);
   FR_COUNT(rays, 16 * __builtin_popcount(valid));
   if (!valid || !b->nodes) return 0;
@@ -674,6 +691,8 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
   unsigned active[16];
   for (int f = 0; f < 16; f++) active[f] = (valid >> f) & 1 ? 0xFFFFu : 0;
   unsigned alive = valid;
+  /* the scene's planar occluders first: no fetch, no box test */
+  if (b->planes) occlude_planes(&F, b->planes, opt, T, active, occ, &alive);
   /* The previous batch's best occluders first (see fr_mft_occluders): all
    * active rays, no box test; the traversal then skips those leaves, which
    * every ray still active has missed. What it saves is the traversal of
@@ -683,7 +702,6 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
    * frustum is seldom finished by two leaves). Ranking leaves by the
    * frusta they finished first, or caching only those that finished one,
    * measured the same or worse. */
-  if (b->planes) occlude_planes(&F, b->planes, opt, T, active, occ, &alive);
   best_leaves best = {{0}, {0}, 0};
   uint32_t skip[FR_MFT_OCCLUDERS] = {0};
   const unsigned ncache = cache ? cache->n : 0;
