@@ -80,8 +80,8 @@ static inline int fr_plane_occluder_hit(const fr_plane_occluder *p, const float 
 
 /* Whether any occluder of ps claims the ray: shadow segments only (finite
  * tfar; see the packets' kernel for why), each occluder only if the ray
- * crosses its plane within its range. The single-ray and ray-stream
- * kernels' test. */
+ * crosses its plane within its range. The single-ray kernel's test (ray
+ * streams do not test occluders: per ray it cost them 12%). */
 static inline int fr_plane_occluders_hit(const fr_plane_occluders *ps, const float o[3], const float d[3],
                                          float tnear, float tfar) {
   if (!(tfar < INFINITY)) return 0;

@@ -105,13 +105,13 @@ static void report(const fr_workload *w0, const bench_run *r, const char *scene,
   if (fr_counters_enabled() && c.packets)
     printf("counters tracer=%s mode=%s workload=%s packets=%llu per_packet pk_nodes=%.2f pk_box_tests=%.2f "
            "pk_tri_tests=%.2f pk_quad_tests=%.2f ia_culled=%.2f mailbox_hits=%.2f switches=%.2f avg_active_box=%.2f "
-           "avg_active_tri=%.2f\n",
+           "avg_active_tri=%.2f plane_rays=%.2f\n",
            tracer, mode, fr_workload_name(w0->kind), (unsigned long long)c.packets, (double)c.pk_nodes / c.packets,
            (double)c.pk_box_tests / c.packets, (double)c.pk_tri_tests / c.packets, (double)c.pk_quad_tests / c.packets,
            (double)c.ia_culled / c.packets,
            (double)c.mailbox_hits / c.packets, (double)c.switches / c.packets,
            c.pk_box_tests ? (double)c.pk_box_lanes / c.pk_box_tests : 0.0,
-           c.pk_tri_tests ? (double)c.pk_tri_lanes / c.pk_tri_tests : 0.0);
+           c.pk_tri_tests ? (double)c.pk_tri_lanes / c.pk_tri_tests : 0.0, (double)c.pk_plane_rays / c.packets);
   if (fr_counters_enabled() && c.lp_packets)
     printf("counters tracer=%s mode=%s workload=%s packets=%llu per_packet rays=%.1f nodes=%.2f culled=%.2f "
            "box_chunks=%.2f leaves=%.2f prims=%.2f tris_culled=%.2f tri_chunks=%.2f spheres_culled=%.2f sphere_chunks=%.2f\n",

@@ -112,7 +112,7 @@ int cmd_stats(int argc, char **argv) {
   printf("scene=%s tris=%zu skipped_degenerate=%zu references=%zu threads=%d build_seconds=%.3f\n", s->name, nt,
          fr_scene_skipped_triangles(s), st.references, threads, st.build_seconds);
   printf("bvh2 inner=%zu leaves=%zu sah=%.2f leaf_fill=%.2f\n", st.bvh2_inner, st.bvh2_leaves, st.bvh2_sah, st.bvh2_leaf_fill);
-  /* the planar occluders shadow frusta test first (accel/plane_occluders.h) */
+  /* the planar occluders occlusion queries test first (accel/plane_occluders.h) */
   size_t ptris = 0;
   double parea = 0.0;
   for (size_t i = 0; i < s->planes.n; i++) { ptris += s->planes.list[i].tris; parea += s->planes.list[i].area; }
