@@ -27,7 +27,7 @@ if [ "${1:-}" != "--report" ]; then
   done
   for s in kitchen conference; do
     for wl in ao16 diffuse8; do
-      for t in $(seq 1 16); do bench "sweep t=$t" "$s" --workload "$wl" --mode hybrid16 --threshold "$t"; done
+      for t in $(seq 1 16); do bench "sweep t=$t" "$s" --workload "$wl" --mode hybrid16 --threshold "$t" --hybrid-tune off; done
     done
     for wl in primary shadow ao16; do
       bench "switch mailbox=off aa=on" "$s" --workload "$wl" --mode packet16

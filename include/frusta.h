@@ -176,8 +176,9 @@ int fr_occluded1(const fr_scene *s, const fr_ray *ray);
  * to trace; lanes not in valid are neither read nor written. The packet
  * traverses the BVH together (8-wide by default, see packet_bvh_width) and,
  * when few of its rays are left in a subtree, continues them one by one (the
- * hybrid of Benthin et al.); the threshold is fr_trace_options.hybrid_threshold, or for a
- * packet whose rays share a direction octant coherent_threshold if smaller. Answers agree with
+ * hybrid of Benthin et al.); the threshold is fr_trace_options.hybrid_threshold (or 16, see
+ * hybrid_tune), or for a packet whose rays share a direction octant coherent_threshold if
+ * smaller. Answers agree with
  * fr_intersect1's ray by ray (same t; the packet's triangle test is not
  * watertight, so a ray exactly through a shared edge may report either
  * triangle, or, rarely, miss where fr_intersect1 hits). See
@@ -242,6 +243,11 @@ typedef struct fr_trace_options {
                              rays, 0..16 (default 2, as Embree's coherent packets): FR_TRACE_AUTO's
                              coherent groups, and FR_TRACE_HYBRID16's packets whose rays share a
                              direction octant (those take the smaller of the two thresholds) */
+  int hybrid_tune;        /* 1 (default): FR_TRACE_HYBRID16's and fr_intersect16/fr_occluded16's
+                             packets whose rays span several direction octants switch either at
+                             hybrid_threshold or at once (every ray alone), whichever each thread
+                             has measured to cost fewer cycles per ray on this scene; 0: always at
+                             hybrid_threshold. Only speed depends on the choice */
 } fr_trace_options;
 #define FR_STREAM_SPREAD_DEFAULT 0.1f
 

@@ -33,8 +33,10 @@
 #include <string.h>
 #include "base/simd.h"
 #include "base/simd_packet.h"
+#include "base/timer.h"
 #include "trace/bvhn_node.h"
 #include "trace/counters.h"
+#include "trace/hybrid_tune.h"
 #include "trace/kernels.h"
 #include "trace/plane_test.h"
 #include "trace/tri4_quad.h"
@@ -492,10 +494,30 @@ static void quad_closest(const fr_bvhn *b, uint32_t ref, const quad_rays *q, con
   }
 }
 
-static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in, hit_regs *out) {
+/* Per thread and kernel: the hybrid's threshold for packets of several
+ * direction octants (trace/hybrid_tune.h). */
+static _Thread_local fr_hybrid_tune tune_closest, tune_any;
+
+/* What a packet's timing goes to: the tuner's arm (-1: not tuned) and the
+ * packet's rays. */
+typedef struct tune_arm { int arm; unsigned rays; } tune_arm;
+
+/* The packet's switch threshold, from the tuner where o->tune asks for it. */
+static int packet_threshold(const fr_bvhn *b, const fr_packet_opts *o, const packet *pk, unsigned valid,
+                            fr_hybrid_tune *t, tune_arm *ta) {
+  if (pk->uniform) return o->uniform_threshold;
+  if (!o->tune || !o->hybrid_threshold || !valid) return o->hybrid_threshold;
+  int timed;
+  const int arm = fr_hybrid_tune_pick(t, b, &timed);
+  if (timed) ta->arm = arm, ta->rays = (unsigned)__builtin_popcount(valid);
+  return arm ? P : o->hybrid_threshold;
+}
+
+static void intersect_walk(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in, hit_regs *out,
+                           tune_arm *ta) {
   packet pk;
   valid = packet_setup(&pk, valid, in);
-  const int threshold = pk.uniform ? o->uniform_threshold : o->hybrid_threshold;
+  const int threshold = packet_threshold(b, o, &pk, valid, &tune_closest, ta);
   FR_COUNT(packets, 1);
   FR_COUNT(rays, __builtin_popcount(valid));
   /* Each lane's best triangle (4 * block + lane) as the bits of a float, in
@@ -640,6 +662,15 @@ static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
   finish(b, &pk, B.u, tfar, U, V, out);
 }
 
+static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in, hit_regs *out) {
+  tune_arm ta = {-1, 0};
+  /* the clock read only before a packet the tuner will time */
+  const int due = o->tune && fr_hybrid_tune_due(&tune_closest);
+  const uint64_t t0 = due ? fr_cycles() : 0;
+  intersect_walk(b, o, valid, in, out, &ta);
+  if (due && ta.arm >= 0) fr_hybrid_tune_record(&tune_closest, ta.arm, fr_cycles() - t0, ta.rays);
+}
+
 static void intersect_packet(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const fr_ray16 *in,
                              fr_hit16 *out) {
   rays_in r;
@@ -699,10 +730,11 @@ static unsigned planes_occluded(const fr_plane_occluders *planes, const packet *
   return occ;
 }
 
-static unsigned occluded_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in) {
+static unsigned occluded_walk(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in,
+                              tune_arm *ta) {
   packet pk;
   valid = packet_setup(&pk, valid, in);
-  const int threshold = pk.uniform ? o->uniform_threshold : o->hybrid_threshold;
+  const int threshold = packet_threshold(b, o, &pk, valid, &tune_any, ta);
   FR_COUNT(packets, 1);
   FR_COUNT(rays, __builtin_popcount(valid));
   pregs R;
@@ -783,6 +815,15 @@ static unsigned occluded_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigne
   next:
     if (occ == valid) break;
   }
+  return occ;
+}
+
+static unsigned occluded_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in) {
+  tune_arm ta = {-1, 0};
+  const int due = o->tune && fr_hybrid_tune_due(&tune_any);
+  const uint64_t t0 = due ? fr_cycles() : 0;
+  const unsigned occ = occluded_walk(b, o, valid, in, &ta);
+  if (due && ta.arm >= 0) fr_hybrid_tune_record(&tune_any, ta.arm, fr_cycles() - t0, ta.rays);
   return occ;
 }
 

@@ -175,7 +175,7 @@ int cmd_bench(int argc, char **argv) {
         !strcmp(a, "--packet-width") || !strcmp(a, "--corner-rays") || !strcmp(a, "--shrink") || !strcmp(a, "--mft-leaf") ||
         !strcmp(a, "--corner-cost") || !strcmp(a, "--mft-fallback") ||
         !strcmp(a, "--light-sets") || !strcmp(a, "--prefetch") || !strcmp(a, "--stream-spread") ||
-        !strcmp(a, "--coherent-threshold") || !strcmp(a, "--quad")) {
+        !strcmp(a, "--coherent-threshold") || !strcmp(a, "--quad") || !strcmp(a, "--hybrid-tune")) {
       if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
       const char *val = argv[++i];
       if (!strcmp(a, "--light-sets")) {
@@ -217,7 +217,8 @@ int cmd_bench(int argc, char **argv) {
         if (!cli_parse_int(val, 4, 8, &topt.packet_bvh_width) || (topt.packet_bvh_width != 4 && topt.packet_bvh_width != 8))
           return cli_error(CLI_USAGE_ERROR, "--packet-width is 4 or 8, not '%s'", val);
       } else if (parse_onoff(a, val, !strcmp(a, "--mailbox") ? &topt.mailbox : !strcmp(a, "--ia") ? &topt.ia_cull
-                                     : !strcmp(a, "--quad") ? &topt.quad_leaves : &topt.axis_aligned))
+                                     : !strcmp(a, "--quad") ? &topt.quad_leaves
+                                     : !strcmp(a, "--hybrid-tune") ? &topt.hybrid_tune : &topt.axis_aligned))
         return CLI_USAGE_ERROR;
       continue;
     }

@@ -21,7 +21,7 @@ static void usage(FILE *f) {
           "                       packet2x2 packet4x4 packet8x8 packet16x16 packet32x32\n"
           "         embree modes: single packet4 packet8 packet16 stream\n"
           "         packets:      [--threshold N] [--packet-width 4|8] [--mailbox on|off] [--axis-aligned on|off]\n"
-          "                       [--ia on|off] [--quad on|off]\n"
+          "                       [--ia on|off] [--quad on|off] [--hybrid-tune on|off]\n"
           "         auto:         [--stream-spread S] [--coherent-threshold N] (also hybrid16's one-octant packets)\n"
           "         single rays:  [--prefetch on|off|auto]\n"
           "         multi-frusta: [--light-sets spread|cells] [--corner-rays on|off] [--corner-cost C]\n"
