@@ -247,7 +247,8 @@ typedef struct fr_trace_options {
                              packets whose rays span several direction octants switch either at
                              hybrid_threshold or at once (every ray alone), whichever each thread
                              has measured to cost fewer cycles per ray on this scene; 0: always at
-                             hybrid_threshold. Only speed depends on the choice */
+                             hybrid_threshold. Only speed depends on the choice, and the last
+                             bits of u and v (t and the triangle are fr_intersect1's either way) */
 } fr_trace_options;
 #define FR_STREAM_SPREAD_DEFAULT 0.1f
 

@@ -12,11 +12,13 @@
  * thread keeps, per kernel, the cycles per ray of packets traced with the
  * hybrid threshold (arm 0) and with every ray alone (arm 1), timing one
  * packet in FR_HYBRID_TUNE_TIMED; it traces most packets with the cheaper
- * arm and one in FR_HYBRID_TUNE_EXPLORE with the other, and halves its sums every FR_HYBRID_TUNE_WINDOW packets so that
- * the choice follows a workload's phases. Only speed depends on it: the
- * answers are the single-ray kernel's either way (up to which of two
+ * arm and one in FR_HYBRID_TUNE_EXPLORE (or _FAR) with the other, and
+ * halves its sums every FR_HYBRID_TUNE_WINDOW packets so that the choice
+ * follows a workload's phases. Only speed depends on it: t and the
+ * triangle are the single-ray kernel's either way (up to which of two
  * triangles a ray exactly through their shared edge reports, as for any
- * packet).
+ * packet); u and v may differ in their last bits, the packet test
+ * computing them otherwise than the single-ray phase's watertight test.
  */
 #ifndef FR_TRACE_HYBRID_TUNE_H
 #define FR_TRACE_HYBRID_TUNE_H
@@ -25,8 +27,9 @@
 
 #define FR_HYBRID_TUNE_TIMED 8u /* one packet in so many is timed: two time stamps are ~2% of an AO packet */
 /* One packet in so many tries the other arm (multiples of the above), the
- * second where the other arm measured over 1.1 times as costly: exploring
- * a 1.4 times costlier arm one packet in 64 cost conference ao16 0.6% */
+ * second where the other arm measured over 1.1 times as costly: on
+ * conference ao16, where it costs 1.4 times as much, one packet in 64
+ * comes to 0.6% */
 #define FR_HYBRID_TUNE_EXPLORE 64u
 #define FR_HYBRID_TUNE_EXPLORE_FAR 512u
 #define FR_HYBRID_TUNE_WINDOW 4096u
