@@ -236,6 +236,11 @@ static fr_error convert_tree(fr_scene *s, const fr_build_tree *tree) {
   return FR_OK;
 }
 
+/* What a commit that failed after convert_tree had built. */
+static void free_trees(fr_scene *s) {
+  fr_bvh2_free(&s->bvh2_mft); fr_bvh2_free(&s->bvh2); fr_bvhn_free(&s->bvh4); fr_bvhn_free(&s->bvh8); fr_bvh2_free(&s->sphere_bvh);
+}
+
 fr_error fr_scene_commit(fr_scene *s) {
   if (!s) return fr_fail(FR_ERR_ARG, "fr_scene_commit: scene is NULL");
   if (s->committed) return FR_OK;
@@ -249,7 +254,7 @@ fr_error fr_scene_commit(fr_scene *s) {
   e = convert_tree(s, &tree);
   fr_build_tree_free(&tree);
   if (e) {
-    fr_bvh2_free(&s->bvh2_mft); fr_bvh2_free(&s->bvh2); fr_bvhn_free(&s->bvh4); fr_bvhn_free(&s->bvh8); fr_bvh2_free(&s->sphere_bvh);
+    free_trees(s);
     return e;
   }
   /* FRUSTA_PLANES=off leaves them out, for measurements */
@@ -257,7 +262,7 @@ fr_error fr_scene_commit(fr_scene *s) {
   if (!(pe && !strcmp(pe, "off"))) {
     e = fr_plane_occluders_find(m, &s->planes);
     if (e) {
-      fr_bvh2_free(&s->bvh2_mft); fr_bvh2_free(&s->bvh2); fr_bvhn_free(&s->bvh4); fr_bvhn_free(&s->bvh8); fr_bvh2_free(&s->sphere_bvh);
+      free_trees(s);
       return e;
     }
   }

@@ -140,6 +140,11 @@ static unsigned behind16(const fr_ray16 *r, unsigned valid) {
   return m & valid & 0xFFFF;
 }
 
+static void hit16_set(fr_hit16 *h, int i, const fr_hit *x) {
+  h->t[i] = x->t; h->u[i] = x->u; h->v[i] = x->v; h->prim[i] = x->prim;
+  h->ng_x[i] = x->ng[0]; h->ng_y[i] = x->ng[1]; h->ng_z[i] = x->ng[2];
+}
+
 static void hit16_miss(unsigned valid, fr_hit16 *h) {
   for (unsigned m = valid & 0xFFFF; m; m &= m - 1) {
     int i = __builtin_ctz(m);
@@ -161,8 +166,7 @@ void fr_intersect16(const fr_scene *s, unsigned valid, const fr_ray16 *rays, fr_
     fr_ray r = lane_ray(rays, i);
     fr_hit h;
     intersect_behind(s, &r, &h);
-    hits->t[i] = h.t; hits->u[i] = h.u; hits->v[i] = h.v; hits->prim[i] = h.prim;
-    hits->ng_x[i] = h.ng[0]; hits->ng_y[i] = h.ng[1]; hits->ng_z[i] = h.ng[2];
+    hit16_set(hits, i, &h);
   }
   if (!has_spheres(s)) return;
   for (unsigned m = valid & 0xFFFF; m; m &= m - 1) {
@@ -170,8 +174,7 @@ void fr_intersect16(const fr_scene *s, unsigned valid, const fr_ray16 *rays, fr_
     fr_ray r = lane_ray(rays, i);
     fr_hit h = {hits->t[i], hits->u[i], hits->v[i], hits->prim[i], {hits->ng_x[i], hits->ng_y[i], hits->ng_z[i]}};
     fr_spheres_intersect1(&s->sphere_bvh, fr_scene_sphere_base(s), &r, &h);
-    hits->t[i] = h.t; hits->u[i] = h.u; hits->v[i] = h.v; hits->prim[i] = h.prim;
-    hits->ng_x[i] = h.ng[0]; hits->ng_y[i] = h.ng[1]; hits->ng_z[i] = h.ng[2];
+    hit16_set(hits, i, &h);
   }
 }
 

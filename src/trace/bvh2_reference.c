@@ -3,10 +3,6 @@
 #include "geom/tri_watertight.h"
 #include "trace/kernels.h"
 
-/* the SIMD kernels' widening (trace/bvhn_node.h), by |tf| so that it
- * widens behind the origin too: the API sends rays with tnear < 0 here */
-#define WIDEN(tf) ((tf) + fabsf(tf) * 0x1p-20f)
-
 static int box_hit(const fr_bvh2_node *n, int k, vec3 o, vec3 rd, float tnear, float tfar) {
   float lo[3] = {n->lo_x[k], n->lo_y[k], n->lo_z[k]}, hi[3] = {n->hi_x[k], n->hi_y[k], n->hi_z[k]};
   float oo[3] = {o.x, o.y, o.z}, r[3] = {rd.x, rd.y, rd.z};
@@ -17,7 +13,7 @@ static int box_hit(const fr_bvh2_node *n, int k, vec3 o, vec3 rd, float tnear, f
     tn = t0 > tn ? t0 : tn;
     tf = t1 < tf ? t1 : tf;
   }
-  return tn <= WIDEN(tf);
+  return tn <= fr_widen_exit(tf);
 }
 
 static vec3 vertex(const fr_mesh *m, uint32_t prim, int k) { return v3_load(m->pos + 3 * (size_t)m->idx[3 * (size_t)prim + k]); }

@@ -11,6 +11,12 @@
  * triangle as 4 * leaf block + lane, t as the test computed it. */
 typedef struct fr_subtree_hit { float t, u, v; uint32_t id; } fr_subtree_hit;
 
+/* The scalar traversals' box test (the reference, spheres): an exit
+ * distance widened by 2^-20 of itself, as the SIMD kernels' tf * (1 +
+ * 2^-20) but by |tf|, so that it widens behind the origin too (the API
+ * sends rays with tnear < 0 to the reference). */
+static inline float fr_widen_exit(float tf) { return tf + (tf < 0.0f ? -tf : tf) * 0x1p-20f; }
+
 /* Single-ray kernels for one BVH width. */
 typedef struct fr_trace_fns {
   void (*intersect1)(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit);

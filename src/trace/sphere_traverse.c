@@ -3,7 +3,6 @@
 #include "trace/counters.h"
 #include "trace/kernels.h"
 
-#define ROUND_UP (1.0f + 0x1p-20f)
 #define STACK 128
 
 typedef struct sray { float o[3], rd[3]; } sray;
@@ -23,8 +22,7 @@ static float box_enter(const fr_bvh2_node *n, int k, const sray *r, float tnear,
     tn = t0 > tn ? t0 : tn;
     tf = t1 < tf ? t1 : tf;
   }
-  /* widened by |tf|: ranges may start behind the origin */
-  return tn <= tf + fabsf(tf) * (ROUND_UP - 1.0f) ? tn : INFINITY;
+  return tn <= fr_widen_exit(tf) ? tn : INFINITY;
 }
 
 void fr_spheres_hit(const fr_bvh2 *b, uint32_t prim_base, const fr_ray *ray, uint32_t li, float t, fr_hit *hit) {
