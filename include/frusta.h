@@ -249,6 +249,10 @@ typedef struct fr_trace_options {
                              has measured to cost fewer cycles per ray on this scene; 0: always at
                              hybrid_threshold. Only speed depends on the choice, and the last
                              bits of u and v (t and the triangle are fr_intersect1's either way) */
+  int occluder_cache;     /* 1 (default): FR_TRACE_SINGLE's fr_occluded_stream tests each ray that
+                             ends (finite tfar: shadow rays) against the four triangles that
+                             occluded the stream's last occluded ray before it traverses, while
+                             that keeps paying; 0: never. Answers do not depend on it */
 } fr_trace_options;
 #define FR_STREAM_SPREAD_DEFAULT 0.1f
 

@@ -28,6 +28,7 @@ void fr_trace_options_default(fr_trace_options *o) {
    * coherence sooner and 7 read 4-10% faster; docs/performance-log.md.) */
   o->coherent_threshold = 2;
   o->hybrid_tune = 1;
+  o->occluder_cache = 1;
 }
 
 fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o) {
@@ -44,6 +45,8 @@ fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o) {
   if (o->coherent_threshold < 0 || o->coherent_threshold > 16)
     return fr_fail(FR_ERR_ARG, "coherent threshold %d (0..16)", o->coherent_threshold);
   if (o->hybrid_tune != 0 && o->hybrid_tune != 1) return fr_fail(FR_ERR_ARG, "hybrid tune %d (0 or 1)", o->hybrid_tune);
+  if (o->occluder_cache != 0 && o->occluder_cache != 1)
+    return fr_fail(FR_ERR_ARG, "occluder cache %d (0 or 1)", o->occluder_cache);
   if (o->packet_bvh_width == 4) {
     fr_error e = fr_scene_need_bvh4(s);
     if (e) return e;
@@ -375,7 +378,7 @@ static void triangles_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ
     const fr_bvhn *sb;
     const fr_trace_fns *single = single_fns(s, &sb);
     if (hits) single->intersect_stream(sb, rays, hits, n);
-    else single->occluded_stream(sb, rays, occ, n);
+    else single->occluded_stream(sb, rays, occ, n, s->trace.occluder_cache);
     return;
   }
   case FR_TRACE_AUTO: octant_trace(s, rays, occ, hits, n, s->trace.stream_spread); return;

@@ -93,7 +93,9 @@ FR_INLINE int closest(const fr_bvhn *b, const ray_pre *rp, uint32_t root, float 
   return found;
 }
 
-FR_INLINE int any_hit(const fr_bvhn *b, const ray_pre *rp, uint32_t root, const float tfar) {
+/* Any hit in the subtree at root before tfar: 1 + the index of the block
+ * that has it, or 0. */
+FR_INLINE uint32_t any_hit(const fr_bvhn *b, const ray_pre *rp, uint32_t root, const float tfar) {
   entry stack[STACK_SIZE];
   int sp = 0;
   stack[sp++] = (entry){root, -INFINITY};
@@ -128,7 +130,7 @@ FR_INLINE int any_hit(const fr_bvhn *b, const ray_pre *rp, uint32_t root, const 
         FR_COUNT(tri_tests, 4);
         tri4_result res;
         tri4_test(&b->tris[k], rp, tfar, &res);
-        if (res.mask) return 1;
+        if (res.mask) return k + 1;
       }
     }
   next:;

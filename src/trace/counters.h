@@ -21,14 +21,15 @@
  * prims (triangles and spheres) reached, triangles culled for the whole
  * packet, 16-ray triangle tests. Spheres: single-ray box and sphere tests
  * in the sphere tree (sp_*), spheres culled for a whole large packet,
- * 16-ray sphere tests. */
+ * 16-ray sphere tests. Single-ray streams' occluder cache: rays that tried
+ * their stream's last occluder, and those it occluded (cache_*). */
 #define FR_COUNTER_FIELDS(X)                                                   \
   X(rays) X(nodes) X(box_tests) X(leaves) X(tri_tests)                         \
   X(packets) X(pk_nodes) X(pk_box_tests) X(pk_box_lanes) X(pk_tri_tests)       \
   X(pk_tri_lanes) X(pk_quad_tests) X(ia_culled) X(mailbox_hits) X(switches) X(switch_rays)    \
   X(mft_batches) X(mft_nodes) X(mft_box_tests) X(mft_box_lanes) X(mft_tris)   \
   X(mft_tri_frusta) X(mft_tri_left) X(mft_ray_batches) X(mft_stream_batches) X(mft_cached_leaves)  \
-  X(mft_stopped_batches) X(mft_plane_rays) X(pk_plane_rays)                                   \
+  X(mft_stopped_batches) X(mft_plane_rays) X(pk_plane_rays) X(cache_tries) X(cache_hits)                                   \
   X(lp_packets) X(lp_nodes) X(lp_culled) X(lp_box_chunks) X(lp_leaves) X(lp_tris) \
   X(lp_tri_culled) X(lp_tri_chunks)                                          \
   X(sp_box_tests) X(sp_tests) X(lp_sph_culled) X(lp_sph_chunks)

@@ -88,9 +88,11 @@ static void report(const fr_workload *w0, const bench_run *r, const char *scene,
   }
   fr_counters c = r->c;
   if (fr_counters_enabled() && c.rays)
-    printf("counters tracer=%s mode=%s workload=%s per_ray nodes=%.2f box_tests=%.2f leaves=%.2f tri_tests=%.2f\n", tracer, mode,
-           fr_workload_name(w0->kind), (double)c.nodes / c.rays, (double)c.box_tests / c.rays, (double)c.leaves / c.rays,
-           (double)c.tri_tests / c.rays);
+    printf("counters tracer=%s mode=%s workload=%s per_ray nodes=%.2f box_tests=%.2f leaves=%.2f tri_tests=%.2f "
+           "cache_tries=%llu cache_hits=%llu\n",
+           tracer, mode, fr_workload_name(w0->kind), (double)c.nodes / c.rays, (double)c.box_tests / c.rays,
+           (double)c.leaves / c.rays, (double)c.tri_tests / c.rays, (unsigned long long)c.cache_tries,
+           (unsigned long long)c.cache_hits);
   if (fr_counters_enabled() && c.mft_batches)
     printf("counters tracer=%s mode=%s workload=%s batches=%llu per_batch nodes=%.2f box_tests=%.2f "
            "avg_active_frusta=%.2f tris=%.2f tri_frusta=%.2f tri_frusta_left=%.2f ray_batches=%llu stream_batches=%llu cached_leaves=%llu "
@@ -175,7 +177,8 @@ int cmd_bench(int argc, char **argv) {
         !strcmp(a, "--packet-width") || !strcmp(a, "--corner-rays") || !strcmp(a, "--shrink") || !strcmp(a, "--mft-leaf") ||
         !strcmp(a, "--corner-cost") || !strcmp(a, "--mft-fallback") ||
         !strcmp(a, "--light-sets") || !strcmp(a, "--prefetch") || !strcmp(a, "--stream-spread") ||
-        !strcmp(a, "--coherent-threshold") || !strcmp(a, "--quad") || !strcmp(a, "--hybrid-tune")) {
+        !strcmp(a, "--coherent-threshold") || !strcmp(a, "--quad") || !strcmp(a, "--hybrid-tune") ||
+        !strcmp(a, "--occluder-cache")) {
       if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
       const char *val = argv[++i];
       if (!strcmp(a, "--light-sets")) {
@@ -218,7 +221,8 @@ int cmd_bench(int argc, char **argv) {
           return cli_error(CLI_USAGE_ERROR, "--packet-width is 4 or 8, not '%s'", val);
       } else if (parse_onoff(a, val, !strcmp(a, "--mailbox") ? &topt.mailbox : !strcmp(a, "--ia") ? &topt.ia_cull
                                      : !strcmp(a, "--quad") ? &topt.quad_leaves
-                                     : !strcmp(a, "--hybrid-tune") ? &topt.hybrid_tune : &topt.axis_aligned))
+                                     : !strcmp(a, "--hybrid-tune") ? &topt.hybrid_tune
+                                     : !strcmp(a, "--occluder-cache") ? &topt.occluder_cache : &topt.axis_aligned))
         return CLI_USAGE_ERROR;
       continue;
     }
