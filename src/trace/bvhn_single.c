@@ -52,25 +52,29 @@ static void intersect_stream(const fr_bvhn *b, const fr_ray *rays, fr_hit *hits,
  * box tests would have entered), a miss costs one block test. Rays without
  * an end (ambient occlusion, bounces) spread over the hemisphere: kitchen
  * ao16 hit 28% of its tries but ran 0.956x, as its traversals are short.
- * Where it stops paying, fewer than one in CACHE_MIN_RATE of a window of
- * CACHE_WINDOW tries hitting (dragon soft16: 1% of its tries hit, 0.980x
- * without this rule), the stream stops trying for CACHE_PAUSE rays.
+ * Where the block seldom occludes the next ray (dragon soft16: 1% of its
+ * tries hit, 0.980x when every ray tried), the stream's first CACHE_PROBE
+ * tries decide: fewer than one in CACHE_MIN_RATE hitting turns the cache
+ * off for the rest of the stream, or of its CACHE_PERIOD rays when it is
+ * longer (the workloads pass a tile's rays, up to 4,096, as one stream). Pausing after each failing window of 64 tries
+ * instead kept dragon at 0.994x but cut the hairball's gain to 1.018x: its
+ * hits come in bursts, pixel by pixel, after stretches of misses.
  * Interleaved pairs, 2 threads, 1024x1024, single rays, on against off (3
- * pairs each, docs/performance-log.md): conference soft16 1.235x, shadow
- * 1.073x, sibenik soft16 1.148x, hairball soft16 1.077x, shadow 1.055x,
- * kitchen soft16 1.020x, dragon soft16 0.990x (its pauses' windows). Doubling
- * the pause after each failed window in a row brought dragon to 0.996x but
- * cost the hairball, whose windows fail now and then, most of its gain. */
-#define CACHE_WINDOW 64u
+ * pairs each, docs/performance-log.md): conference soft16 1.234x, shadow
+ * 1.095x, sibenik soft16 1.149x, hairball soft16 1.046x, shadow 1.061x,
+ * kitchen soft16 1.031x, shadow 1.029x, dragon soft16 1.011x, shadow
+ * 0.991x. */
+#define CACHE_PROBE 64u
 #define CACHE_MIN_RATE 16u
-#define CACHE_PAUSE 1024u
+#define CACHE_PERIOD 4096u
 
 static void occluded_stream(const fr_bvhn *b, const fr_ray *rays, uint8_t *occ, size_t n, int cache) {
   uint32_t last = 0; /* 1 + the block that occluded the last ray the traversal found occluded */
   unsigned tries = 0, hits = 0;
-  size_t resume = 0;
+  const int wanted = cache;
   for (size_t i = 0; i < n; i++) {
     const fr_ray *ray = &rays[i];
+    if (i % CACHE_PERIOD == 0) cache = wanted, tries = hits = 0; /* a long stream decides again */
     FR_COUNT(rays, 1);
     occ[i] = 0;
     if (fr_ray_invalid(ray)) continue;
@@ -80,20 +84,18 @@ static void occluded_stream(const fr_bvhn *b, const fr_ray *rays, uint8_t *occ, 
     }
     ray_pre r;
     ray_setup(&r, ray);
-    if (last && ray->tfar < INFINITY && i >= resume) {
+    if (last && ray->tfar < INFINITY) {
       tri4_result res;
-      FR_COUNT(cache_tries, 1);
       tri4_test(&b->tris[last - 1], &r, ray->tfar, &res);
-      tries++;
-      if (res.mask) {
-        FR_COUNT(cache_hits, 1);
+      FR_COUNT(cache_tries, 1);
+      const unsigned hit = res.mask != 0;
+      FR_COUNT(cache_hits, hit);
+      hits += hit;
+      /* the stream's first CACHE_PROBE tries decide for the rest of it */
+      if (++tries == CACHE_PROBE && hits * CACHE_MIN_RATE < tries) cache = 0, last = 0;
+      if (hit) {
         occ[i] = 1;
-        hits++;
         continue;
-      }
-      if (tries == CACHE_WINDOW) {
-        if (hits * CACHE_MIN_RATE < tries) resume = i + CACHE_PAUSE;
-        tries = hits = 0;
       }
     }
     const uint32_t k = any_hit(b, &r, b->root, ray->tfar);
