@@ -25,13 +25,20 @@ static void intersect1(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit) {
     fr_hit_finish(b, &best, v3_load(ray->org), v3_load(ray->dir), ray->tnear, ray->tfar, hit);
 }
 
-static int occluded1(const fr_bvhn *b, const fr_ray *ray) {
+/* A ray's occlusion where no traversal is needed: 0 for an invalid ray, 1
+ * where a planar occluder blocks it; else -1, with *r set up. */
+static inline int occluded_before(const fr_bvhn *b, const fr_ray *ray, ray_pre *r) {
   FR_COUNT(rays, 1);
   if (fr_ray_invalid(ray)) return 0;
   if (b->planes && fr_plane_occluders_hit(b->planes, ray->org, ray->dir, ray->tnear, ray->tfar)) return 1;
+  ray_setup(r, ray);
+  return -1;
+}
+
+static int occluded1(const fr_bvhn *b, const fr_ray *ray) {
   ray_pre r;
-  ray_setup(&r, ray);
-  return any_hit(b, &r, b->root, ray->tfar) != 0;
+  const int known = occluded_before(b, ray, &r);
+  return known >= 0 ? known : any_hit(b, &r, b->root, ray->tfar) != 0;
 }
 
 static int occluded_subtree(const fr_bvhn *b, uint32_t ref, const fr_ray *ray) {
@@ -56,9 +63,10 @@ static void intersect_stream(const fr_bvhn *b, const fr_ray *rays, fr_hit *hits,
  * tries hit, 0.980x when every ray tried), the stream's first CACHE_PROBE
  * tries decide: fewer than one in CACHE_MIN_RATE hitting turns the cache
  * off for the rest of the stream, or of its CACHE_PERIOD rays when it is
- * longer (the workloads pass a tile's rays, up to 4,096, as one stream). Pausing after each failing window of 64 tries
- * instead kept dragon at 0.994x but cut the hairball's gain to 1.018x: its
- * hits come in bursts, pixel by pixel, after stretches of misses.
+ * longer (the workloads pass a tile's rays, up to 4,096, as one stream).
+ * Pausing after each failing window of 64 tries instead kept dragon at
+ * 0.994x but cut the hairball's gain to 1.018x: its hits come in bursts,
+ * pixel by pixel, after stretches of misses.
  * Interleaved pairs, 2 threads, 1024x1024, single rays, on against off (3
  * pairs each, docs/performance-log.md): conference soft16 1.234x, shadow
  * 1.095x, sibenik soft16 1.149x, hairball soft16 1.046x, shadow 1.061x,
@@ -75,15 +83,12 @@ static void occluded_stream(const fr_bvhn *b, const fr_ray *rays, uint8_t *occ, 
   for (size_t i = 0; i < n; i++) {
     const fr_ray *ray = &rays[i];
     if (i % CACHE_PERIOD == 0) cache = wanted, tries = hits = 0; /* a long stream decides again */
-    FR_COUNT(rays, 1);
-    occ[i] = 0;
-    if (fr_ray_invalid(ray)) continue;
-    if (b->planes && fr_plane_occluders_hit(b->planes, ray->org, ray->dir, ray->tnear, ray->tfar)) {
-      occ[i] = 1;
+    ray_pre r;
+    const int known = occluded_before(b, ray, &r);
+    if (known >= 0) {
+      occ[i] = (uint8_t)known;
       continue;
     }
-    ray_pre r;
-    ray_setup(&r, ray);
     if (last && ray->tfar < INFINITY) {
       tri4_result res;
       tri4_test(&b->tris[last - 1], &r, ray->tfar, &res);
@@ -91,7 +96,7 @@ static void occluded_stream(const fr_bvhn *b, const fr_ray *rays, uint8_t *occ, 
       const unsigned hit = res.mask != 0;
       FR_COUNT(cache_hits, hit);
       hits += hit;
-      /* the stream's first CACHE_PROBE tries decide for the rest of it */
+      /* the first CACHE_PROBE tries decide for the rest of the period */
       if (++tries == CACHE_PROBE && hits * CACHE_MIN_RATE < tries) cache = 0, last = 0;
       if (hit) {
         occ[i] = 1;
