@@ -110,28 +110,29 @@ static void check_scene(fr_scene *s, const fr_view *v) {
   free(one);
 }
 
+/* Commits s, checks it from its own view, and releases it. */
+static void check_and_release(fr_scene *s) {
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  fr_view v;
+  if (!fr_view_lookup(s->name, &v)) fail_msg("%s: no view", s->name);
+  check_scene(s, &v);
+  fr_scene_release(s);
+}
+
 static void builtin_scene(void **st) {
   (void)st;
   fr_scene *s;
   assert_int_equal(fr_scene_builtin(&s), FR_OK);
-  assert_int_equal(fr_scene_commit(s), FR_OK);
-  fr_view v;
-  assert_true(fr_view_lookup(s->name, &v));
   tally_tries = tally_hits = 0;
-  check_scene(s, &v);
+  check_and_release(s);
   check_tally();
-  fr_scene_release(s);
 }
 
 static void shared_one(const char *path, void *ctx) {
   (void)ctx;
   fr_scene *s;
   if (fr_scene_load(path, &s) != FR_OK) fail_msg("%s: %s", path, fr_last_error());
-  assert_int_equal(fr_scene_commit(s), FR_OK);
-  fr_view v;
-  if (!fr_view_lookup(s->name, &v)) fail_msg("%s: no view", s->name);
-  check_scene(s, &v);
-  fr_scene_release(s);
+  check_and_release(s);
 }
 
 static void shared_scenes(void **st) {
