@@ -22,6 +22,7 @@ typedef struct conv {
    * subtree's area is one difference; NULL keeps the collapse's slot order
    * (FRUSTA_CHILD_ORDER=tree, for measurements). */
   double *area;
+  int too_many; /* more nodes than a ref can address */
 } conv;
 
 static void fill_block(conv *c, fr_tri4 *blk, uint32_t first, uint32_t count) {
@@ -87,8 +88,8 @@ static int leaf_pays(conv *c, const fr_build_node *n) {
 }
 
 /* Node i's float arrays (generic over the width). */
-static float *node_floats(conv *c, uint32_t i) { return (float *)((char *)c->b->nodes + (size_t)i * c->node_bytes); }
-static uint32_t *node_children(conv *c, uint32_t i) { return (uint32_t *)(node_floats(c, i) + 6 * c->b->width); }
+static float *node_floats(conv *c, uint32_t ref) { return (float *)((char *)c->b->nodes + (size_t)ref * FR_BVHN_NODE_UNIT); }
+static uint32_t *node_children(conv *c, uint32_t ref) { return (uint32_t *)(node_floats(c, ref) + 6 * c->b->width); }
 
 /* Any-hit traversal stops at the first triangle hit, so it pays to try
  * first the children that most likely hold one per unit of work: for a
@@ -145,7 +146,9 @@ static fr_error area_prefix(conv *c) {
 static uint32_t convert(conv *c, int32_t bi, int depth);
 static uint32_t emit_node(conv *c, int32_t *kids, int nk, int depth) {
   const int W = c->b->width;
-  uint32_t self = (uint32_t)c->b->nnodes++;
+  const size_t index = c->b->nnodes++;
+  if ((index + 1) * (c->node_bytes / FR_BVHN_NODE_UNIT) > FR_BVHN_LEAF) c->too_many = 1;
+  const uint32_t self = c->too_many ? 0 : (uint32_t)(index * (c->node_bytes / FR_BVHN_NODE_UNIT));
   if (c->area) order_for_occlusion(c, kids, nk);
   float *f = node_floats(c, self);
   uint32_t *child = node_children(c, self);
@@ -301,7 +304,7 @@ fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width,
   const char *env = getenv("FRUSTA_LEAF_BLOCKS");
   int mb = FR_BVHN_DEFAULT_LEAF_BLOCKS;
   if (env && env[0] >= '1' && env[0] <= '0' + FR_BVHN_MAX_LEAF_BLOCKS && !env[1]) mb = env[0] - '0';
-  conv c = {t, m, out, node_bytes, mb, NULL, NULL, NULL, 1, NULL};
+  conv c = {t, m, out, node_bytes, mb, NULL, NULL, NULL, 1, NULL, 0};
   const char *how = getenv("FRUSTA_COLLAPSE"); /* greedy: the old rule, for measurements */
   if ((how && !strcmp(how, "greedy")) || !t->nprims) c.dp = 0; /* no triangles: one empty leaf */
   const char *order = getenv("FRUSTA_CHILD_ORDER"); /* tree: the collapse's order, for measurements */
@@ -312,6 +315,10 @@ fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width,
   if (c.dp) plan_node(&c, 0);
   out->root = convert(&c, 0, 1);
   free(c.row); fr_free_aligned(c.cost); free(c.pick); free(c.area);
+  if (c.too_many) {
+    fr_bvhn_free(out);
+    return fr_fail(FR_ERR_ARG, "BVH%d: %zu triangles need more nodes than a node reference can address", width, t->nprims);
+  }
   out->prefetch = fr_bvhn_prefetch_auto(out);
   out->packet_prefetch = fr_bvhn_packet_prefetch_auto(out);
   return FR_OK;

@@ -15,9 +15,15 @@
 #include "geom/mesh.h"
 #include "geom/tri_shevtsov.h"
 
-/* A child ref is a node index, or FR_BVHN_LEAF | (blocks - 1) << 28 | the
- * index of the leaf's first tri4 block; its blocks are consecutive. */
+/* A child ref is a node's byte offset in the node array in units of
+ * FR_BVHN_NODE_UNIT, or FR_BVHN_LEAF | (blocks - 1) << 28 | the index of the
+ * leaf's first tri4 block; its blocks are consecutive. An offset rather
+ * than an index so that a node's address is one scaled-index addressing
+ * mode (base + ref * 8) rather than a shift and an add on the path from a
+ * node's child load to the next node's loads. */
 #define FR_BVHN_LEAF 0x80000000u
+#define FR_BVHN_NODE_UNIT 8u
+#define FR_BVHN_NODE_AT(b, ref) ((const void *)((const char *)(b)->nodes + (size_t)(ref) * FR_BVHN_NODE_UNIT))
 #define FR_BVHN_EMPTY 0x7FFFFFFFu  /* unused slot; its box is inverted and never hit */
 #define FR_BVHN_MAX_LEAF_BLOCKS 8
 /* The most blocks the builder puts in a leaf; it ends a node of up to 12

@@ -608,7 +608,7 @@ static void intersect_walk(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
       }
       continue;
     }
-    const node_t *n = (const node_t *)b->nodes + ref;
+    const node_t *n = (const node_t *)FR_BVHN_NODE_AT(b, ref);
     const float *f = (const float *)n;
     FR_COUNT(pk_nodes, 1);
     int nc = (int)n->nchildren;
@@ -791,7 +791,7 @@ static unsigned occluded_walk(const fr_bvhn *b, const fr_packet_opts *o, unsigne
         active &= ~hit;
       }
     } else {
-      const node_t *n = (const node_t *)b->nodes + ref;
+      const node_t *n = (const node_t *)FR_BVHN_NODE_AT(b, ref);
       const float *f = (const float *)n;
       FR_COUNT(pk_nodes, 1);
       int cand = (1 << n->nchildren) - 1;

@@ -65,7 +65,7 @@ FR_INLINE int closest(const fr_bvhn *b, const ray_pre *rp, uint32_t root, float 
     if (top.dist > tfar * ROUND_UP) continue;
     uint32_t ref = top.ref;
     while (!(ref & FR_BVHN_LEAF)) {
-      const node_t *n = (const node_t *)b->nodes + ref;
+      const node_t *n = (const node_t *)FR_BVHN_NODE_AT(b, ref);
       int mask;
       vnode tn = visit_node(n, rp, tfar, &mask);
       if (!mask) goto next;
@@ -102,7 +102,7 @@ FR_INLINE uint32_t any_hit(const fr_bvhn *b, const ray_pre *rp, uint32_t root, c
   while (sp) {
     uint32_t ref = stack[--sp].ref;
     while (!(ref & FR_BVHN_LEAF)) {
-      const node_t *n = (const node_t *)b->nodes + ref;
+      const node_t *n = (const node_t *)FR_BVHN_NODE_AT(b, ref);
       int mask;
       (void)visit_node(n, rp, tfar, &mask);
       if (!mask) goto next;

@@ -117,7 +117,7 @@ static uint64_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint3
     if (!m) continue;
     uint32_t ref = top.ref;
     while (!(ref & FR_BVHN_LEAF)) {
-      const node_t *nd = (const node_t *)b->nodes + ref;
+      const node_t *nd = (const node_t *)FR_BVHN_NODE_AT(b, ref);
       uint64_t child_rays[8];
       int hit = stream_node(nd, pre, tfar, m, uniform, child_rays, NULL, NULL);
       if (!hit) goto next;
@@ -198,7 +198,7 @@ static void intersect_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t
     uint32_t ref = top.ref;
     while (!(ref & FR_BVHN_LEAF)) {
       if (!(m & (m - 1))) goto single;
-      const node_t *nd = (const node_t *)b->nodes + ref;
+      const node_t *nd = (const node_t *)FR_BVHN_NODE_AT(b, ref);
       uint64_t child_rays[8];
       float min_tn[W] __attribute__((aligned(32))), mean_tn[W] __attribute__((aligned(32)));
       int hit = stream_node(nd, pre, tfar, m, uniform, child_rays, min_tn, mean_tn);
