@@ -118,7 +118,7 @@ FR_INLINE uint32_t any_hit(const fr_bvhn *b, const ray_pre *rp, uint32_t root, c
         ref = n->child[last];
         for (int m = mask & ~(1 << last); m; m &= m - 1) {
           uint32_t c = n->child[__builtin_ctz(m)];
-          if (b->prefetch) prefetch_ref(b, c);
+          if (b->anyhit_prefetch) prefetch_ref(b, c);
           stack[sp++] = (entry){c, 0.0f};
         }
       }
