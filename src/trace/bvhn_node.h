@@ -50,9 +50,13 @@ typedef vfloat4 vnode;
 #endif
 #define W FR_WIDTH
 
-/* Starts loading a pushed child while the nearer one is traversed: a node's
- * four lines and a block's three come as two pairs (the adjacent-line
- * prefetcher fetches 128-byte pairs). Prefetch on against off, same binary,
+/* Starts loading a pushed child while the nearer one is traversed: its first
+ * four lines, a node's all or a leaf's first block and a half. Until
+ * session 56 only every other line was prefetched, on the thought that the
+ * adjacent-line prefetcher fetches 128-byte pairs; all four measured, same
+ * binary, interleaved, 2 threads, 1024x1024: single rays hairball soft16
+ * 1.038x, dragon ao16 1.019x; auto mode hairball diffuse8 1.030x, ao16
+ * 1.032x; packet16 primary 0.994-1.003x. Prefetch on against off, same binary,
  * interleaved, 1 thread, 512x512, mean of 5 pairs: hairball (183 MB) shadow
  * +9%, diffuse8 +8%, ao16 +4%; dragon (55 MB) diffuse8 +3%, ao16 +4%, but
  * shadow -9% (coherent rays find the tree in the caches); kitchen, which
@@ -65,9 +69,9 @@ FR_INLINE void prefetch_ref(const fr_bvhn *b, uint32_t ref) {
   const char *p = (ref & FR_BVHN_LEAF) ? (const char *)&b->tris[FR_BVHN_LEAF_FIRST(ref)]
                                        : (const char *)((const node_t *)FR_BVHN_NODE_AT(b, ref));
   __builtin_prefetch(p);
+  __builtin_prefetch(p + 64);
   __builtin_prefetch(p + 128);
-  /* a leaf's second block ends at byte 320 */
-  if ((ref & FR_BVHN_LEAF) && FR_BVHN_LEAF_BLOCKS(ref) > 1) __builtin_prefetch(p + 256);
+  __builtin_prefetch(p + 192);
 }
 
 /* The child a walk visits next, all its lines (a node's four, a leaf's
