@@ -232,9 +232,9 @@ typedef struct fr_trace_options {
                              four triangles at once, with the single-ray kernel's watertight test
                              (default on, see docs/performance-log.md) */
   int prefetch;           /* rays and packets prefetch the children they defer: 1 on, 0 off, -1
-                             (default) on for rays when the BVH and triangles exceed 64 MB (32 MB
-                             for single rays' any-hit walks), for packets when the BVH and their
-                             triangle records exceed 32 MB (see docs/performance-log.md) */
+                             (default) on for rays when the BVH and triangles exceed 32 MB, for
+                             packets when the BVH and their triangle records exceed 32 MB (see
+                             docs/performance-log.md) */
   float stream_spread;    /* FR_TRACE_AUTO: a group of 16 goes as a packet when its unit directions
                              lie within this distance of its first ray's (probed at 3 rays), else
                              in a ray stream; 0..2: 0 streams every group, 2 none (default

@@ -321,18 +321,12 @@ fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width,
   }
   out->prefetch = fr_bvhn_prefetch_auto(out);
   out->packet_prefetch = fr_bvhn_packet_prefetch_auto(out);
-  out->anyhit_prefetch = fr_bvhn_anyhit_prefetch_auto(out);
   return FR_OK;
 }
 
 int fr_bvhn_prefetch_auto(const fr_bvhn *b) {
   size_t node_bytes = b->width == 4 ? sizeof(fr_bvh4_node) : sizeof(fr_bvh8_node);
   return b->nnodes * node_bytes + b->nblocks * sizeof(fr_tri4) > FR_BVHN_PREFETCH_BYTES;
-}
-
-int fr_bvhn_anyhit_prefetch_auto(const fr_bvhn *b) {
-  size_t node_bytes = b->width == 4 ? sizeof(fr_bvh4_node) : sizeof(fr_bvh8_node);
-  return b->nnodes * node_bytes + b->nblocks * sizeof(fr_tri4) > FR_BVHN_ANYHIT_PREFETCH_BYTES;
 }
 
 int fr_bvhn_packet_prefetch_auto(const fr_bvhn *b) {

@@ -74,17 +74,14 @@ typedef struct fr_bvhn {
   /* Traversals prefetch the children they push (trace/bvhn_node.h). That
    * hides memory latency once the tree outgrows the caches and only costs
    * instructions while it fits: by default (fr_bvhn_prefetch_auto) it is on
-   * above FR_BVHN_PREFETCH_BYTES. */
+   * above FR_BVHN_PREFETCH_BYTES, this host's L3. Single rays on dragon (48
+   * MB), on against off, same binary (3/3 interleaved pairs each, 2
+   * threads, 1024x1024): primary 1.020x and 1.018x, diffuse8 1.016x,
+   * specular8 1.014x (2/3), ao16 1.023x, soft16 1.016x, shadow 1.006x;
+   * below it, conference primary 0.970x and shadow 0.965x, kitchen shadow
+   * 0.976x. The bound was 64 MB while only every other line of a deferred
+   * child was prefetched, which cost dragon's primary and diffuse8 rays. */
   int prefetch;
-  /* The same for the single-ray any-hit walks, on above
-   * FR_BVHN_ANYHIT_PREFETCH_BYTES (fr_bvhn_anyhit_prefetch_auto): an any-hit
-   * walk visits every child it defers unless it ends first, where a
-   * closest-hit walk skips those its shortened ray no longer reaches, so
-   * prefetching them pays in smaller trees. Dragon (48 MB), single rays,
-   * on against off (3/3 interleaved pairs each, 2 threads, 1024x1024):
-   * ao16 1.023x, soft16 1.016x, shadow 1.006x; its primary and diffuse8
-   * rays lost 3-5% with it (session 55). */
-  int anyhit_prefetch;
   /* The same for the packet kernels, whose leaves read the Shevtsov
    * records: on by default (fr_bvhn_packet_prefetch_auto) above
    * FR_BVHN_PACKET_PREFETCH_BYTES of nodes and records. Dragon (55 MB of
@@ -98,9 +95,8 @@ typedef struct fr_bvhn {
   const struct fr_plane_occluders *planes;
 } fr_bvhn;
 
-#define FR_BVHN_PREFETCH_BYTES ((size_t)64 << 20)
+#define FR_BVHN_PREFETCH_BYTES ((size_t)32 << 20)
 #define FR_BVHN_PACKET_PREFETCH_BYTES ((size_t)32 << 20)
-#define FR_BVHN_ANYHIT_PREFETCH_BYTES ((size_t)32 << 20)
 
 typedef struct fr_bvhn_stats {
   size_t inner, leaves, node_bytes, tri_bytes;
@@ -116,7 +112,6 @@ fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width,
 void fr_bvhn_free(fr_bvhn *b);
 int fr_bvhn_prefetch_auto(const fr_bvhn *b);
 int fr_bvhn_packet_prefetch_auto(const fr_bvhn *b);
-int fr_bvhn_anyhit_prefetch_auto(const fr_bvhn *b);
 /* SAH with a node visit (one SIMD box test) costing 1, and a triangle test or
  * a block test costing 1. */
 void fr_bvhn_stats_get(const fr_bvhn *b, fr_bvhn_stats *st);

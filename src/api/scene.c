@@ -29,7 +29,6 @@ void fr_scene_apply_prefetch(fr_scene *s) {
   for (int i = 0; i < 2; i++) {
     b[i]->prefetch = s->trace.prefetch < 0 ? fr_bvhn_prefetch_auto(b[i]) : s->trace.prefetch;
     b[i]->packet_prefetch = s->trace.prefetch < 0 ? fr_bvhn_packet_prefetch_auto(b[i]) : s->trace.prefetch;
-    b[i]->anyhit_prefetch = s->trace.prefetch < 0 ? fr_bvhn_anyhit_prefetch_auto(b[i]) : s->trace.prefetch;
   }
 }
 

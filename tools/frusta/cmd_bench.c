@@ -280,12 +280,11 @@ int cmd_bench(int argc, char **argv) {
     return cli_error(1, "%s", fr_last_error());
   }
   const int prefetch = (st.single_width == 4 ? &s->bvh4 : &s->bvh8)->prefetch;
-  const int anyhit_prefetch = (st.single_width == 4 ? &s->bvh4 : &s->bvh8)->anyhit_prefetch;
   const int packet_prefetch = (topt.packet_bvh_width == 4 ? &s->bvh4 : &s->bvh8)->packet_prefetch;
   printf("build_seconds=%.3f tracer=frusta scene=%s tris=%zu threads=%d isa=%s bvh_width=%d sah=%.2f bytes_per_tri=%.1f "
-         "prefetch=%s anyhit_prefetch=%s packet_bvh_width=%d packet_bytes_per_tri=%.1f packet_prefetch=%s\n",
+         "prefetch=%s packet_bvh_width=%d packet_bytes_per_tri=%.1f packet_prefetch=%s\n",
          st.build_seconds, s->name, tris, threads, fr_isa_name(fr_get_isa()), st.single_width, ws->sah,
-         (double)(ws->node_bytes + ws->tri_bytes) / (double)tris, prefetch ? "on" : "off", anyhit_prefetch ? "on" : "off", topt.packet_bvh_width,
+         (double)(ws->node_bytes + ws->tri_bytes) / (double)tris, prefetch ? "on" : "off", topt.packet_bvh_width,
          (double)(wp->node_bytes + wp->tri_bytes + wp->packet_tri_bytes) / (double)tris, packet_prefetch ? "on" : "off");
   if (want_mft && !all_modes && fr_scene_sphere_count(s)) {
     size_t ns = fr_scene_sphere_count(s);
