@@ -87,7 +87,7 @@ static int leaf_pays(conv *c, const fr_build_node *n) {
   return leaf_cost(n) <= aabb_half_area(n->box) + leaf_cost(l) + leaf_cost(r);
 }
 
-/* Node i's float arrays (generic over the width). */
+/* The float arrays of the node at ref (generic over the width). */
 static float *node_floats(conv *c, uint32_t ref) { return (float *)((char *)c->b->nodes + (size_t)ref * FR_BVHN_NODE_UNIT); }
 static uint32_t *node_children(conv *c, uint32_t ref) { return (uint32_t *)(node_floats(c, ref) + 6 * c->b->width); }
 
