@@ -146,9 +146,9 @@ static fr_error area_prefix(conv *c) {
 static uint32_t convert(conv *c, int32_t bi, int depth);
 static uint32_t emit_node(conv *c, int32_t *kids, int nk, int depth) {
   const int W = c->b->width;
-  const size_t index = c->b->nnodes++;
-  if ((index + 1) * (c->node_bytes / FR_BVHN_NODE_UNIT) > FR_BVHN_LEAF) c->too_many = 1;
-  const uint32_t self = c->too_many ? 0 : (uint32_t)(index * (c->node_bytes / FR_BVHN_NODE_UNIT));
+  const size_t index = c->b->nnodes++, units = c->node_bytes / FR_BVHN_NODE_UNIT;
+  if ((index + 1) * units > FR_BVHN_LEAF) c->too_many = 1;
+  const uint32_t self = c->too_many ? 0 : (uint32_t)(index * units);
   if (c->area) order_for_occlusion(c, kids, nk);
   float *f = node_floats(c, self);
   uint32_t *child = node_children(c, self);

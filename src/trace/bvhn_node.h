@@ -67,7 +67,7 @@ typedef vfloat4 vnode;
  * their own (fr_bvhn.packet_prefetch). */
 FR_INLINE void prefetch_ref(const fr_bvhn *b, uint32_t ref) {
   const char *p = (ref & FR_BVHN_LEAF) ? (const char *)&b->tris[FR_BVHN_LEAF_FIRST(ref)]
-                                       : (const char *)((const node_t *)FR_BVHN_NODE_AT(b, ref));
+                                       : (const char *)FR_BVHN_NODE_AT(b, ref);
   __builtin_prefetch(p);
   __builtin_prefetch(p + 64);
   __builtin_prefetch(p + 128);
@@ -86,7 +86,7 @@ FR_INLINE void prefetch_next(const fr_bvhn *b, uint32_t ref) {
     const uint32_t bytes = (uint32_t)sizeof(fr_tri4) * FR_BVHN_LEAF_BLOCKS(ref);
     for (uint32_t k = 0; k < bytes; k += 64) __builtin_prefetch(p + k);
   } else {
-    const char *p = (const char *)((const node_t *)FR_BVHN_NODE_AT(b, ref));
+    const char *p = (const char *)FR_BVHN_NODE_AT(b, ref);
     for (int k = 0; k < (int)sizeof(node_t); k += 64) __builtin_prefetch(p + k);
   }
 }
