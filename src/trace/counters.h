@@ -29,7 +29,7 @@
   X(pk_tri_lanes) X(pk_quad_tests) X(ia_culled) X(mailbox_hits) X(switches) X(switch_rays)    \
   X(mft_batches) X(mft_nodes) X(mft_box_tests) X(mft_box_lanes) X(mft_tris)   \
   X(mft_tri_frusta) X(mft_tri_left) X(mft_ray_batches) X(mft_stream_batches) X(mft_cached_leaves)  \
-  X(mft_stopped_batches) X(mft_plane_rays) X(pk_plane_rays) X(cache_tries) X(cache_hits)                                   \
+  X(mft_stopped_batches) X(mft_plane_rays) X(mft_plane_frusta) X(mft_plane_whole) X(pk_plane_rays) X(cache_tries) X(cache_hits)                                   \
   X(lp_packets) X(lp_nodes) X(lp_culled) X(lp_box_chunks) X(lp_leaves) X(lp_tris) \
   X(lp_tri_culled) X(lp_tri_chunks)                                          \
   X(sp_box_tests) X(sp_tests) X(lp_sph_culled) X(lp_sph_chunks)
