@@ -253,6 +253,13 @@ typedef struct fr_trace_options {
                              ends (finite tfar: shadow rays) against the four triangles that
                              occluded the stream's last occluded ray before it traverses, while
                              that keeps paying; 0: never. Answers do not depend on it */
+  int anyhit_order;       /* FR_TRACE_SINGLE's fr_occluded_stream: the order a ray's any-hit walk
+                             visits the children it hits. -1 (default): rays that end (shadow
+                             rays) go in chunks of 32, each by whichever order the thread has
+                             measured to cost fewer cycles per ray on this scene (nearest first
+                             only where it measured 10% cheaper), other rays by rank; 0: by the
+                             builder's occlusion rank; 1: nearest first. Answers do not depend
+                             on it */
 } fr_trace_options;
 #define FR_STREAM_SPREAD_DEFAULT 0.1f
 

@@ -5,7 +5,9 @@
  * pixel as the workloads make them, with hemisphere rays (no end, so never
  * cached) and an invalid ray mixed in. At every ISA, fr_occluded_stream in
  * single mode must give the same answer for every ray with the cache on
- * and off, and the same as fr_occluded1 ray by ray. A counters build also
+ * and off, with the any-hit walk by occlusion rank, nearest child first and
+ * chosen by measurement (fr_trace_options.anyhit_order), and the same as
+ * fr_occluded1 ray by ray. A counters build also
  * checks that the cache was tried and hit (on the built-in scene, and over
  * the shared scenes).
  */
@@ -64,7 +66,7 @@ static size_t make_rays(fr_scene *s, const fr_view *v, fr_ray *rays) {
 static void check_scene(fr_scene *s, const fr_view *v) {
   fr_ray *rays = malloc((size_t)SZ * SZ * (SAMPLES + 1) * sizeof *rays);
   const size_t n = make_rays(s, v, rays);
-  uint8_t *on = malloc(n), *off = malloc(n), *one = malloc(n);
+  uint8_t *on = malloc(n), *off = malloc(n), *one = malloc(n), *ordered = malloc(n);
   fr_trace_options o;
   fr_trace_options_default(&o);
   assert_int_equal(o.occluder_cache, 1);
@@ -90,6 +92,18 @@ static void check_scene(fr_scene *s, const fr_view *v) {
     const fr_counters c = fr_counters_read();
     tally_tries += (long)c.cache_tries;
     tally_hits += (long)c.cache_hits;
+    for (int order = 0; order <= 1; order++) {
+      o.anyhit_order = order;
+      assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+      memset(ordered, 0x5A, n);
+      fr_occluded_stream(s, rays, ordered, n);
+      for (size_t i = 0; i < n; i++)
+        if (ordered[i] != one[i])
+          fail_msg("%s, %s, ray %zu: %s first %d, fr_occluded1 %d", s->name, fr_isa_name((fr_isa)isa), i,
+                   order ? "nearest" : "rank", ordered[i], one[i]);
+    }
+    o.anyhit_order = -1;
+    assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
     occluded = 0;
     for (size_t i = 0; i < n; i++) {
       if (on[i] != off[i] || on[i] != one[i])
@@ -108,6 +122,7 @@ static void check_scene(fr_scene *s, const fr_view *v) {
   free(on);
   free(off);
   free(one);
+  free(ordered);
 }
 
 /* Commits s, checks it from its own view, and releases it. */

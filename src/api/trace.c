@@ -29,6 +29,7 @@ void fr_trace_options_default(fr_trace_options *o) {
   o->coherent_threshold = 2;
   o->hybrid_tune = 1;
   o->occluder_cache = 1;
+  o->anyhit_order = -1;
 }
 
 fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o) {
@@ -47,6 +48,8 @@ fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o) {
   if (o->hybrid_tune != 0 && o->hybrid_tune != 1) return fr_fail(FR_ERR_ARG, "hybrid tune %d (0 or 1)", o->hybrid_tune);
   if (o->occluder_cache != 0 && o->occluder_cache != 1)
     return fr_fail(FR_ERR_ARG, "occluder cache %d (0 or 1)", o->occluder_cache);
+  if (o->anyhit_order < -1 || o->anyhit_order > 1)
+    return fr_fail(FR_ERR_ARG, "any-hit order %d (-1, 0 or 1)", o->anyhit_order);
   if (o->packet_bvh_width == 4) {
     fr_error e = fr_scene_need_bvh4(s);
     if (e) return e;
@@ -378,7 +381,7 @@ static void triangles_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ
     const fr_bvhn *sb;
     const fr_trace_fns *single = single_fns(s, &sb);
     if (hits) single->intersect_stream(sb, rays, hits, n);
-    else single->occluded_stream(sb, rays, occ, n, s->trace.occluder_cache);
+    else single->occluded_stream(sb, rays, occ, n, s->trace.occluder_cache, s->trace.anyhit_order);
     return;
   }
   case FR_TRACE_AUTO: octant_trace(s, rays, occ, hits, n, s->trace.stream_spread); return;

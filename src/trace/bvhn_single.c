@@ -9,6 +9,8 @@
 #include "accel/plane_occluders.h"
 #include "trace/bvhn_single.h"
 #include "trace/kernels.h"
+#include "base/timer.h"
+#include "trace/anyhit_tune.h"
 
 static __attribute__((noinline)) int intersect_subtree(const fr_bvhn *b, uint32_t ref, const fr_ray *ray, fr_subtree_hit *best) {
   ray_pre r;
@@ -76,13 +78,23 @@ static void intersect_stream(const fr_bvhn *b, const fr_ray *rays, fr_hit *hits,
 #define CACHE_MIN_RATE 16u
 #define CACHE_PERIOD 4096u
 
-static void occluded_stream(const fr_bvhn *b, const fr_ray *rays, uint8_t *occ, size_t n, int cache) {
-  uint32_t last = 0; /* 1 + the block that occluded the last ray the traversal found occluded */
-  unsigned tries = 0, hits = 0;
-  const int wanted = cache;
-  for (size_t i = 0; i < n; i++) {
+/* The occluder cache across a stream. */
+typedef struct occ_cache {
+  uint32_t last;  /* 1 + the block that occluded the last ray the traversal found occluded */
+  unsigned tries, hits;
+  int cache, wanted;
+} occ_cache;
+
+/* Rays [i0, i1) of a stream, the hit children nearest first or by the
+ * slots' occlusion rank (a constant where inlined). */
+FR_INLINE void occluded_run(const fr_bvhn *b, const fr_ray *rays, uint8_t *occ, size_t i0, size_t i1, occ_cache *c,
+                            int nearest) {
+  uint32_t last = c->last;
+  unsigned tries = c->tries, hits = c->hits;
+  int cache = c->cache;
+  for (size_t i = i0; i < i1; i++) {
     const fr_ray *ray = &rays[i];
-    if (i % CACHE_PERIOD == 0) cache = wanted, tries = hits = 0; /* a long stream decides again */
+    if (i % CACHE_PERIOD == 0) cache = c->wanted, tries = hits = 0; /* a long stream decides again */
     ray_pre r;
     const int known = occluded_before(b, ray, &r);
     if (known >= 0) {
@@ -103,9 +115,65 @@ static void occluded_stream(const fr_bvhn *b, const fr_ray *rays, uint8_t *occ, 
         continue;
       }
     }
-    const uint32_t k = any_hit(b, &r, b->root, ray->tfar);
+    const uint32_t k = nearest ? any_hit_nearest(b, &r, b->root, ray->tfar) : any_hit(b, &r, b->root, ray->tfar);
     occ[i] = k != 0;
     if (k && cache) last = k;
+  }
+  c->last = last;
+  c->tries = tries;
+  c->hits = hits;
+  c->cache = cache;
+}
+
+/* Out of line, so that the rank order's loop keeps its registers: with both
+ * walks inlined in one loop, kitchen soft16 ran 0.987x with the rank order
+ * alone. */
+static __attribute__((noinline)) void occluded_run_nearest(const fr_bvhn *b, const fr_ray *rays, uint8_t *occ,
+                                                           size_t i0, size_t i1, occ_cache *c) {
+  occluded_run(b, rays, occ, i0, i1, c, 1);
+}
+
+/* The any-hit order by measurement (trace/anyhit_tune.h). Which children
+ * hold a ray's occluder first depends on the scene: among the hairball's
+ * strands the nearest, elsewhere the occlusion rank (accel/bvhn.c) finds it
+ * in fewer visits, and nearest-first costs kitchen ao16 43% and dragon
+ * soft16 16%. So rays with an end (shadow rays) go in chunks of
+ * ORDER_CHUNK, each walked by the order the thread's probes price lower.
+ * Rays without one (ambient occlusion, bounces) keep the rank: there a
+ * tuner cost hairball ao16 4% and kitchen ao16 1.6% (session 55). Every
+ * order gives the same answers. Against the rank alone, same binary
+ * (--anyhit-order rank), interleaved, 2 threads, 1024x1024, 3 pairs each
+ * (docs/performance-log.md, session 57): hairball soft16 1.248x (3/3),
+ * kitchen shadow 1.019x, kitchen soft16 0.997x, conference soft16 0.996x,
+ * dragon soft16 0.990x, shadow 0.991x; nearest-first always, hairball
+ * soft16 1.265x. */
+#define ORDER_CHUNK 32u
+
+static _Thread_local fr_anyhit_tune order_tune;
+
+/* A probe: rays [i0, i1) by either order in turn, each timed, without the
+ * occluder cache: which block each order finds decides which of the next
+ * rays the cache answers, and so would bias the sums. */
+static __attribute__((noinline)) void occluded_probe(const fr_bvhn *b, const fr_ray *rays, uint8_t *occ, size_t i0,
+                                                     size_t i1) {
+  occ_cache none = {0, 0, 0, 0, 0};
+  for (size_t i = i0; i < i1; i++) {
+    const int arm = (int)(i & 1);
+    const uint64_t t0 = fr_cycles();
+    if (arm) occluded_run_nearest(b, rays, occ, i, i + 1, &none);
+    else occluded_run(b, rays, occ, i, i + 1, &none, 0);
+    fr_anyhit_tune_record(&order_tune, arm, fr_cycles() - t0);
+  }
+}
+
+static void occluded_stream(const fr_bvhn *b, const fr_ray *rays, uint8_t *occ, size_t n, int cache, int order) {
+  occ_cache c = {0, 0, 0, cache, cache};
+  for (size_t i0 = 0, i1; i0 < n; i0 = i1) {
+    i1 = n - i0 > ORDER_CHUNK ? i0 + ORDER_CHUNK : n;
+    const int how = order >= 0 ? order : rays[i0].tfar < INFINITY ? fr_anyhit_tune_pick(&order_tune, b) : 0;
+    if (how == FR_ANYHIT_PROBE) occluded_probe(b, rays, occ, i0, i1);
+    else if (how) occluded_run_nearest(b, rays, occ, i0, i1, &c);
+    else occluded_run(b, rays, occ, i0, i1, &c, 0);
   }
 }
 

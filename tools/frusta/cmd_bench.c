@@ -179,7 +179,7 @@ int cmd_bench(int argc, char **argv) {
         !strcmp(a, "--corner-cost") || !strcmp(a, "--mft-fallback") ||
         !strcmp(a, "--light-sets") || !strcmp(a, "--prefetch") || !strcmp(a, "--stream-spread") ||
         !strcmp(a, "--coherent-threshold") || !strcmp(a, "--quad") || !strcmp(a, "--hybrid-tune") ||
-        !strcmp(a, "--occluder-cache")) {
+        !strcmp(a, "--occluder-cache") || !strcmp(a, "--anyhit-order")) {
       if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
       const char *val = argv[++i];
       if (!strcmp(a, "--light-sets")) {
@@ -209,6 +209,10 @@ int cmd_bench(int argc, char **argv) {
         if (!strcmp(val, "auto")) topt.prefetch = -1;
         else if (!strcmp(val, "on") || !strcmp(val, "off")) topt.prefetch = !strcmp(val, "on");
         else return cli_error(CLI_USAGE_ERROR, "--prefetch is on, off or auto, not '%s'", val);
+      } else if (!strcmp(a, "--anyhit-order")) {
+        if (!strcmp(val, "auto")) topt.anyhit_order = -1;
+        else if (!strcmp(val, "rank") || !strcmp(val, "nearest")) topt.anyhit_order = !strcmp(val, "nearest");
+        else return cli_error(CLI_USAGE_ERROR, "--anyhit-order is auto, rank or nearest, not '%s'", val);
       } else if (!strcmp(a, "--stream-spread")) {
         if (!cli_parse_float(val, &topt.stream_spread) || !(topt.stream_spread >= 0.0f && topt.stream_spread <= 2.0f))
           return cli_error(CLI_USAGE_ERROR, "--stream-spread wants 0..2, got '%s'", val);

@@ -23,7 +23,7 @@ static void usage(FILE *f) {
           "         packets:      [--threshold N] [--packet-width 4|8] [--mailbox on|off] [--axis-aligned on|off]\n"
           "                       [--ia on|off] [--quad on|off] [--hybrid-tune on|off]\n"
           "         auto:         [--stream-spread S] [--coherent-threshold N] (also hybrid16's one-octant packets)\n"
-          "         single rays:  [--prefetch on|off|auto] [--occluder-cache on|off]\n"
+          "         single rays:  [--prefetch on|off|auto] [--occluder-cache on|off] [--anyhit-order auto|rank|nearest]\n"
           "         multi-frusta: [--light-sets spread|cells] [--corner-rays on|off] [--corner-cost C]\n"
           "                       [--shrink on|corners|off] [--mft-leaf N] [--mft-fallback on|off]\n"
           "         NxN packets:  [--traversal masked|ranged|partition] [--cull off|ia|planes|corners]\n"
