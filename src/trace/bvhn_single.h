@@ -55,6 +55,31 @@ FR_INLINE uint32_t order_children(const node_t *n, int mask, vnode tn, entry *st
 }
 #endif
 
+/* From *ref down the nearest hit children to a leaf, into *ref, the other
+ * hit children pushed farthest first; 0 where a node has no hit child. */
+FR_INLINE int descend_nearest(const fr_bvhn *b, const ray_pre *rp, float tfar, uint32_t *ref, entry *stack, int *spp) {
+  uint32_t r = *ref;
+  int sp = *spp;
+  while (!(r & FR_BVHN_LEAF)) {
+    const node_t *n = (const node_t *)FR_BVHN_NODE_AT(b, r);
+    int mask;
+    vnode tn = visit_node(n, rp, tfar, &mask);
+    if (!mask) {
+      *spp = sp;
+      return 0;
+    }
+    int sp0 = sp;
+    r = order_children(n, mask, tn, stack, &sp);
+    if (b->prefetch) {
+      prefetch_next(b, r);
+      for (int i = sp0; i < sp; i++) prefetch_ref(b, stack[i].ref);
+    }
+  }
+  *ref = r;
+  *spp = sp;
+  return 1;
+}
+
 /* Closest hit in the subtree at root before *tfar; fills *best on a hit. */
 FR_INLINE int closest(const fr_bvhn *b, const ray_pre *rp, uint32_t root, float tfar, fr_subtree_hit *best) {
   entry stack[STACK_SIZE + STACK_SLACK];
@@ -64,18 +89,7 @@ FR_INLINE int closest(const fr_bvhn *b, const ray_pre *rp, uint32_t root, float 
     entry top = stack[--sp];
     if (top.dist > tfar * ROUND_UP) continue;
     uint32_t ref = top.ref;
-    while (!(ref & FR_BVHN_LEAF)) {
-      const node_t *n = (const node_t *)FR_BVHN_NODE_AT(b, ref);
-      int mask;
-      vnode tn = visit_node(n, rp, tfar, &mask);
-      if (!mask) goto next;
-      int sp0 = sp;
-      ref = order_children(n, mask, tn, stack, &sp);
-      if (b->prefetch) {
-        prefetch_next(b, ref);
-        for (int i = sp0; i < sp; i++) prefetch_ref(b, stack[i].ref);
-      }
-    }
+    if (!descend_nearest(b, rp, tfar, &ref, stack, &sp)) continue;
     {
       const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
       FR_COUNT(leaves, 1);
@@ -88,7 +102,6 @@ FR_INLINE int closest(const fr_bvhn *b, const ray_pre *rp, uint32_t root, float 
         found = 1;
       }
     }
-  next:;
   }
   return found;
 }
@@ -103,29 +116,15 @@ FR_INLINE uint32_t any_hit_nearest(const fr_bvhn *b, const ray_pre *rp, uint32_t
   stack[sp++] = (entry){root, -INFINITY};
   while (sp) {
     uint32_t ref = stack[--sp].ref;
-    while (!(ref & FR_BVHN_LEAF)) {
-      const node_t *n = (const node_t *)FR_BVHN_NODE_AT(b, ref);
-      int mask;
-      vnode tn = visit_node(n, rp, tfar, &mask);
-      if (!mask) goto next;
-      int sp0 = sp;
-      ref = order_children(n, mask, tn, stack, &sp);
-      if (b->prefetch) {
-        prefetch_next(b, ref);
-        for (int i = sp0; i < sp; i++) prefetch_ref(b, stack[i].ref);
-      }
+    if (!descend_nearest(b, rp, tfar, &ref, stack, &sp)) continue;
+    const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
+    FR_COUNT(leaves, 1);
+    for (uint32_t k = first; k < first + nb; k++) {
+      FR_COUNT(tri_tests, 4);
+      tri4_result res;
+      tri4_test(&b->tris[k], rp, tfar, &res);
+      if (res.mask) return k + 1;
     }
-    {
-      const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
-      FR_COUNT(leaves, 1);
-      for (uint32_t k = first; k < first + nb; k++) {
-        FR_COUNT(tri_tests, 4);
-        tri4_result res;
-        tri4_test(&b->tris[k], rp, tfar, &res);
-        if (res.mask) return k + 1;
-      }
-    }
-  next:;
   }
   return 0;
 }
