@@ -55,6 +55,19 @@ FR_INLINE uint32_t order_children(const node_t *n, int mask, vnode tn, entry *st
 }
 #endif
 
+/* An any-hit walk's leaf: 1 + the index of its first block with a hit, or 0. */
+FR_INLINE uint32_t any_hit_leaf(const fr_bvhn *b, const ray_pre *rp, uint32_t ref, float tfar) {
+  const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
+  FR_COUNT(leaves, 1);
+  for (uint32_t k = first; k < first + nb; k++) {
+    FR_COUNT(tri_tests, 4);
+    tri4_result res;
+    tri4_test(&b->tris[k], rp, tfar, &res);
+    if (res.mask) return k + 1;
+  }
+  return 0;
+}
+
 /* From *ref down the nearest hit children to a leaf, into *ref, the other
  * hit children pushed farthest first; 0 where a node has no hit child. */
 FR_INLINE int descend_nearest(const fr_bvhn *b, const ray_pre *rp, float tfar, uint32_t *ref, entry *stack, int *spp) {
@@ -117,14 +130,8 @@ FR_INLINE uint32_t any_hit_nearest(const fr_bvhn *b, const ray_pre *rp, uint32_t
   while (sp) {
     uint32_t ref = stack[--sp].ref;
     if (!descend_nearest(b, rp, tfar, &ref, stack, &sp)) continue;
-    const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
-    FR_COUNT(leaves, 1);
-    for (uint32_t k = first; k < first + nb; k++) {
-      FR_COUNT(tri_tests, 4);
-      tri4_result res;
-      tri4_test(&b->tris[k], rp, tfar, &res);
-      if (res.mask) return k + 1;
-    }
+    const uint32_t k = any_hit_leaf(b, rp, ref, tfar);
+    if (k) return k;
   }
   return 0;
 }
@@ -166,14 +173,8 @@ FR_INLINE uint32_t any_hit(const fr_bvhn *b, const ray_pre *rp, uint32_t root, c
       }
     }
     {
-      const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
-      FR_COUNT(leaves, 1);
-      for (uint32_t k = first; k < first + nb; k++) {
-        FR_COUNT(tri_tests, 4);
-        tri4_result res;
-        tri4_test(&b->tris[k], rp, tfar, &res);
-        if (res.mask) return k + 1;
-      }
+      const uint32_t k = any_hit_leaf(b, rp, ref, tfar);
+      if (k) return k;
     }
   next:;
   }
