@@ -17,6 +17,7 @@
 #define FR_BASE_SIMD_H
 
 #include <stdint.h>
+#include <string.h>
 
 #if defined(FR_BUILD_ISA_AVX512)
 #define FR_ISA_SUFFIX avx512
@@ -52,6 +53,8 @@ FR_INLINE vfloat4 vf4_mul(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_mul_ps(a.v, b
 FR_INLINE vfloat4 vf4_div(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_div_ps(a.v, b.v)}; return r; }
 FR_INLINE vfloat4 vf4_min(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_min_ps(a.v, b.v)}; return r; }
 FR_INLINE vfloat4 vf4_max(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_max_ps(a.v, b.v)}; return r; }
+FR_INLINE vfloat4 vf4_imin(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_castsi128_ps(_mm_min_epi32(_mm_castps_si128(a.v), _mm_castps_si128(b.v)))}; return r; }
+FR_INLINE vfloat4 vf4_imax(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_castsi128_ps(_mm_max_epi32(_mm_castps_si128(a.v), _mm_castps_si128(b.v)))}; return r; }
 FR_INLINE vfloat4 vf4_neg(vfloat4 a) { vfloat4 r = {_mm_xor_ps(a.v, _mm_set1_ps(-0.0f))}; return r; }
 
 #if defined(FR_BUILD_ISA_AVX512)
@@ -92,6 +95,18 @@ FR_INLINE vfloat8 vf8_sub(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_sub_ps(a.v
 FR_INLINE vfloat8 vf8_mul(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_mul_ps(a.v, b.v)}; return r; }
 FR_INLINE vfloat8 vf8_min(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_min_ps(a.v, b.v)}; return r; }
 FR_INLINE vfloat8 vf8_max(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_max_ps(a.v, b.v)}; return r; }
+/* Min and max of the bit patterns as signed integers (one cycle where the
+ * float forms take two): the float min and max where both are >= +0 or one
+ * is >= +0 and the other < -0; among negatives the order reverses, and -0
+ * is the least of all. */
+FR_INLINE vfloat8 vf8_imin(vfloat8 a, vfloat8 b) {
+  vfloat8 r = {_mm256_castsi256_ps(_mm256_min_epi32(_mm256_castps_si256(a.v), _mm256_castps_si256(b.v)))};
+  return r;
+}
+FR_INLINE vfloat8 vf8_imax(vfloat8 a, vfloat8 b) {
+  vfloat8 r = {_mm256_castsi256_ps(_mm256_max_epi32(_mm256_castps_si256(a.v), _mm256_castps_si256(b.v)))};
+  return r;
+}
 FR_INLINE vfloat8 vf8_div(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_div_ps(a.v, b.v)}; return r; }
 FR_INLINE vfloat8 vf8_add(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_add_ps(a.v, b.v)}; return r; }
 /* lanes 0-3 from lo, 4-7 from hi: two rays' four-lane values side by side */
@@ -165,6 +180,9 @@ FR_INLINE vfloat4 vf4_mul(vfloat4 a, vfloat4 b) FR_LANES4(a.f[i] * b.f[i])
 FR_INLINE vfloat4 vf4_div(vfloat4 a, vfloat4 b) FR_LANES4(a.f[i] / b.f[i])
 FR_INLINE vfloat4 vf4_min(vfloat4 a, vfloat4 b) FR_LANES4(a.f[i] < b.f[i] ? a.f[i] : b.f[i])
 FR_INLINE vfloat4 vf4_max(vfloat4 a, vfloat4 b) FR_LANES4(a.f[i] > b.f[i] ? a.f[i] : b.f[i])
+FR_INLINE int32_t fr_f2i(float f) { int32_t i; memcpy(&i, &f, sizeof i); return i; }
+FR_INLINE vfloat4 vf4_imin(vfloat4 a, vfloat4 b) FR_LANES4(fr_f2i(a.f[i]) < fr_f2i(b.f[i]) ? a.f[i] : b.f[i])
+FR_INLINE vfloat4 vf4_imax(vfloat4 a, vfloat4 b) FR_LANES4(fr_f2i(a.f[i]) > fr_f2i(b.f[i]) ? a.f[i] : b.f[i])
 FR_INLINE vfloat4 vf4_neg(vfloat4 a) FR_LANES4(-a.f[i])
 FR_INLINE vmask4 vf4_lt(vfloat4 a, vfloat4 b) FR_MASK4(a.f[i] < b.f[i])
 FR_INLINE vmask4 vf4_le(vfloat4 a, vfloat4 b) FR_MASK4(a.f[i] <= b.f[i])
@@ -187,6 +205,8 @@ FR_INLINE vfloat8 vf8_sub(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] - b.f[i])
 FR_INLINE vfloat8 vf8_mul(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] * b.f[i])
 FR_INLINE vfloat8 vf8_min(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] < b.f[i] ? a.f[i] : b.f[i])
 FR_INLINE vfloat8 vf8_max(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] > b.f[i] ? a.f[i] : b.f[i])
+FR_INLINE vfloat8 vf8_imin(vfloat8 a, vfloat8 b) FR_LANES8(fr_f2i(a.f[i]) < fr_f2i(b.f[i]) ? a.f[i] : b.f[i])
+FR_INLINE vfloat8 vf8_imax(vfloat8 a, vfloat8 b) FR_LANES8(fr_f2i(a.f[i]) > fr_f2i(b.f[i]) ? a.f[i] : b.f[i])
 FR_INLINE int vf8_le_bits(vfloat8 a, vfloat8 b) { int m = 0; for (int i = 0; i < 8; i++) m |= (a.f[i] <= b.f[i]) << i; return m; }
 FR_INLINE vfloat8 vf8_div(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] / b.f[i])
 FR_INLINE vfloat8 vf8_add(vfloat8 a, vfloat8 b) FR_LANES8(a.f[i] + b.f[i])

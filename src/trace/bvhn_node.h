@@ -31,6 +31,8 @@ typedef vfloat8 vnode;
 #define VN_MUL vf8_mul
 #define VN_MIN vf8_min
 #define VN_MAX vf8_max
+#define VN_IMIN vf8_imin
+#define VN_IMAX vf8_imax
 #define VN_LE_BITS vf8_le_bits
 #define VN_DIV vf8_div
 #define VN_ADD_WHERE vf8_add_where
@@ -44,6 +46,8 @@ typedef vfloat4 vnode;
 #define VN_MUL vf4_mul
 #define VN_MIN vf4_min
 #define VN_MAX vf4_max
+#define VN_IMIN vf4_imin
+#define VN_IMAX vf4_imax
 #define VN_LE_BITS(a, b) vm4_bits(vf4_le(a, b))
 #define VN_DIV vf4_div
 #define VN_ADD_WHERE vf4_add_where

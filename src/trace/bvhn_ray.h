@@ -69,7 +69,17 @@ FR_INLINE node_planes load_planes(const node_t *n, const ray_pre *r) {
  * threads, 1024x1024, 3 pairs each: single rays dragon primary 1.075x, ao16
  * 1.045x and 1.023x, hairball ao16 1.054x, soft16 1.026x, primary 1.006x,
  * kitchen ao16 1.024x, conference shadow 1.028x (an identical second copy
- * read 1.002-1.008x). */
+ * read 1.002-1.008x).
+ * The min and max are taken on the distances' bit patterns as integers, a
+ * cycle each rather than two. With tnear >= +0, tn is the float max
+ * exactly, and tf the float min where that is >= +0, else another value
+ * < +0: the same mask as the float forms', but for a box left exactly at
+ * t = 0. With tnear < 0 both only loosen (among negatives the integer order
+ * is reversed): tn is never above the float max nor tf below the float min,
+ * so no box is lost. Same binary, interleaved, 2 threads,
+ * 1024x1024, 3 pairs each (session 58): single rays dragon ao16 1.036x and
+ * 1.036x, hairball ao16 1.045x, kitchen ao16 1.056x, dragon primary 1.029x,
+ * conference shadow 1.025x. */
 FR_INLINE vnode planes_test(const node_planes *p, const ray_pre *r, float tfar, int *mask) {
   vnode tnx = VN_MUL(VN_SUB(r->ox, p->nx), r->nrx);
   vnode tny = VN_MUL(VN_SUB(r->oy, p->ny), r->nry);
@@ -77,8 +87,8 @@ FR_INLINE vnode planes_test(const node_planes *p, const ray_pre *r, float tfar, 
   vnode tfx = VN_MUL(VN_SUB(r->ox, p->fx), r->nrx_w);
   vnode tfy = VN_MUL(VN_SUB(r->oy, p->fy), r->nry_w);
   vnode tfz = VN_MUL(VN_SUB(r->oz, p->fz), r->nrz_w);
-  vnode tn = VN_MAX(VN_MAX(tnx, tny), VN_MAX(tnz, VN(r->tnear)));
-  vnode tf = VN_MIN(VN_MIN(tfx, tfy), VN_MIN(tfz, VN(tfar * ROUND_UP)));
+  vnode tn = VN_IMAX(VN_IMAX(tnx, tny), VN_IMAX(tnz, VN(r->tnear)));
+  vnode tf = VN_IMIN(VN_IMIN(tfx, tfy), VN_IMIN(tfz, VN(tfar * ROUND_UP)));
   *mask = VN_LE_BITS(tn, tf);
   return tn;
 }
