@@ -197,6 +197,80 @@ static void test_add_where(void **st) {
   print_message("masked adds: %d lane sets\n", tested);
 }
 
+typedef void (*imin_imax_fn)(const float *, const float *, float *, float *, float *, float *);
+void fr_test_imin_imax_scalar(const float *a, const float *b, float *min8, float *max8, float *min4, float *max4);
+void fr_test_imin_imax_avx2(const float *a, const float *b, float *min8, float *max8, float *min4, float *max4);
+void fr_test_imin_imax_avx512(const float *a, const float *b, float *min8, float *max8, float *min4, float *max4);
+
+static int32_t float_bits(float f) {
+  int32_t i;
+  memcpy(&i, &f, sizeof i);
+  return i;
+}
+
+/* A float from a mix that has the cases the node test meets: zeros of both
+ * signs, infinities, and finite values of either sign and many scales. */
+static float mixed_float(fr_rng *r) {
+  static const float special[] = {0.0f, -0.0f, INFINITY, -INFINITY, 1.0f, -1.0f, 0x1p-149f, -0x1p-149f};
+  const unsigned k = fr_rng_u32(r) % 16;
+  if (k < 8) return special[k];
+  return urand(r, -1.0f, 1.0f) * ldexpf(1.0f, (int)(fr_rng_u32(r) % 40) - 20);
+}
+
+/* max (or min) of v[0..3] as planes_test takes it, by a level's imax (imin) */
+static float level_reduce(imin_imax_fn fn, const float *v, int want_max) {
+  float a[8] = {v[0], v[2]}, b[8] = {v[1], v[3]}, mn[8], mx[8], mn4[4], mx4[4];
+  fn(a, b, mn, mx, mn4, mx4);
+  float a2[8] = {want_max ? mx[0] : mn[0]}, b2[8] = {want_max ? mx[1] : mn[1]};
+  fn(a2, b2, mn, mx, mn4, mx4);
+  return want_max ? mx[0] : mn[0];
+}
+
+/* vf8/vf4_imin and _imax on every level pick the operand whose bit pattern
+ * is the lesser or greater signed integer. And the node test built on them
+ * (bvhn_ray.h, planes_test): max(near distances, tnear) <= min(far
+ * distances, tfar) never rejects what the float forms accept, and with
+ * tnear >= +0 and no far value of -0 accepts the same. */
+static void test_imin_imax(void **st) {
+  (void)st;
+  const struct { fr_isa isa; imin_imax_fn fn; } levels[] = {{FR_ISA_SCALAR, fr_test_imin_imax_scalar},
+                                                            {FR_ISA_AVX2, fr_test_imin_imax_avx2},
+                                                            {FR_ISA_AVX512, fr_test_imin_imax_avx512}};
+  fr_rng r = fr_rng_seed(13, 5);
+  int tested = 0, boxes = 0;
+  for (size_t l = 0; l < sizeof levels / sizeof levels[0]; l++) {
+    if (!fr_isa_supported(levels[l].isa)) continue;
+    for (int round = 0; round < 20000; round++) {
+      float a[8], b[8], mn8[8], mx8[8], mn4[4], mx4[4];
+      for (int i = 0; i < 8; i++) a[i] = mixed_float(&r), b[i] = mixed_float(&r);
+      levels[l].fn(a, b, mn8, mx8, mn4, mx4);
+      for (int i = 0; i < 8; i++) {
+        const float lo = float_bits(a[i]) < float_bits(b[i]) ? a[i] : b[i];
+        const float hi = float_bits(a[i]) > float_bits(b[i]) ? a[i] : b[i];
+        assert_memory_equal(&mn8[i], &lo, sizeof(float));
+        assert_memory_equal(&mx8[i], &hi, sizeof(float));
+        if (i < 4) {
+          assert_memory_equal(&mn4[i], &lo, sizeof(float));
+          assert_memory_equal(&mx4[i], &hi, sizeof(float));
+        }
+      }
+      /* a node test as planes_test reduces it: a[0..2] near distances,
+       * a[3] tnear, a[4..6] far distances, a[7] tfar */
+      const float tn = level_reduce(levels[l].fn, a, 1), tf = level_reduce(levels[l].fn, a + 4, 0);
+      const float fn = fmaxf(fmaxf(a[0], a[1]), fmaxf(a[2], a[3])), ff = fminf(fminf(a[4], a[5]), fminf(a[6], a[7]));
+      const int want = fn <= ff, got = tn <= tf;
+      if (want) assert_true(got); /* never rejects what the float test accepts */
+      int far_neg_zero = 0;
+      for (int i = 4; i < 8; i++) far_neg_zero |= float_bits(a[i]) == float_bits(-0.0f);
+      const int exact = float_bits(a[3]) >= 0 && !far_neg_zero;
+      if (exact) assert_int_equal(got, want);
+      tested++;
+      boxes += exact;
+    }
+  }
+  print_message("integer-order min/max: %d lane sets, %d node tests exact\n", tested, boxes);
+}
+
 typedef void (*load_records_fn)(const float *, size_t, int, float (*)[16], float (*)[16], float *);
 void fr_test_load_records_scalar(const float *src, size_t stride, int n, float (*out8)[16], float (*out4)[16], float *back4);
 void fr_test_load_records_avx2(const float *src, size_t stride, int n, float (*out8)[16], float (*out4)[16], float *back4);
@@ -392,6 +466,7 @@ static void test_tri4_quad(void **st) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_add_where),
+      cmocka_unit_test(test_imin_imax),
       cmocka_unit_test(test_load_records),
       cmocka_unit_test(test_tri4_pair),
       cmocka_unit_test(test_tri4_quad),

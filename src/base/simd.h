@@ -53,6 +53,10 @@ FR_INLINE vfloat4 vf4_mul(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_mul_ps(a.v, b
 FR_INLINE vfloat4 vf4_div(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_div_ps(a.v, b.v)}; return r; }
 FR_INLINE vfloat4 vf4_min(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_min_ps(a.v, b.v)}; return r; }
 FR_INLINE vfloat4 vf4_max(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_max_ps(a.v, b.v)}; return r; }
+/* Min and max of the bit patterns as signed integers (one cycle where the
+ * float forms take two): the float min and max where both are >= +0 or one
+ * is >= +0 and the other < -0; among negatives the order reverses, and -0
+ * is the least of all. */
 FR_INLINE vfloat4 vf4_imin(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_castsi128_ps(_mm_min_epi32(_mm_castps_si128(a.v), _mm_castps_si128(b.v)))}; return r; }
 FR_INLINE vfloat4 vf4_imax(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_castsi128_ps(_mm_max_epi32(_mm_castps_si128(a.v), _mm_castps_si128(b.v)))}; return r; }
 FR_INLINE vfloat4 vf4_neg(vfloat4 a) { vfloat4 r = {_mm_xor_ps(a.v, _mm_set1_ps(-0.0f))}; return r; }
@@ -95,10 +99,6 @@ FR_INLINE vfloat8 vf8_sub(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_sub_ps(a.v
 FR_INLINE vfloat8 vf8_mul(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_mul_ps(a.v, b.v)}; return r; }
 FR_INLINE vfloat8 vf8_min(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_min_ps(a.v, b.v)}; return r; }
 FR_INLINE vfloat8 vf8_max(vfloat8 a, vfloat8 b) { vfloat8 r = {_mm256_max_ps(a.v, b.v)}; return r; }
-/* Min and max of the bit patterns as signed integers (one cycle where the
- * float forms take two): the float min and max where both are >= +0 or one
- * is >= +0 and the other < -0; among negatives the order reverses, and -0
- * is the least of all. */
 FR_INLINE vfloat8 vf8_imin(vfloat8 a, vfloat8 b) {
   vfloat8 r = {_mm256_castsi256_ps(_mm256_min_epi32(_mm256_castps_si256(a.v), _mm256_castps_si256(b.v)))};
   return r;
