@@ -257,8 +257,9 @@ static void test_imin_imax(void **st) {
       /* a node test as planes_test reduces it: a[0..2] near distances,
        * a[3] tnear, a[4..6] far distances, a[7] tfar */
       const float tn = level_reduce(levels[l].fn, a, 1), tf = level_reduce(levels[l].fn, a + 4, 0);
-      const float fn = fmaxf(fmaxf(a[0], a[1]), fmaxf(a[2], a[3])), ff = fminf(fminf(a[4], a[5]), fminf(a[6], a[7]));
-      const int want = fn <= ff, got = tn <= tf;
+      const float tn_float = fmaxf(fmaxf(a[0], a[1]), fmaxf(a[2], a[3]));
+      const float tf_float = fminf(fminf(a[4], a[5]), fminf(a[6], a[7]));
+      const int want = tn_float <= tf_float, got = tn <= tf;
       if (want) assert_true(got); /* never rejects what the float test accepts */
       int far_neg_zero = 0;
       for (int i = 4; i < 8; i++) far_neg_zero |= float_bits(a[i]) == float_bits(-0.0f);
