@@ -55,9 +55,8 @@ FR_INLINE vfloat4 vf4_min(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_min_ps(a.v, b
 FR_INLINE vfloat4 vf4_max(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_max_ps(a.v, b.v)}; return r; }
 /* Min and max of the bit patterns as signed integers (one cycle of latency
  * where the float forms take two on AMD Zen 4 and 5): the float min and max
- * where both are >= +0 or one
- * is >= +0 and the other < -0; among negatives the order reverses, and -0
- * is the least of all. */
+ * where both are >= +0 or one is >= +0 and the other < -0; among negatives
+ * the order reverses, and -0 is the least of all. */
 FR_INLINE vfloat4 vf4_imin(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_castsi128_ps(_mm_min_epi32(_mm_castps_si128(a.v), _mm_castps_si128(b.v)))}; return r; }
 FR_INLINE vfloat4 vf4_imax(vfloat4 a, vfloat4 b) { vfloat4 r = {_mm_castsi128_ps(_mm_max_epi32(_mm_castps_si128(a.v), _mm_castps_si128(b.v)))}; return r; }
 FR_INLINE vfloat4 vf4_neg(vfloat4 a) { vfloat4 r = {_mm_xor_ps(a.v, _mm_set1_ps(-0.0f))}; return r; }
