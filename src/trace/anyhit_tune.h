@@ -22,7 +22,8 @@
 #include <string.h>
 
 #define FR_ANYHIT_TUNE_PROBE 32u      /* one chunk in so many is a probe ... */
-#define FR_ANYHIT_TUNE_PROBE_FAR 256u /* ... where one order measured over 1.25 times the other's cost */
+#define FR_ANYHIT_TUNE_PROBE_FAR 256u /* ... where one order measured over FR_ANYHIT_TUNE_FAR times the other's cost */
+#define FR_ANYHIT_TUNE_FAR 1.25
 #define FR_ANYHIT_TUNE_WINDOW 1024u   /* chunks: the sums halve, so the choice follows a workload's phases */
 #define FR_ANYHIT_TUNE_MARGIN 0.9
 #define FR_ANYHIT_PROBE 2             /* fr_anyhit_tune_pick's answer for a probe */
@@ -48,7 +49,7 @@ static inline int fr_anyhit_tune_pick(fr_anyhit_tune *t, const void *owner) {
   const double cost0 = (double)t->cycles[0] / (double)t->rays[0];
   const double cost1 = (double)t->cycles[1] / (double)t->rays[1];
   const int nearest = cost1 < FR_ANYHIT_TUNE_MARGIN * cost0;
-  const int far = cost0 > 1.25 * cost1 || cost1 > 1.25 * cost0;
+  const int far = cost0 > FR_ANYHIT_TUNE_FAR * cost1 || cost1 > FR_ANYHIT_TUNE_FAR * cost0;
   return c % (far ? FR_ANYHIT_TUNE_PROBE_FAR : FR_ANYHIT_TUNE_PROBE) == 0 ? FR_ANYHIT_PROBE : nearest;
 }
 
