@@ -170,6 +170,8 @@ expect 2 "$F" bench --builtin --size 32x32 --workload soft16 --mode mft --repeat
 expect 0 "$F" bench --builtin --size 32x32 --workload soft16 --mode mft --repeat 1 --mft-fallback off
 grep -q ' fallback=off' "$T/out" && ok || bad "bench mft fallback off"
 expect 2 "$F" bench --builtin --workload soft16 --mode mft --mft-fallback maybe
+expect 0 "$F" bench --builtin --size 32x32 --workload soft16 --mode mft --repeat 1 --mft-shaft off
+expect 2 "$F" bench --builtin --workload soft16 --mode mft --mft-shaft maybe
 expect 2 "$F" bench --builtin --workload soft16 --mode mft --mft-leaf 16
 expect 2 "$F" bench --builtin --workload soft16 --mode mft --corner-rays sometimes
 

@@ -49,7 +49,26 @@ static void make_shadow_batch(fr_rng *r, const mesh_ref *m, vec3 lc, float eps, 
   }
 }
 
-typedef struct tally { long rays, disagree, excused, cache_filled, plane_rays, planes_only; } tally;
+typedef struct tally { long rays, disagree, excused, cache_filled, plane_rays, planes_only, shafts; } tally;
+
+/* A shaft (fr_mft_shaft) around every ray of batch b: from the box of its
+ * origins to the box of its rays' ends, origin + start + the box of the
+ * set's deltas. */
+static int batch_shaft(const fr_bvh2 *tree, const fr_mft_batch *b, const fr_mft_sets *T, fr_mft_shaft *sh) {
+  float plo[3] = {INFINITY, INFINITY, INFINITY}, phi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  float qlo[3] = {INFINITY, INFINITY, INFINITY}, qhi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  if (!(b->valid & 0xFFFFu)) return 0;
+  for (int f = 0; f < 16; f++) {
+    if (!((b->valid >> f) & 1)) continue;
+    const fr_mft_set *S = &T->set[b->set[f]];
+    for (int a = 0; a < 3; a++) {
+      const float o = b->org[a][f], e = o + b->start[a][f];
+      plo[a] = fminf(plo[a], o); phi[a] = fmaxf(phi[a], o);
+      qlo[a] = fminf(qlo[a], e + S->lo[a]); qhi[a] = fmaxf(qhi[a], e + S->hi[a]);
+    }
+  }
+  return fr_mft_shaft_build(tree, plo, phi, qlo, qhi, sh);
+}
 
 /* The same rays as 16 packets of 16 (one per frustum), traced as pure packets. */
 static void packet16_occluded(fr_scene *s, const fr_mft_batch *b, const fr_mft_sets *T, uint16_t occ[16]) {
@@ -125,6 +144,24 @@ static void check_shadows_vs(const fr_scene *s, const fr_mft_batch *b, const fr_
           isa_fns[i]->occluded(&s->bvh2_mft, &o, b, T, occ_c, NULL, &c);
           assert_memory_equal(occ_c, occ, sizeof occ);
           if (!own) carried = c;
+        }
+        /* the leaves of a shaft around the batch in place of the walk
+         * (fr_mft_shaft), alone and after cached occluders: the same bits
+         * (with the default switches at every ISA) */
+        fr_mft_shaft sh;
+        if (corner == 2 && shrink == FR_MFT_SHRINK_ALL && batch_shaft(&s->bvh2_mft, b, T, &sh)) {
+          for (int cached = 0; cached < 2; cached++) {
+            fr_mft_occluders c = {{0}, 0, &sh};
+            uint16_t occ_s[16];
+            if (cached) {
+              c.shaft = NULL;
+              isa_fns[i]->occluded(&s->bvh2_mft, &o, b, T, occ_s, NULL, &c);
+              c.shaft = &sh;
+            }
+            isa_fns[i]->occluded(&s->bvh2_mft, &o, b, T, occ_s, NULL, &c);
+            assert_memory_equal(occ_s, occ, sizeof occ);
+          }
+          tl->shafts++;
         }
         if (first) {
           memcpy(ref, occ, sizeof ref);
@@ -506,8 +543,9 @@ static void builtin_scene(void **state) {
       camera_shadow_batch(s, &cam, bx, by, lc, centre, 1e-4f * v3_len(ext), &b);
       check_shadows(s, &b, &T, &tl);
     }
-  print_message("built-in scene: %ld rays, %ld disagreements (all at edges or range ends), %ld batches with cached occluders\n",
-                tl.rays, tl.disagree, tl.cache_filled);
+  print_message("built-in scene: %ld rays, %ld disagreements (all at edges or range ends), %ld batches with cached occluders, "
+                "%ld through shafts\n", tl.rays, tl.disagree, tl.cache_filled, tl.shafts);
+  assert_true(tl.shafts > 0);
   assert_true(tl.disagree * 1000 < tl.rays);
   assert_true(tl.cache_filled > 0);
   fr_scene_release(s);
@@ -673,6 +711,8 @@ static void shared_scenes(void **state) {
   print_message("shared scenes: %ld rays, %ld disagreements (all at edges or range ends), %ld rays in planar occluders "
                 "(%ld bits from the occluders alone)\n",
                 tl.rays, tl.disagree, tl.plane_rays, tl.planes_only);
+  print_message("shared scenes: %ld batches through shafts\n", tl.shafts);
+  assert_true(tl.shafts > 0);
   assert_true(tl.planes_only > 0); /* kitchen's table top */
   assert_true(checked >= 14);
   assert_true(tl.disagree * 1000 < tl.rays);
@@ -730,7 +770,7 @@ static void light_sets_are_nets(void **state) {
  * short, its rays still open joining the streams. On the kitchen at 64x64
  * every path runs (frusta, streams, a stopped batch): the visibility must
  * match the stream tracer's, pixel by pixel, up to rays grazing an edge. */
-typedef struct ray_counter { fr_tracer inner; size_t rays, batches, stream_rays, stopped; } ray_counter;
+typedef struct ray_counter { fr_tracer inner; size_t rays, batches, stream_rays, stopped, shaft_batches; } ray_counter;
 
 static void counted_occluded(void *ctx, const fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
   ray_counter *c = ctx;
@@ -753,9 +793,15 @@ static unsigned counted_occluded_frusta(void *ctx, const fr_mft_batch *b, const 
                                         fr_mft_budget *budget, fr_mft_occluders *cache) {
   ray_counter *c = ctx;
   c->batches++;
+  c->shaft_batches += cache && cache->shaft;
   const unsigned fetched = c->inner.occluded_frusta(c->inner.ctx, b, t, occ, budget, cache);
   c->stopped += budget && budget->stopped;
   return fetched;
+}
+
+static const fr_bvh2 *counted_shaft_tree(void *ctx) {
+  ray_counter *c = ctx;
+  return c->inner.shaft_tree(c->inner.ctx);
 }
 
 static void soft_fallback(void **state) {
@@ -765,7 +811,7 @@ static void soft_fallback(void **state) {
   fr_scene *s;
   if (fr_scene_load(path, &s) != FR_OK) fail_msg("%s: %s", path, fr_last_error());
   assert_int_equal(fr_scene_commit(s), FR_OK);
-  enum { SZ = 64 };
+  enum { SZ = 128 };
   fr_workload w;
   memset(&w, 0, sizeof w);
   w.scene = s;
@@ -778,14 +824,25 @@ static void soft_fallback(void **state) {
   fr_softshadow_opts so = {16, 0, FR_LIGHT_SETS_SPREAD};
   static float img[SZ * SZ * 3], vis_mft[SZ * SZ], vis_rays[SZ * SZ];
   fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
-  ray_counter c = {fr_tracer_mft(&mctx), 0, 0, 0, 0};
-  fr_tracer counted = {&c, counted_intersect, counted_occluded, counted_intersect_frusta, counted_occluded_frusta, 0};
+  ray_counter c = {fr_tracer_mft(&mctx), 0, 0, 0, 0, 0};
+  fr_tracer counted = {&c, counted_intersect, counted_occluded, counted_intersect_frusta, counted_occluded_frusta, 0,
+                       counted_shaft_tree};
   fr_workload_result r;
+  /* without tile shafts first (every batch walks from the root), then
+   * with: the same visibility */
+  static float vis_walk[SZ * SZ];
+  w.mft_no_shaft = 1;
+  assert_int_equal(fr_render_softshadow(&w, &counted, &so, img, vis_walk, &r), FR_OK);
+  w.mft_no_shaft = 0;
+  assert_int_equal(c.shaft_batches, 0);
+  c.batches = c.stopped = c.rays = c.stream_rays = 0;
   assert_int_equal(fr_render_softshadow(&w, &counted, &so, img, vis_mft, &r), FR_OK);
+  assert_true(c.shaft_batches > 0);
+  assert_memory_equal(vis_walk, vis_mft, sizeof vis_mft);
   fr_tracer rays = fr_tracer_frusta(s);
   assert_int_equal(fr_render_softshadow(&w, &rays, &so, img, vis_rays, &r), FR_OK);
-  print_message("kitchen soft shadows: %zu frusta batches (%zu stopped short), %zu rays as rays, %zu of them in ray "
-                "streams\n", c.batches, c.stopped, c.rays, c.stream_rays);
+  print_message("kitchen soft shadows: %zu frusta batches (%zu stopped short, %zu through tile shafts), %zu rays as "
+                "rays, %zu of them in ray streams\n", c.batches, c.stopped, c.shaft_batches, c.rays, c.stream_rays);
   /* every path ran; fallen-back tiles take streams only */
   assert_true(c.batches > 0 && c.rays > 0 && c.rays == c.stream_rays && c.stopped > 0);
   double sum = 0.0;
@@ -798,6 +855,114 @@ static void soft_fallback(void **state) {
   fr_scene_release(s);
 }
 
+/* Whether segment p + t (q - p), t in [0, 1], meets box [lo, hi], in
+ * double precision. */
+static int segment_meets(const double p[3], const double q[3], const float lo[3], const float hi[3]) {
+  double t0 = 0.0, t1 = 1.0;
+  for (int a = 0; a < 3; a++) {
+    const double d = q[a] - p[a];
+    if (d == 0.0) {
+      if (p[a] < lo[a] || p[a] > hi[a]) return 0;
+      continue;
+    }
+    double u = (lo[a] - p[a]) / d, v = (hi[a] - p[a]) / d;
+    if (u > v) { double w = u; u = v; v = w; }
+    t0 = u > t0 ? u : t0;
+    t1 = v < t1 ? v : t1;
+  }
+  return t0 <= t1;
+}
+
+/* Every leaf a segment from P to Q meets, walking the whole tree, must be
+ * in the shaft's list: random boxes of origins (points, flat, wide) on
+ * random scenes and the built-in one, a quad light's box, and segments
+ * from their corners, faces and insides. */
+static void check_shaft_covers(const fr_bvh2 *b, fr_rng *r, const float plo[3], const float phi[3], const float qlo[3],
+                               const float qhi[3], long *built, long *segments) {
+  fr_mft_shaft sh;
+  if (!fr_mft_shaft_build(b, plo, phi, qlo, qhi, &sh)) return;
+  (*built)++;
+  for (int n = 0; n < 200; n++) {
+    double p[3], q[3];
+    for (int a = 0; a < 3; a++) {
+      /* a third of the coordinates on the box's faces */
+      const unsigned k = fr_rng_u32(r) % 3;
+      const double up = k == 0 ? 0.0 : k == 1 ? 1.0 : fr_rng_float(r), uq = fr_rng_u32(r) % 3 ? fr_rng_float(r) : (double)(n & 1);
+      p[a] = plo[a] + up * ((double)phi[a] - plo[a]);
+      q[a] = qlo[a] + uq * ((double)qhi[a] - qlo[a]);
+    }
+    uint32_t stack[256];
+    int sp = 0;
+    stack[sp++] = b->root;
+    while (sp) {
+      const uint32_t node = stack[--sp];
+      const fr_bvh2_node *nd = &b->nodes[node];
+      for (int k = 0; k < 2; k++) {
+        const float lo[3] = {nd->lo_x[k], nd->lo_y[k], nd->lo_z[k]}, hi[3] = {nd->hi_x[k], nd->hi_y[k], nd->hi_z[k]};
+        if (!segment_meets(p, q, lo, hi)) continue;
+        const uint32_t c = nd->child[k];
+        if (!(c & FR_BVH2_LEAF)) {
+          assert_true(sp < 256);
+          stack[sp++] = c;
+          continue;
+        }
+        if (!FR_BVH2_LEAF_COUNT(c)) continue;
+        int listed = 0;
+        for (unsigned i = 0; i < sh.n; i++) listed |= sh.leaf[i] == (node << 1 | (uint32_t)k);
+        if (!listed) fail_msg("leaf %u/%d met by a segment is not in the shaft", node, k);
+      }
+    }
+    (*segments)++;
+  }
+}
+
+static void shaft_covers(void **state) {
+  (void)state;
+  fr_rng r = fr_rng_seed(17, 4);
+  long built = 0, segments = 0;
+  for (int round = 0; round < 7; round++) {
+    fr_scene *s;
+    scene_data sd = {0};
+    float size = 1.0f;
+    vec3 center = v3(0, 0, 0);
+    if (round == 6) {
+      assert_int_equal(fr_scene_builtin(&s), FR_OK);
+      assert_int_equal(fr_scene_commit(s), FR_OK);
+      float lo[3], hi[3];
+      fr_scene_bounds(s, lo, hi);
+      center = v3_scale(v3_add(v3_load(lo), v3_load(hi)), 0.5f);
+      size = 0.5f * v3_len(v3_sub(v3_load(hi), v3_load(lo)));
+    } else {
+      center = round % 3 == 2 ? v3(1e4f, -3e3f, 2e3f) : v3(0, 0, 0);
+      size = round % 2 ? 1.0f : 30.0f;
+      sd = make_scene(&r, 400 + 200 * (size_t)round, center, size);
+      s = commit_scene(&sd);
+    }
+    mesh_ref m = scene_mesh(s);
+    for (int n = 0; n < 300; n++) {
+      /* origins around a surface point: a point, a flat box, a box */
+      const vec3 c = random_surface_point(&r, &m);
+      const float ext[3] = {0.0f, n % 3 ? 0.02f * size * fr_rng_float(&r) : 0.0f, n % 3 == 2 ? 0.05f * size : 0.0f};
+      float plo[3], phi[3], qlo[3], qhi[3];
+      const float cc[3] = {c.x, c.y, c.z};
+      for (int a = 0; a < 3; a++) {
+        plo[a] = cc[a] - ext[(a + n) % 3];
+        phi[a] = cc[a] + ext[(a + n) % 3];
+      }
+      /* a quad light above the scene, flat in y */
+      const float lx = center.x + urand(&r, -size, size), lz = center.z + urand(&r, -size, size), ly = center.y + 2.0f * size;
+      qlo[0] = lx; qhi[0] = lx + 0.3f * size;
+      qlo[1] = qhi[1] = ly;
+      qlo[2] = lz; qhi[2] = lz + 0.2f * size;
+      check_shaft_covers(&s->bvh2_mft, &r, plo, phi, qlo, qhi, &built, &segments);
+    }
+    fr_scene_release(s);
+    if (round < 6) free_scene(&sd);
+  }
+  print_message("shafts: %ld built, %ld segments, every leaf they meet listed\n", built, segments);
+  assert_true(built > 100);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(light_sets_are_nets),
@@ -807,6 +972,7 @@ int main(void) {
       cmocka_unit_test(builtin_scene),
       cmocka_unit_test(fine_far_sphere),
       cmocka_unit_test(shared_scenes),
+      cmocka_unit_test(shaft_covers),
       cmocka_unit_test(soft_fallback),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

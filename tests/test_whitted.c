@@ -137,7 +137,7 @@ static void check_whitted_mft(fr_scene *s, const char *name, const fr_whitted_ma
     w.mft_no_fallback = no_budget;
     fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
     checker c = {fr_tracer_mft(&mctx), s, 0, 0, 0, 0, 0};
-    fr_tracer t = {&c, check_intersect, check_occluded, check_intersect_frusta, check_occluded_frusta, 0};
+    fr_tracer t = {&c, check_intersect, check_occluded, check_intersect_frusta, check_occluded_frusta, 0, NULL};
     fr_workload_result r = fr_workload_run(&w, &t);
     /* shadow frusta repeat a partial frustum's last ray, and a batch over budget goes again as rays */
     const long traced = c.rays + c.occluded_rays + c.frusta_rays;
@@ -176,7 +176,7 @@ static void check_whitted(fr_scene *s, const char *name, const char *mirror, con
   for (size_t k = 0; k < sizeof configs / sizeof configs[0]; k++) {
     fr_lp_tracer lpc = {s, {&s->bvh2, &s->sphere_bvh, fr_scene_sphere_base(s)}, {configs[k].t, configs[k].c}, configs[k].side};
     checker c = {fr_tracer_lp(&lpc), s, 0, 0, 0, 0, 0};
-    fr_tracer t = {&c, check_intersect, check_occluded, NULL, NULL, configs[k].side};
+    fr_tracer t = {&c, check_intersect, check_occluded, NULL, NULL, configs[k].side, NULL};
     fr_workload_result r = fr_workload_run(&w, &t);
     assert_int_equal(r.rays, (uint64_t)(c.rays + c.occluded_rays));
     /* secondary rays: more closest-hit rays than pixels, and shadow rays */

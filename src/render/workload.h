@@ -49,6 +49,9 @@ typedef struct fr_tracer {
   unsigned (*occluded_frusta)(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t occ[FR_MFT_FRUSTA],
                               fr_mft_budget *budget, fr_mft_occluders *cache);
   int packet_side;
+  /* the tree occluded_frusta walks, for shafts around runs of batches
+   * (fr_mft_shaft); NULL: none */
+  const fr_bvh2 *(*shaft_tree)(void *ctx);
 } fr_tracer;
 
 typedef enum fr_shade { FR_SHADE_NONE, FR_SHADE_EYELIGHT, FR_SHADE_NORMALS, FR_SHADE_LIGHT } fr_shade;
@@ -76,6 +79,9 @@ typedef struct fr_workload {
    * (SOFT_FRUSTA_MAX_TRIS in workload.c); 1 keeps every batch as frusta (the
    * paper's pure multi-frusta, to measure) */
   int mft_no_fallback;
+  /* 1: no tile shafts (SOFT_SHAFT_MAX_NODES in workload.c): every batch
+   * walks the tree from the root, to measure */
+  int mft_no_shaft;
   /* set by fr_workload_run for its tiles */
   const fr_mft_sets *light_sets;  /* this frame's interleaved samples on the quad light */
   const fr_mft_sets *camera_set;  /* the 4x4 pixels of a block */

@@ -99,9 +99,31 @@ fr_mft_opts fr_mft_opts_default(void);
  * triangle is hit, whatever the order. A caller keeps one per run of
  * neighbouring batches on one tree, zeroed at its start. */
 #define FR_MFT_OCCLUDERS 2 /* 4: conference -1% instructions, kitchen +0.6% */
+
+/* A run of batches' shaft: every leaf of the tree that a segment from the
+ * box of their origins to the box of their rays' ends may reach, as
+ * parent node << 1 | slot, so a batch tests these leaves' boxes alone
+ * instead of walking the tree from its root (fr_mft_shaft_build). */
+#define FR_MFT_SHAFT_MAX 64
+#define FR_MFT_SHAFT_STACK 128
+#define FR_MFT_SHAFT_VISITS 256 /* inner nodes a build visits at most */
+typedef struct fr_mft_shaft {
+  unsigned n;
+  uint32_t leaf[FR_MFT_SHAFT_MAX];
+} fr_mft_shaft;
+
+/* The leaves of b's tree that segments from box P (plo, phi) to box Q may
+ * reach, for t in [0, 1], into *s. Returns 0 where the shaft meets more
+ * than FR_MFT_SHAFT_MAX leaves or the root is a leaf (no list: walk). */
+int fr_mft_shaft_build(const fr_bvh2 *b, const float plo[3], const float phi[3], const float qlo[3],
+                       const float qhi[3], fr_mft_shaft *s);
+
 typedef struct fr_mft_occluders {
   uint32_t leaf[FR_MFT_OCCLUDERS]; /* leaf references of the tree, best first */
   unsigned n;
+  /* when not NULL, a shaft of this tree around every ray of the batch:
+   * its leaves replace the walk */
+  const fr_mft_shaft *shaft;
 } fr_mft_occluders;
 
 /* What a shadow batch may spend, and what it spent. A batch stops before

@@ -739,6 +739,40 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
     const unsigned got = occlude_leaf(&F, b, opt, T, ref, alive, active, active, occ, &alive, eager);
     if (got) best_leaves_add(&best, ref, got);
   }
+  if (cache && cache->shaft) {
+    /* The shaft's leaves alone, in the order its build met them: no leaf
+     * outside it can be reached, and each one's box test is the one its
+     * parent's visit would make, so the rays meet the same triangles (the
+     * answers do not depend on the order). A leaf test counts as a node
+     * visit for the budget. */
+    const fr_mft_shaft *sh = cache->shaft;
+    FR_COUNT(mft_shaft_batches, 1);
+    for (unsigned i = 0; i < sh->n && alive; i++) {
+      if (bounded && visited >= budget->nodes && fetched >= budget->tris) {
+        budget->stopped = 1;
+        goto out;
+      }
+      visited++;
+      const fr_bvh2_node *pn = &b->nodes[sh->leaf[i] >> 1];
+      const int slot = (int)(sh->leaf[i] & 1u);
+      FR_COUNT(mft_box_tests, 1);
+      FR_COUNT(mft_box_lanes, __builtin_popcount(alive));
+      vpf tn;
+      const unsigned hit = box_test(&F, pn, slot, alive, &tn);
+      if (!hit) continue;
+      const entry e = {pn->child[slot], hit, pn, slot};
+      int cached = 0;
+      for (unsigned c = 0; c < FR_MFT_OCCLUDERS; c++) cached |= e.ref == skip[c];
+      if (cached) continue;
+      unsigned rays[16], m = leaf_rays(&F, &e, hit, active, NULL, rays);
+      if (!m) continue;
+      fetched += FR_BVH2_LEAF_COUNT(e.ref);
+      const int eager = opt->shrink && fetched > EAGER_FETCHED;
+      const unsigned got = occlude_leaf(&F, b, opt, T, e.ref, m, rays, active, occ, &alive, eager);
+      if (got) best_leaves_add(&best, e.ref, got);
+    }
+    goto out;
+  }
   entry stack[STACK];
   int sp = 0;
   stack[sp++] = (entry){b->root, valid, NULL, 0};

@@ -96,13 +96,14 @@ static void report(const fr_workload *w0, const bench_run *r, const char *scene,
   if (fr_counters_enabled() && c.mft_batches)
     printf("counters tracer=%s mode=%s workload=%s batches=%llu per_batch nodes=%.2f box_tests=%.2f "
            "avg_active_frusta=%.2f tris=%.2f tri_frusta=%.2f tri_frusta_left=%.2f ray_batches=%llu stream_batches=%llu cached_leaves=%llu "
-           "stopped_batches=%llu plane_rays=%llu plane_frusta=%llu plane_whole=%llu\n",
+           "stopped_batches=%llu shafts=%llu shaft_fails=%llu shaft_batches=%llu plane_rays=%llu plane_frusta=%llu plane_whole=%llu\n",
            tracer, mode, fr_workload_name(w0->kind), (unsigned long long)c.mft_batches,
            (double)c.mft_nodes / c.mft_batches, (double)c.mft_box_tests / c.mft_batches,
            c.mft_box_tests ? (double)c.mft_box_lanes / c.mft_box_tests : 0.0, (double)c.mft_tris / c.mft_batches,
            (double)c.mft_tri_frusta / c.mft_batches, (double)c.mft_tri_left / c.mft_batches,
            (unsigned long long)c.mft_ray_batches, (unsigned long long)c.mft_stream_batches,
            (unsigned long long)c.mft_cached_leaves, (unsigned long long)c.mft_stopped_batches,
+           (unsigned long long)c.mft_shafts, (unsigned long long)c.mft_shaft_fails, (unsigned long long)c.mft_shaft_batches,
            (unsigned long long)c.mft_plane_rays, (unsigned long long)c.mft_plane_frusta,
            (unsigned long long)c.mft_plane_whole);
   if (fr_counters_enabled() && c.packets)
@@ -164,7 +165,7 @@ int cmd_bench(int argc, char **argv) {
   fr_trace_options topt;
   fr_trace_options_default(&topt);
   fr_mft_opts mopt = fr_mft_opts_default();
-  int mft_leaf = FR_MFT_LEAF, mft_leaf_set = 0, mft_no_fallback = 0;
+  int mft_leaf = FR_MFT_LEAF, mft_leaf_set = 0, mft_no_fallback = 0, mft_no_shaft = 0;
   fr_light_sets light_sets = FR_LIGHT_SETS_SPREAD;
   cli_whitted wo;
   cli_whitted_default(&wo);
@@ -176,7 +177,7 @@ int cmd_bench(int argc, char **argv) {
     const char *a = argv[i];
     if (!strcmp(a, "--threshold") || !strcmp(a, "--mailbox") || !strcmp(a, "--axis-aligned") || !strcmp(a, "--ia") ||
         !strcmp(a, "--packet-width") || !strcmp(a, "--corner-rays") || !strcmp(a, "--shrink") || !strcmp(a, "--mft-leaf") ||
-        !strcmp(a, "--corner-cost") || !strcmp(a, "--mft-fallback") ||
+        !strcmp(a, "--corner-cost") || !strcmp(a, "--mft-fallback") || !strcmp(a, "--mft-shaft") ||
         !strcmp(a, "--light-sets") || !strcmp(a, "--prefetch") || !strcmp(a, "--stream-spread") ||
         !strcmp(a, "--coherent-threshold") || !strcmp(a, "--quad") || !strcmp(a, "--hybrid-tune") ||
         !strcmp(a, "--occluder-cache") || !strcmp(a, "--anyhit-order")) {
@@ -198,6 +199,10 @@ int cmd_bench(int argc, char **argv) {
         int on = 1;
         if (parse_onoff(a, val, &on)) return CLI_USAGE_ERROR;
         mft_no_fallback = !on;
+      } else if (!strcmp(a, "--mft-shaft")) {
+        int on = 1;
+        if (parse_onoff(a, val, &on)) return CLI_USAGE_ERROR;
+        mft_no_shaft = !on;
       } else if (!strcmp(a, "--corner-cost")) {
         if (!cli_parse_float(val, &mopt.corner_cost) || !(mopt.corner_cost >= 0.0f && mopt.corner_cost <= 16.0f))
           return cli_error(CLI_USAGE_ERROR, "--corner-cost wants 0..16, got '%s'", val);
@@ -268,6 +273,7 @@ int cmd_bench(int argc, char **argv) {
   w.seed = 7;
   w.light_sets_kind = light_sets;
   w.mft_no_fallback = mft_no_fallback;
+  w.mft_no_shaft = mft_no_shaft;
   size_t tris = fr_scene_triangle_count(s);
   /* the BVH4 is built on demand: now, before any run, when a 4-wide mode wants it */
   if ((topt.packet_bvh_width == 4 || ((fsel >> 1) & 1)) && fr_scene_need_bvh4(s) != FR_OK) {
@@ -305,9 +311,9 @@ int cmd_bench(int argc, char **argv) {
     mctx.bvh = mctx.shadow_bvh = &shallow;
   }
   if (want_mft)
-    printf("mft_bvh leaf=%d shadow_leaf=%d inner=%zu leaves=%zu sah=%.2f corner_rays=%s corner_cost=%g shrink=%s fallback=%s\n",
+    printf("mft_bvh leaf=%d shadow_leaf=%d inner=%zu leaves=%zu sah=%.2f corner_rays=%s corner_cost=%g shrink=%s fallback=%s shaft=%s\n",
            mctx.bvh->max_leaf, mctx.shadow_bvh->max_leaf, mctx.bvh->nnodes, mctx.bvh->nleaves, fr_bvh2_sah(mctx.bvh), mopt.corner_rays ? "on" : "off",
-           (double)mopt.corner_cost, mopt.shrink == FR_MFT_SHRINK_ALL ? "on" : mopt.shrink == FR_MFT_SHRINK_CORNERS ? "corners" : "off", mft_no_fallback ? "off" : "on");
+           (double)mopt.corner_cost, mopt.shrink == FR_MFT_SHRINK_ALL ? "on" : mopt.shrink == FR_MFT_SHRINK_CORNERS ? "corners" : "off", mft_no_fallback ? "off" : "on", mft_no_shaft ? "off" : "on");
   fr_whitted_mats mats = {0};
   if ((all_wl || wk == FR_WL_WHITTED) && (rc = cli_whitted_setup(s, &wo, &mats, &w))) {
     fr_bvh2_free(&shallow);

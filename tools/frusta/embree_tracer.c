@@ -234,7 +234,7 @@ static void ebr_occluded(void *c, const fr_ray *rays, uint8_t *occ, size_t n, in
 }
 
 fr_tracer ebr_tracer(ebr_scene *e, ebr_mode m) {
-  fr_tracer t = {&e->ctx[m], ebr_intersect, ebr_occluded, NULL, NULL, 0};
+  fr_tracer t = {&e->ctx[m], ebr_intersect, ebr_occluded, NULL, NULL, 0, NULL};
   return t;
 }
 

@@ -25,7 +25,7 @@ static void usage(FILE *f) {
           "         auto:         [--stream-spread S] [--coherent-threshold N] (also hybrid16's one-octant packets)\n"
           "         single rays:  [--prefetch on|off|auto] [--occluder-cache on|off] [--anyhit-order auto|rank|nearest]\n"
           "         multi-frusta: [--light-sets spread|cells] [--corner-rays on|off] [--corner-cost C]\n"
-          "                       [--shrink on|corners|off] [--mft-leaf N] [--mft-fallback on|off]\n"
+          "                       [--shrink on|corners|off] [--mft-leaf N] [--mft-fallback on|off] [--mft-shaft on|off]\n"
           "         NxN packets:  [--traversal masked|ranged|partition] [--cull off|ia|planes|corners]\n"
           "         whitted:      [--mirror NAME,..|all] [--glass NAME,..] [--depth N]\n"
           "  trace  SCENE RAYS --query closest|any --out FILE [--tracer frusta|embree]\n"
