@@ -110,6 +110,10 @@ fr_mft_opts fr_mft_opts_default(void);
 typedef struct fr_mft_shaft {
   unsigned n;
   uint32_t leaf[FR_MFT_SHAFT_MAX];
+  /* bit i: the tree's planar occluder i (accel/plane_occluders.h) may be
+   * crossed by a segment of the shaft (bits past the 32nd are not kept:
+   * those are always tested) */
+  uint32_t planes;
 } fr_mft_shaft;
 
 /* The leaves of b's tree that segments from box P (plo, phi) to box Q may

@@ -8,6 +8,7 @@
  * two boxes, done once per tile in double precision on padded boxes.
  */
 #include <math.h>
+#include "accel/plane_occluders.h"
 #include "trace/mft.h"
 
 /* The shaft as six planes of t: per axis, its low side plo + t dl and its
@@ -51,6 +52,18 @@ int fr_mft_shaft_build(const fr_bvh2 *b, const float plo[3], const float phi[3],
     if (fabsf(dh) < tiny) dh = copysignf(tiny, dh);
     S.il[a] = 1.0f / dl;
     S.ih[a] = 1.0f / dh;
+  }
+  /* the planar occluders whose polygon's box the shaft meets: a ray one
+   * claims crosses the polygon, so the others can claim none */
+  s->planes = 0;
+  for (size_t i = 0; b->planes && i < b->planes->n && i < 32; i++) {
+    const fr_plane_occluder *p = &b->planes->list[i];
+    const int a = p->axis, u = (a + 1) % 3, v = (a + 2) % 3;
+    float lo[3], hi[3];
+    lo[a] = hi[a] = p->c;
+    lo[u] = p->lo[0]; hi[u] = p->hi[0];
+    lo[v] = p->lo[1]; hi[v] = p->hi[1];
+    if (shaft_meets(&S, lo, hi)) s->planes |= 1u << i;
   }
   uint32_t stack[FR_MFT_SHAFT_STACK];
   int sp = 0, visits = 0;

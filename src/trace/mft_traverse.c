@@ -595,13 +595,16 @@ FR_INLINE unsigned occlude_leaf(frusta *F, const fr_bvh2 *b, const fr_mft_opts *
  * margins far above the rounding of this test and of the triangle tests, is
  * occluded by one of its triangles, so it joins occ[f] as its traversal
  * would have made it. A frustum whose corner rays do not all cross the
- * plane is passed by (its rays are left to the traversal). Returns the rays
- * occluded. */
-static unsigned occlude_planes(frusta *F, const fr_plane_occluders *planes, const fr_mft_opts *opt, const fr_mft_sets *T,
-                               unsigned active[16], uint16_t occ[16], unsigned *alive) {
+ * plane is passed by (its rays are left to the traversal). Only the
+ * occluders of bit mask `which` are tested (those past the 32nd always):
+ * a shaft around the batch (fr_mft_shaft) tells which it may cross.
+ * Returns the rays occluded. */
+static unsigned occlude_planes(frusta *F, const fr_plane_occluders *planes, uint32_t which, const fr_mft_opts *opt,
+                               const fr_mft_sets *T, unsigned active[16], uint16_t occ[16], unsigned *alive) {
   unsigned shrink = 0, occluded = 0;
   const vpf zero = vp(0.0f), tf16 = vp_load(F->tfar);
   for (size_t i = 0; i < planes->n && *alive; i++) {
+    if (i < 32 && !((which >> i) & 1u)) continue;
     const fr_plane_occluder *p = &planes->list[i];
     const int a = p->axis, u = (a + 1) % 3, v = (a + 2) % 3;
     /* All frusta at once (one by one this cost Whitted's thin point-light
@@ -687,7 +690,7 @@ static void occluded_planes_only(const fr_bvh2 *b, const fr_mft_opts *opt, const
   frusta_setup(&F, B, T, valid);
   unsigned active[16], alive = valid;
   for (int f = 0; f < 16; f++) active[f] = (valid >> f) & 1 ? 0xFFFFu : 0;
-  occlude_planes(&F, b->planes, opt, T, active, occ, &alive);
+  occlude_planes(&F, b->planes, ~0u, opt, T, active, occ, &alive);
 }
 
 static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B, const fr_mft_sets *T,
@@ -712,7 +715,7 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
   for (int f = 0; f < 16; f++) active[f] = (valid >> f) & 1 ? 0xFFFFu : 0;
   unsigned alive = valid;
   /* the scene's planar occluders first: no fetch, no box test */
-  if (b->planes) occlude_planes(&F, b->planes, opt, T, active, occ, &alive);
+  if (b->planes) occlude_planes(&F, b->planes, cache && cache->shaft ? cache->shaft->planes : ~0u, opt, T, active, occ, &alive);
   /* The previous batch's best occluders first (see fr_mft_occluders): all
    * active rays, no box test; the traversal then skips those leaves, which
    * every ray still active has missed. What it saves is the traversal of
