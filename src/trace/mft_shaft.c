@@ -32,30 +32,30 @@ static inline int shaft_meets(const shaft_planes *S, const float lo[3], const fl
   return t0 <= t1;
 }
 
-int fr_mft_shaft_build(const fr_bvh2 *b, const float plo[3], const float phi[3], const float qlo[3],
-                       const float qhi[3], fr_mft_shaft *s) {
-  s->n = 0;
-  if (!b->nodes || (b->root & FR_BVH2_LEAF)) return 0;
-  /* Pad both boxes far beyond the rounding of the rays' directions (made in
-   * float from the light's corner and edges) and of this test: by 1e-4 of
-   * the scene's size and position. */
+/* The shaft of the padded boxes on tree b. Pad both boxes far beyond the
+ * rounding of the rays' directions (made in float from the light's corner
+ * and edges) and of this test: by 1e-4 of the scene's size and position. */
+static void shaft_setup(const fr_bvh2 *b, const float plo[3], const float phi[3], const float qlo[3], const float qhi[3],
+                        shaft_planes *S) {
   const float *blo = &b->bounds.lo.x, *bhi = &b->bounds.hi.x;
   float size = 0.0f;
-  for (int a = 0; a < 3; a++) size = fmaxf(size, fmaxf(fmaxf(fabsf(blo[a]), fabsf(bhi[a])), bhi[a] - blo[a]));
+  for (int a = 0; a < 3; a++) size = max2(size, max2(max2(fabsf(blo[a]), fabsf(bhi[a])), bhi[a] - blo[a]));
   const float pad = 1e-4f * size, tiny = 1e-30f;
-  shaft_planes S;
   for (int a = 0; a < 3; a++) {
-    S.plo[a] = plo[a] - pad;
-    S.phi[a] = phi[a] + pad;
-    float dl = (qlo[a] - pad) - S.plo[a], dh = (qhi[a] + pad) - S.phi[a];
+    S->plo[a] = plo[a] - pad;
+    S->phi[a] = phi[a] + pad;
+    float dl = (qlo[a] - pad) - S->plo[a], dh = (qhi[a] + pad) - S->phi[a];
     if (fabsf(dl) < tiny) dl = copysignf(tiny, dl);
     if (fabsf(dh) < tiny) dh = copysignf(tiny, dh);
-    S.il[a] = 1.0f / dl;
-    S.ih[a] = 1.0f / dh;
+    S->il[a] = 1.0f / dl;
+    S->ih[a] = 1.0f / dh;
   }
-  /* the planar occluders whose polygon's box the shaft meets: a ray one
-   * claims crosses the polygon, so the others can claim none */
-  s->planes = 0;
+}
+
+/* The planar occluders whose polygon's box the shaft meets: a ray one
+ * claims crosses the polygon, so the others can claim none. */
+static uint32_t shaft_planes_met(const fr_bvh2 *b, const shaft_planes *S) {
+  uint32_t m = 0;
   for (size_t i = 0; b->planes && i < b->planes->n && i < 32; i++) {
     const fr_plane_occluder *p = &b->planes->list[i];
     const int a = p->axis, u = (a + 1) % 3, v = (a + 2) % 3;
@@ -63,8 +63,18 @@ int fr_mft_shaft_build(const fr_bvh2 *b, const float plo[3], const float phi[3],
     lo[a] = hi[a] = p->c;
     lo[u] = p->lo[0]; hi[u] = p->hi[0];
     lo[v] = p->lo[1]; hi[v] = p->hi[1];
-    if (shaft_meets(&S, lo, hi)) s->planes |= 1u << i;
+    if (shaft_meets(S, lo, hi)) m |= 1u << i;
   }
+  return m;
+}
+
+int fr_mft_shaft_build(const fr_bvh2 *b, const float plo[3], const float phi[3], const float qlo[3],
+                       const float qhi[3], fr_mft_shaft *s) {
+  s->n = 0;
+  if (!b->nodes || (b->root & FR_BVH2_LEAF)) return 0;
+  shaft_planes S;
+  shaft_setup(b, plo, phi, qlo, qhi, &S);
+  s->planes = shaft_planes_met(b, &S);
   uint32_t stack[FR_MFT_SHAFT_STACK];
   int sp = 0, visits = 0;
   stack[sp++] = b->root;
