@@ -844,8 +844,8 @@ static void soft_fallback(void **state) {
   fr_tracer counted = {&c, counted_intersect, counted_occluded, counted_intersect_frusta, counted_occluded_frusta, 0,
                        counted_shaft_tree};
   fr_workload_result r;
-  /* without tile shafts first (every batch walks from the root), then
-   * with: the same visibility */
+  /* without tile shafts first (every batch walks from the root, and no
+   * shaft decides a fall-back), then with: the same visibility */
   static float vis_walk[SZ * SZ];
   w.mft_no_shaft = 1;
   assert_int_equal(fr_render_softshadow(&w, &counted, &so, img, vis_walk, &r), FR_OK);

@@ -125,6 +125,18 @@ void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, 
  * Interleaved, 2 threads, 1024x1024, soft16 mft, against bounds of 2
  * and 6: 1.009x, 1.010x; 64 leaves at most against 32 and 128: the same. */
 #define SOFT_SHAFT_MAX_NODES 3u
+/* A tile whose first batch fetched more than this many triangles and
+ * visited more than this many nodes per frustum, but stayed within the
+ * fall-back's bounds (SOFT_FRUSTA_MAX_*), falls back too unless its shaft
+ * can be listed: then its batches' cost is bounded by the list's, without
+ * it they walk as many nodes as the first. Lowering the fall-back's own
+ * bounds to these gained kitchen 1.037x but cost conference 0.950x and
+ * sibenik 0.974x (3 pairs each); decided by the shaft, kitchen 1.024x,
+ * dragon 1.042x, conference 0.990x, sibenik 0.997x (interleaved, 2
+ * threads, 1024x1024, soft16 mft). Tris 2 or 3 read the same as 4; nodes
+ * 10 gave kitchen 1.011x. */
+#define SOFT_SHAFT_DECIDES_TRIS 4u
+#define SOFT_SHAFT_DECIDES_NODES 8u
 
 /* The shaft of a tile's n pixels' shadow rays on tree b: from the box of
  * their primary hit points to the box of the quad light. 0: none (no hit,
@@ -214,8 +226,8 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
     rays += 16u * (uint64_t)bits16(b.valid);
     uint16_t occ[FR_MFT_FRUSTA] = {0};
     const int framed = !as_rays; /* traced as frusta (planar occluders included) */
-    if (framed && jj == 1 && !w->mft_no_shaft && t->shaft_tree && first_visited <= SOFT_SHAFT_MAX_NODES * first_nf &&
-        tile_shaft(w, t->shaft_tree(t->ctx), B, n, &shaft))
+    if (framed && jj == 1 && !cache.shaft && !w->mft_no_shaft && t->shaft_tree &&
+        first_visited <= SOFT_SHAFT_MAX_NODES * first_nf && tile_shaft(w, t->shaft_tree(t->ctx), B, n, &shaft))
       cache.shaft = &shaft;
     if (!as_rays) {
       /* The batch stops as soon as the rule below is sure to send the rest
@@ -232,9 +244,17 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
         budget.tris = SOFT_FRUSTA_MAX_TRIS * nf + 1;
       }
       const unsigned fetched = t->occluded_frusta(t->ctx, &b, T, occ, &budget, &cache);
-      if (jj == 0) first_visited = budget.visited, first_nf = nf;
       as_rays = as_streams = !w->mft_no_fallback && fetched > SOFT_FRUSTA_MAX_TRIS * nf &&
                              budget.visited > SOFT_FRUSTA_MAX_NODES * nf;
+      if (jj == 0) {
+        first_visited = budget.visited, first_nf = nf;
+        /* a first batch between the bounds: the tile's shaft decides */
+        if (!as_rays && !w->mft_no_fallback && !w->mft_no_shaft && t->shaft_tree &&
+            fetched > SOFT_SHAFT_DECIDES_TRIS * nf && budget.visited > SOFT_SHAFT_DECIDES_NODES * nf) {
+          if (tile_shaft(w, t->shaft_tree(t->ctx), B, n, &shaft)) cache.shaft = &shaft;
+          else as_rays = as_streams = 1;
+        }
+      }
       if (!budget.stopped) {
         float open[FR_MFT_FRUSTA]; /* all lanes at once, vectorized */
         for (int f = 0; f < FR_MFT_FRUSTA; f++) open[f] = (float)(16 - bits16(occ[f])) / 16.0f;
