@@ -54,7 +54,8 @@ typedef struct tally { long rays, disagree, excused, cache_filled, plane_rays, p
 /* A shaft (fr_mft_shaft) around every ray of batch b: from the box of its
  * origins to the box of its rays' ends, origin + start + the box of the
  * set's deltas. */
-static int batch_shaft(const fr_bvh2 *tree, const fr_mft_batch *b, const fr_mft_sets *T, fr_mft_shaft *sh) {
+static int batch_shaft(const fr_bvh2 *tree, const fr_mft_batch *b, const fr_mft_sets *T, fr_mft_shaft *sh,
+                       uint32_t *planes_off) {
   float plo[3] = {INFINITY, INFINITY, INFINITY}, phi[3] = {-INFINITY, -INFINITY, -INFINITY};
   float qlo[3] = {INFINITY, INFINITY, INFINITY}, qhi[3] = {-INFINITY, -INFINITY, -INFINITY};
   if (!(b->valid & 0xFFFFu)) return 0;
@@ -67,6 +68,7 @@ static int batch_shaft(const fr_bvh2 *tree, const fr_mft_batch *b, const fr_mft_
       qlo[a] = fminf(qlo[a], e + S->lo[a]); qhi[a] = fmaxf(qhi[a], e + S->hi[a]);
     }
   }
+  *planes_off = fr_mft_shaft_planes_off(tree, plo, phi, qlo, qhi);
   return fr_mft_shaft_build(tree, plo, phi, qlo, qhi, sh);
 }
 
@@ -149,12 +151,13 @@ static void check_shadows_vs(const fr_scene *s, const fr_mft_batch *b, const fr_
          * (fr_mft_shaft), alone and after cached occluders: the same bits
          * (with the default switches at every ISA) */
         fr_mft_shaft sh;
+        uint32_t off = 0;
         const fr_bvh2 *st = &s->bvh2; /* soft shadows' tree, with the planar occluders */
-        if (corner == 2 && shrink == FR_MFT_SHRINK_ALL && batch_shaft(st, b, T, &sh)) {
+        if (corner == 2 && shrink == FR_MFT_SHRINK_ALL && batch_shaft(st, b, T, &sh, &off)) {
           uint16_t occ_w[16];
           isa_fns[i]->occluded(st, &o, b, T, occ_w, NULL, NULL);
           for (int cached = 0; cached < 2; cached++) {
-            fr_mft_occluders c = {{0}, 0, &sh};
+            fr_mft_occluders c = {{0}, 0, &sh, off};
             uint16_t occ_s[16];
             if (cached) {
               c.shaft = NULL;
@@ -164,10 +167,20 @@ static void check_shadows_vs(const fr_scene *s, const fr_mft_batch *b, const fr_
             isa_fns[i]->occluded(st, &o, b, T, occ_s, NULL, &c);
             assert_memory_equal(occ_s, occ_w, sizeof occ_w);
           }
+          /* the planar occluders alone (a fall-back's batches), with and
+           * without those the shaft leaves out: the same bits */
+          if (st->planes) {
+            fr_mft_occluders c = {{0}, 0, NULL, off};
+            fr_mft_budget only = {0, 0, 0, 0, 1};
+            uint16_t occ_o[16], occ_a[16];
+            isa_fns[i]->occluded(st, &o, b, T, occ_o, &only, &c);
+            isa_fns[i]->occluded(st, &o, b, T, occ_a, &only, NULL);
+            assert_memory_equal(occ_o, occ_a, sizeof occ_a);
+          }
           /* the planar occluders the shaft leaves out claim none of its rays */
           const fr_plane_occluders *po = st->planes;
           for (size_t q = 0; i == 0 && po && q < po->n && q < 32; q++) {
-            if ((sh.planes >> q) & 1u) continue;
+            if (!((off >> q) & 1u)) continue;
             for (int f = 0; f < 16; f++)
               for (int k = 0; f < 16 && ((b->valid >> f) & 1) && k < 16; k++) {
                 fr_ray r;

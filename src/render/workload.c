@@ -138,36 +138,42 @@ void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, 
 #define SOFT_SHAFT_DECIDES_TRIS 4u
 #define SOFT_SHAFT_DECIDES_NODES 8u
 
-/* The shaft of a tile's n pixels' shadow rays on tree b: from the box of
- * their primary hit points to the box of the quad light. 0: none (no hit,
- * or too wide a shaft). */
-static int tile_shaft(const fr_workload *w, const fr_bvh2 *b, const buffers *B, int n, fr_mft_shaft *s) {
-  float plo[3] = {INFINITY, INFINITY, INFINITY}, phi[3] = {-INFINITY, -INFINITY, -INFINITY};
+/* The box of a tile's n pixels' shadow rays' origins (their primary hit
+ * points) and the box of their ends (the quad light); 0 where no pixel has
+ * a hit. */
+typedef struct tile_box { float plo[3], phi[3], qlo[3], qhi[3]; } tile_box;
+
+static int tile_box_of(const fr_workload *w, const buffers *B, int n, tile_box *tb) {
   int any = 0;
+  for (int a = 0; a < 3; a++) tb->plo[a] = tb->qlo[a] = INFINITY, tb->phi[a] = tb->qhi[a] = -INFINITY;
   for (int i = 0; i < n; i++) {
     const fr_hit *h = &B->prim_hit[i];
     if (h->prim == FR_INVALID_ID) continue;
     const vec3 p = hit_point(&B->prim_ray[i], h); /* the batches' origins, bit for bit */
     const float pc[3] = {p.x, p.y, p.z};
     for (int a = 0; a < 3; a++) { /* comparisons, not fminf: a libm call without -ffast-math */
-      plo[a] = pc[a] < plo[a] ? pc[a] : plo[a];
-      phi[a] = pc[a] > phi[a] ? pc[a] : phi[a];
+      tb->plo[a] = pc[a] < tb->plo[a] ? pc[a] : tb->plo[a];
+      tb->phi[a] = pc[a] > tb->phi[a] ? pc[a] : tb->phi[a];
     }
     any = 1;
   }
-  if (!any) return 0;
   const vec3 c0 = w->view.area_c, c1 = v3_add(c0, w->view.area_e1), c2 = v3_add(c0, w->view.area_e2),
              c3 = v3_add(c1, w->view.area_e2);
   const vec3 cs[4] = {c0, c1, c2, c3};
-  float qlo[3] = {INFINITY, INFINITY, INFINITY}, qhi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (int k = 0; k < 4; k++) {
     const float q[3] = {cs[k].x, cs[k].y, cs[k].z};
     for (int a = 0; a < 3; a++) {
-      qlo[a] = q[a] < qlo[a] ? q[a] : qlo[a];
-      qhi[a] = q[a] > qhi[a] ? q[a] : qhi[a];
+      tb->qlo[a] = q[a] < tb->qlo[a] ? q[a] : tb->qlo[a];
+      tb->qhi[a] = q[a] > tb->qhi[a] ? q[a] : tb->qhi[a];
     }
   }
-  const int ok = fr_mft_shaft_build(b, plo, phi, qlo, qhi, s);
+  return any;
+}
+
+/* The shaft of a tile's shadow rays on tree b (fr_mft_shaft_build);
+ * 0: none (too wide). */
+static int tile_shaft(const fr_bvh2 *b, const tile_box *tb, fr_mft_shaft *s) {
+  const int ok = fr_mft_shaft_build(b, tb->plo, tb->phi, tb->qlo, tb->qhi, s);
   FR_COUNT(mft_shafts, 1);
   FR_COUNT(mft_shaft_fails, !ok);
   return ok;
@@ -195,8 +201,14 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
   uint8_t by_rays[TILE_PIX] = {0};
   /* one per tile, so that what a batch costs does not depend on which
    * thread traced the tile before */
-  fr_mft_occluders cache = {{0}, 0, NULL};
+  fr_mft_occluders cache = {{0}, 0, NULL, 0};
   fr_mft_shaft shaft;
+  /* the tile's shaft: which planar occluders its rays may cross, and
+   * (below) the leaves they may reach */
+  tile_box tb;
+  const fr_bvh2 *shaft_tree = t->occluded_frusta && t->shaft_tree && !w->mft_no_shaft ? t->shaft_tree(t->ctx) : NULL;
+  if (shaft_tree && !tile_box_of(w, B, n, &tb)) shaft_tree = NULL;
+  if (shaft_tree) cache.planes_off = fr_mft_shaft_planes_off(shaft_tree, tb.plo, tb.phi, tb.qlo, tb.qhi);
   unsigned first_visited = 0, first_nf = 0; /* the tile's first batch's walk */
   for (int jj = 0; jj < (n + 15) / 16; jj++) {
     /* a full tile's 4x4 blocks in serpentine order: each batch borrows the
@@ -226,8 +238,8 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
     rays += 16u * (uint64_t)bits16(b.valid);
     uint16_t occ[FR_MFT_FRUSTA] = {0};
     const int framed = !as_rays; /* traced as frusta (planar occluders included) */
-    if (framed && jj == 1 && !cache.shaft && !w->mft_no_shaft && t->shaft_tree &&
-        first_visited <= SOFT_SHAFT_MAX_NODES * first_nf && tile_shaft(w, t->shaft_tree(t->ctx), B, n, &shaft))
+    if (framed && jj == 1 && !cache.shaft && shaft_tree && first_visited <= SOFT_SHAFT_MAX_NODES * first_nf &&
+        tile_shaft(shaft_tree, &tb, &shaft))
       cache.shaft = &shaft;
     if (!as_rays) {
       /* The batch stops as soon as the rule below is sure to send the rest
@@ -249,9 +261,9 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
       if (jj == 0) {
         first_visited = budget.visited, first_nf = nf;
         /* a first batch between the bounds: the tile's shaft decides */
-        if (!as_rays && !w->mft_no_fallback && !w->mft_no_shaft && t->shaft_tree &&
-            fetched > SOFT_SHAFT_DECIDES_TRIS * nf && budget.visited > SOFT_SHAFT_DECIDES_NODES * nf) {
-          if (tile_shaft(w, t->shaft_tree(t->ctx), B, n, &shaft)) cache.shaft = &shaft;
+        if (!as_rays && !w->mft_no_fallback && shaft_tree && fetched > SOFT_SHAFT_DECIDES_TRIS * nf &&
+            budget.visited > SOFT_SHAFT_DECIDES_NODES * nf) {
+          if (tile_shaft(shaft_tree, &tb, &shaft)) cache.shaft = &shaft;
           else as_rays = as_streams = 1;
         }
       }
@@ -270,7 +282,7 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
         /* the batches after the tile's verdict: the planar occluders still
          * end the rays they cover, which the streams would trace */
         fr_mft_budget planes = {0, 0, 0, 0, 1};
-        t->occluded_frusta(t->ctx, &b, T, occ, &planes, NULL);
+        t->occluded_frusta(t->ctx, &b, T, occ, &planes, &cache);
       }
       for (unsigned v = b.valid; v; v &= v - 1) by_rays[16 * j + __builtin_ctz(v)] = 1;
       B->held[nheld] = b;

@@ -110,10 +110,6 @@ fr_mft_opts fr_mft_opts_default(void);
 typedef struct fr_mft_shaft {
   unsigned n;
   uint32_t leaf[FR_MFT_SHAFT_MAX];
-  /* bit i: the tree's planar occluder i (accel/plane_occluders.h) may be
-   * crossed by a segment of the shaft (bits past the 32nd are not kept:
-   * those are always tested) */
-  uint32_t planes;
 } fr_mft_shaft;
 
 /* The leaves of b's tree that segments from box P (plo, phi) to box Q may
@@ -122,12 +118,22 @@ typedef struct fr_mft_shaft {
 int fr_mft_shaft_build(const fr_bvh2 *b, const float plo[3], const float phi[3], const float qlo[3],
                        const float qhi[3], fr_mft_shaft *s);
 
+/* The planar occluders of b (accel/plane_occluders.h) that segments from
+ * box P to box Q cannot cross (bit i: occluder i; those past the 32nd are
+ * not told apart): a ray one claims crosses its polygon, so these claim
+ * none. */
+uint32_t fr_mft_shaft_planes_off(const fr_bvh2 *b, const float plo[3], const float phi[3], const float qlo[3],
+                                 const float qhi[3]);
+
 typedef struct fr_mft_occluders {
   uint32_t leaf[FR_MFT_OCCLUDERS]; /* leaf references of the tree, best first */
   unsigned n;
   /* when not NULL, a shaft of this tree around every ray of the batch:
    * its leaves replace the walk */
   const fr_mft_shaft *shaft;
+  /* planar occluders the batch's rays cannot cross, not tested
+   * (fr_mft_shaft_planes_off) */
+  uint32_t planes_off;
 } fr_mft_occluders;
 
 /* What a shadow batch may spend, and what it spent. A batch stops before

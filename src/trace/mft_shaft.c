@@ -68,13 +68,20 @@ static uint32_t shaft_planes_met(const fr_bvh2 *b, const shaft_planes *S) {
   return m;
 }
 
+uint32_t fr_mft_shaft_planes_off(const fr_bvh2 *b, const float plo[3], const float phi[3], const float qlo[3],
+                                 const float qhi[3]) {
+  if (!b->planes || !b->planes->n) return 0;
+  shaft_planes S;
+  shaft_setup(b, plo, phi, qlo, qhi, &S);
+  return ~shaft_planes_met(b, &S);
+}
+
 int fr_mft_shaft_build(const fr_bvh2 *b, const float plo[3], const float phi[3], const float qlo[3],
                        const float qhi[3], fr_mft_shaft *s) {
   s->n = 0;
   if (!b->nodes || (b->root & FR_BVH2_LEAF)) return 0;
   shaft_planes S;
   shaft_setup(b, plo, phi, qlo, qhi, &S);
-  s->planes = shaft_planes_met(b, &S);
   uint32_t stack[FR_MFT_SHAFT_STACK];
   int sp = 0, visits = 0;
   stack[sp++] = b->root;

@@ -597,7 +597,7 @@ FR_INLINE unsigned occlude_leaf(frusta *F, const fr_bvh2 *b, const fr_mft_opts *
  * would have made it. A frustum whose corner rays do not all cross the
  * plane is passed by (its rays are left to the traversal). Only the
  * occluders of bit mask `which` are tested (those past the 32nd always):
- * a shaft around the batch (fr_mft_shaft) tells which it may cross.
+ * a shaft around the batch tells which it may cross (fr_mft_shaft_planes_off).
  * Returns the rays occluded. */
 static unsigned occlude_planes(frusta *F, const fr_plane_occluders *planes, uint32_t which, const fr_mft_opts *opt,
                                const fr_mft_sets *T, unsigned active[16], uint16_t occ[16], unsigned *alive) {
@@ -683,14 +683,14 @@ static void best_leaves_add(best_leaves *L, uint32_t ref, unsigned rays) {
 
 /* fr_mft_budget.planes_only: the planar occluders alone. */
 static void occluded_planes_only(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B,
-                                 const fr_mft_sets *T, uint16_t occ[16]) {
+                                 const fr_mft_sets *T, uint32_t which, uint16_t occ[16]) {
   const unsigned valid = B->valid & 0xFFFFu;
   if (!valid || !b->planes) return;
   frusta F;
   frusta_setup(&F, B, T, valid);
   unsigned active[16], alive = valid;
   for (int f = 0; f < 16; f++) active[f] = (valid >> f) & 1 ? 0xFFFFu : 0;
-  occlude_planes(&F, b->planes, ~0u, opt, T, active, occ, &alive);
+  occlude_planes(&F, b->planes, which, opt, T, active, occ, &alive);
 }
 
 static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B, const fr_mft_sets *T,
@@ -702,7 +702,7 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
   for (int f = 0; f < 16; f++) occ[f] = 0;
   if (budget) budget->visited = 0, budget->stopped = 0;
   if (budget && budget->planes_only) {
-    occluded_planes_only(b, opt, B, T, occ);
+    occluded_planes_only(b, opt, B, T, cache ? ~cache->planes_off : ~0u, occ);
     budget->stopped = 1;
     return 0;
   }
@@ -715,7 +715,7 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
   for (int f = 0; f < 16; f++) active[f] = (valid >> f) & 1 ? 0xFFFFu : 0;
   unsigned alive = valid;
   /* the scene's planar occluders first: no fetch, no box test */
-  if (b->planes) occlude_planes(&F, b->planes, cache && cache->shaft ? cache->shaft->planes : ~0u, opt, T, active, occ, &alive);
+  if (b->planes) occlude_planes(&F, b->planes, cache ? ~cache->planes_off : ~0u, opt, T, active, occ, &alive);
   /* The previous batch's best occluders first (see fr_mft_occluders): all
    * active rays, no box test; the traversal then skips those leaves, which
    * every ray still active has missed. What it saves is the traversal of
