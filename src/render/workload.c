@@ -114,27 +114,31 @@ void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, 
  * early that rule no longer paid (without it, 3 pairs: dragon 1.012x,
  * kitchen 1.002x) and is gone. */
 
-/* After a tile's first batch, its other batches trace through the tile's
- * shaft (fr_mft_shaft: the leaves segments from the box of its hit points
- * to the light can reach) instead of walking the tree from the root, where
- * that first batch's walk visited at most this many nodes per frustum:
- * wider shafts mostly meet more than FR_MFT_SHAFT_MAX leaves, and a build
- * that gives up is lost work. Kitchen at 1024x1024: of the tiles that pass
- * this bound 2,649 shafts held 7 leaves on average against the batches'
- * 31 node visits, 768 gave up; without the bound 1,141 of 3,888 gave up.
- * Interleaved, 2 threads, 1024x1024, soft16 mft, against bounds of 2
- * and 6: 1.009x, 1.010x; 64 leaves at most against 32 and 128: the same. */
-#define SOFT_SHAFT_MAX_NODES 3u
-/* A tile whose first batch fetched more than this many triangles and
- * visited more than this many nodes per frustum, but stayed within the
- * fall-back's bounds (SOFT_FRUSTA_MAX_*), falls back too unless its shaft
- * can be listed: then its batches' cost is bounded by the list's, without
- * it they walk as many nodes as the first. Lowering the fall-back's own
+/* Every tile first builds its shaft (fr_mft_shaft: the leaves that
+ * segments from the box of its hit points to the light can reach); where
+ * it lists at most FR_MFT_SHAFT_MAX leaves, all its batches test those
+ * leaves' boxes instead of walking the tree from the root. Kitchen at
+ * 1024x1024: shafts held 7 leaves on average against the batches' 31
+ * node visits. Interleaved, 2 threads, 1024x1024, soft16 mft, shafts
+ * against none: kitchen 1.076x, conference 1.043x, sibenik 1.042x, dragon
+ * 0.997x (4/4 each but dragon) when built after the tile's first batch,
+ * and only where that batch's walk visited at most 3 nodes per frustum
+ * (bounds of 2 and 6 read 0.991x and 0.990x of that); built before it,
+ * for every tile, and then used by the first batch too, against that:
+ * sibenik 1.039x, kitchen and conference 1.007x, dragon 0.987x (3/3 each;
+ * dragon's shafts mostly give up, lost work). At most 64 leaves read the
+ * same as 32 and 128; a build that gives up after 96 node visits rather
+ * than 256, sibenik 0.979x.
+ *
+ * A tile whose shaft gave up and whose first batch fetched more than
+ * SOFT_SHAFT_DECIDES_TRIS triangles and visited more than
+ * SOFT_SHAFT_DECIDES_NODES nodes per frustum, but stayed within the
+ * fall-back's bounds (SOFT_FRUSTA_MAX_*), falls back too: its batches
+ * would walk as many nodes as the first. Lowering the fall-back's own
  * bounds to these gained kitchen 1.037x but cost conference 0.950x and
  * sibenik 0.974x (3 pairs each); decided by the shaft, kitchen 1.024x,
- * dragon 1.042x, conference 0.990x, sibenik 0.997x (interleaved, 2
- * threads, 1024x1024, soft16 mft). Tris 2 or 3 read the same as 4; nodes
- * 10 gave kitchen 1.011x. */
+ * dragon 1.042x, conference 0.990x, sibenik 0.997x. Tris 2 or 3 read the
+ * same as 4; nodes 10 gave kitchen 1.011x. */
 #define SOFT_SHAFT_DECIDES_TRIS 4u
 #define SOFT_SHAFT_DECIDES_NODES 8u
 
@@ -203,13 +207,15 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
    * thread traced the tile before */
   fr_mft_occluders cache = {{0}, 0, NULL, 0};
   fr_mft_shaft shaft;
-  /* the tile's shaft: which planar occluders its rays may cross, and
-   * (below) the leaves they may reach */
+  /* the tile's shaft: which planar occluders its rays may cross, and the
+   * leaves they may reach (see SOFT_SHAFT_DECIDES_*) */
   tile_box tb;
   const fr_bvh2 *shaft_tree = t->occluded_frusta && t->shaft_tree && !w->mft_no_shaft ? t->shaft_tree(t->ctx) : NULL;
   if (shaft_tree && !tile_box_of(w, B, n, &tb)) shaft_tree = NULL;
-  if (shaft_tree) cache.planes_off = fr_mft_shaft_planes_off(shaft_tree, tb.plo, tb.phi, tb.qlo, tb.qhi);
-  unsigned first_visited = 0, first_nf = 0; /* the tile's first batch's walk */
+  if (shaft_tree) {
+    cache.planes_off = fr_mft_shaft_planes_off(shaft_tree, tb.plo, tb.phi, tb.qlo, tb.qhi);
+    if (tile_shaft(shaft_tree, &tb, &shaft)) cache.shaft = &shaft;
+  }
   for (int jj = 0; jj < (n + 15) / 16; jj++) {
     /* a full tile's 4x4 blocks in serpentine order: each batch borrows the
      * occluders of a neighbour */
@@ -238,9 +244,6 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
     rays += 16u * (uint64_t)bits16(b.valid);
     uint16_t occ[FR_MFT_FRUSTA] = {0};
     const int framed = !as_rays; /* traced as frusta (planar occluders included) */
-    if (framed && jj == 1 && !cache.shaft && shaft_tree && first_visited <= SOFT_SHAFT_MAX_NODES * first_nf &&
-        tile_shaft(shaft_tree, &tb, &shaft))
-      cache.shaft = &shaft;
     if (!as_rays) {
       /* The batch stops as soon as the rule below is sure to send the rest
        * of the tile to ray streams, and its rays still open join them:
@@ -258,15 +261,11 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
       const unsigned fetched = t->occluded_frusta(t->ctx, &b, T, occ, &budget, &cache);
       as_rays = as_streams = !w->mft_no_fallback && fetched > SOFT_FRUSTA_MAX_TRIS * nf &&
                              budget.visited > SOFT_FRUSTA_MAX_NODES * nf;
-      if (jj == 0) {
-        first_visited = budget.visited, first_nf = nf;
-        /* a first batch between the bounds: the tile's shaft decides */
-        if (!as_rays && !w->mft_no_fallback && shaft_tree && fetched > SOFT_SHAFT_DECIDES_TRIS * nf &&
-            budget.visited > SOFT_SHAFT_DECIDES_NODES * nf) {
-          if (tile_shaft(shaft_tree, &tb, &shaft)) cache.shaft = &shaft;
-          else as_rays = as_streams = 1;
-        }
-      }
+      /* a first batch between the bounds: the tile's shaft decides (a
+       * listed shaft keeps a batch's visits far below them) */
+      if (jj == 0 && !as_rays && !w->mft_no_fallback && shaft_tree && !cache.shaft &&
+          fetched > SOFT_SHAFT_DECIDES_TRIS * nf && budget.visited > SOFT_SHAFT_DECIDES_NODES * nf)
+        as_rays = as_streams = 1;
       if (!budget.stopped) {
         float open[FR_MFT_FRUSTA]; /* all lanes at once, vectorized */
         for (int f = 0; f < FR_MFT_FRUSTA; f++) open[f] = (float)(16 - bits16(occ[f])) / 16.0f;
