@@ -56,8 +56,13 @@
  * (6/6 pairs) and kitchen 10% (5/6) and gained dragon 1-2% (2/6 pairs each
  * way; CONCURRENT=1 bench/ab.sh, 1 thread, 1024x1024, soft16 mft): dropped.
  * (Measured when frusta shrank after each triangle; now they shrink after
- * each leaf with an occlusion, see occluded_mft.) */
-#define EAGER_FETCHED 64u
+ * each leaf with an occlusion, see occluded_mft.) The bound was 64 until
+ * soft shadows' tile shafts (session 59) made a batch's walk cheap and left
+ * its leaves the most of its cost; 8 against 64 since, interleaved, 2
+ * threads, 1024x1024, soft16 mft: conference 1.017x, dragon 1.012x (3/3
+ * each), sibenik 1.002x, kitchen 1.004x and 0.997x, Whitted kitchen mft
+ * 1.003x; 24 gave conference 1.009x, 0 (always) kitchen 0.986x. */
+#define EAGER_FETCHED 8u
 
 /* The 16 frusta in structure-of-arrays form; lane f is frustum f. */
 typedef struct frusta {
