@@ -138,7 +138,10 @@ void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, 
  * bounds to these gained kitchen 1.037x but cost conference 0.950x and
  * sibenik 0.974x (3 pairs each); decided by the shaft, kitchen 1.024x,
  * dragon 1.042x, conference 0.990x, sibenik 0.997x. Tris 2 or 3 read the
- * same as 4; nodes 10 gave kitchen 1.011x. */
+ * same as 4; nodes 10 gave kitchen 1.011x. Such a first batch stops as
+ * soon as it passes these bounds, as at the fall-back's own: kitchen
+ * 1.014x, dragon 1.014x, sibenik 1.008x, conference 1.003x (3/3, 2/3, 4/4,
+ * 3/4). */
 #define SOFT_SHAFT_DECIDES_TRIS 4u
 #define SOFT_SHAFT_DECIDES_NODES 8u
 
@@ -255,8 +258,10 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
       const unsigned nf = (unsigned)bits16(b.valid);
       fr_mft_budget budget = {0, 0, 0, 0, 0};
       if (!w->mft_no_fallback) {
-        budget.nodes = SOFT_FRUSTA_MAX_NODES * nf + 1;
-        budget.tris = SOFT_FRUSTA_MAX_TRIS * nf + 1;
+        /* a tile's first batch without a shaft: the lower bounds decide */
+        const int lower = jj == 0 && shaft_tree && !cache.shaft;
+        budget.nodes = (lower ? SOFT_SHAFT_DECIDES_NODES : SOFT_FRUSTA_MAX_NODES) * nf + 1;
+        budget.tris = (lower ? SOFT_SHAFT_DECIDES_TRIS : SOFT_FRUSTA_MAX_TRIS) * nf + 1;
       }
       const unsigned fetched = t->occluded_frusta(t->ctx, &b, T, occ, &budget, &cache);
       as_rays = as_streams = !w->mft_no_fallback && fetched > SOFT_FRUSTA_MAX_TRIS * nf &&
