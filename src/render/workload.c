@@ -309,26 +309,30 @@ static uint64_t soft_shadows(const fr_workload *w, const fr_tracer *t, buffers *
   }
   /* An occluded ray adds nothing to its pixel's count, so the held
    * batches' rays the frusta found occluded are not traced again.
-   * Streams take the held batches' rays two samples at a time: the sets
+   * Streams take the held batches' rays four samples at a time: the sets
    * are consecutive runs of one Sobol (0,8,2)-net, so sample k of every
    * set lies in the same 1/16-wide strip of the light along e1 (the first
    * coordinate's top bits are k's, reversed), and a pixel's two samples of
-   * a pair of korder in one quarter by half of it. A stream of 64 rays then
-   * runs from 32 pixels to a quarter strip of the light rather than from 4
-   * pixels to all of it. Interleaved, 2 threads, 1024x1024, soft16 mft,
-   * against pixel by pixel: pairs of samples kitchen 1.054x (4/4 pairs),
-   * dragon 1.007x (noise); fours kitchen 1.037x, dragon 1.012x (3/3 each);
-   * one sample (64 pixels to one strip) kitchen 1.062x but dragon 0.970x
+   * a pair of korder in one quarter by half of it (a four of korder in
+   * one quarter of it). A stream of 64 rays then runs from 16 pixels to a
+   * quarter of the light rather than from 4 pixels to all of it.
+   * Interleaved, 2 threads, 1024x1024, soft16 mft, against pixel by pixel
+   * (session 43): pairs of samples kitchen 1.054x (4/4 pairs), dragon
+   * 1.007x (noise); fours kitchen 1.037x, dragon 1.012x (3/3 each); one
+   * sample (64 pixels to one strip) kitchen 1.062x but dragon 0.970x
    * (0/3). Dragon's shadow rays start among the fine triangles that
    * occlude them, where, we think, a stream's rays part ways by origin
-   * sooner than by direction. */
+   * sooner than by direction. Since tile shafts and the lower bounds that
+   * send more of dragon's tiles to streams (session 59), fours against
+   * pairs: dragon 1.024x (3/3), kitchen 1.005x and 1.002x, conference
+   * 1.004x; one sample against pairs, dragon 0.986x. */
   static const int korder[16] = {0, 12, 4, 8, 5, 9, 1, 13, 6, 10, 2, 14, 3, 15, 7, 11};
-  for (int q = 0; q < 8; q++)
+  for (int q = 0; q < 4; q++)
     for (int h = 0; h < nheld; h++) {
       const fr_mft_batch *hb = &B->held[h];
       for (unsigned v = hb->valid; v; v &= v - 1)
-        for (int kk = 0; kk < 2; kk++) {
-          int f = __builtin_ctz(v), k = korder[2 * q + kk];
+        for (int kk = 0; kk < 4; kk++) {
+          int f = __builtin_ctz(v), k = korder[4 * q + kk];
           if ((B->held_occ[h][f] >> k) & 1) continue;
           fr_ray *r = &B->rays[m];
           fr_mft_ray(hb, T, f, k, r->org, r->dir);
