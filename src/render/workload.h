@@ -79,8 +79,9 @@ typedef struct fr_workload {
    * (SOFT_FRUSTA_MAX_TRIS in workload.c); 1 keeps every batch as frusta (the
    * paper's pure multi-frusta, to measure) */
   int mft_no_fallback;
-  /* 1: no tile shafts (SOFT_SHAFT_MAX_NODES in workload.c): every batch
-   * walks the tree from the root, to measure */
+  /* 1: no tile shafts (SOFT_SHAFT_DECIDES_* in workload.c): every batch
+   * walks the tree from the root and no shaft decides a fall-back, to
+   * measure */
   int mft_no_shaft;
   /* set by fr_workload_run for its tiles */
   const fr_mft_sets *light_sets;  /* this frame's interleaved samples on the quad light */

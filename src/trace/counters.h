@@ -17,8 +17,9 @@
  * leaves, frustum-triangle pairs before and after the corner-ray cull
  * (each pair left is one 16-ray test), soft-shadow batches traced as rays
  * instead (render/workload.c), tiles' shafts built and given up (too
- * many leaves) and the batches traced through one (mft_shaft*). Large packets (lp_*): packets, stack entries
- * popped, boxes culled for the whole packet, 16-ray box tests, leaves,
+ * many leaves) and the batches traced through one (mft_shaft*). Large
+ * packets (lp_*): packets, stack entries popped, boxes culled for the
+ * whole packet, 16-ray box tests, leaves,
  * prims (triangles and spheres) reached, triangles culled for the whole
  * packet, 16-ray triangle tests. Spheres: single-ray box and sphere tests
  * in the sphere tree (sp_*), spheres culled for a whole large packet,

@@ -698,6 +698,25 @@ static void occluded_planes_only(const fr_bvh2 *b, const fr_mft_opts *opt, const
   occlude_planes(&F, b->planes, which, opt, T, active, occ, &alive);
 }
 
+/* A shadow batch entering leaf e with the frusta m, whose box test passed:
+ * unless it is a cached occluder (tested already, skip), its rays' own box
+ * tests, then its triangles; *fetched counts them, best (when not NULL)
+ * ranks the leaf by the rays it occluded. */
+FR_INLINE void shadow_leaf(frusta *F, const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_sets *T, const entry *e,
+                           unsigned m, const uint32_t skip[FR_MFT_OCCLUDERS], unsigned active[16], uint16_t occ[16],
+                           unsigned *alive, unsigned *fetched, best_leaves *best) {
+  int cached = 0;
+  for (unsigned c = 0; c < FR_MFT_OCCLUDERS; c++) cached |= e->ref == skip[c];
+  if (cached) return;
+  unsigned rays[16];
+  m = leaf_rays(F, e, m, active, NULL, rays);
+  if (!m) return;
+  *fetched += FR_BVH2_LEAF_COUNT(e->ref);
+  const int eager = opt->shrink && *fetched > EAGER_FETCHED;
+  const unsigned got = occlude_leaf(F, b, opt, T, e->ref, m, rays, active, occ, alive, eager);
+  if (got && best) best_leaves_add(best, e->ref, got);
+}
+
 static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_mft_batch *B, const fr_mft_sets *T,
                              uint16_t occ[16], fr_mft_budget *budget, fr_mft_occluders *cache) {
   frusta F;
@@ -769,15 +788,7 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
       const unsigned hit = box_test(&F, pn, slot, alive, &tn);
       if (!hit) continue;
       const entry e = {pn->child[slot], hit, pn, slot};
-      int cached = 0;
-      for (unsigned c = 0; c < FR_MFT_OCCLUDERS; c++) cached |= e.ref == skip[c];
-      if (cached) continue;
-      unsigned rays[16], m = leaf_rays(&F, &e, hit, active, NULL, rays);
-      if (!m) continue;
-      fetched += FR_BVH2_LEAF_COUNT(e.ref);
-      const int eager = opt->shrink && fetched > EAGER_FETCHED;
-      const unsigned got = occlude_leaf(&F, b, opt, T, e.ref, m, rays, active, occ, &alive, eager);
-      if (got) best_leaves_add(&best, e.ref, got);
+      shadow_leaf(&F, b, opt, T, &e, hit, skip, active, occ, &alive, &fetched, &best);
     }
     goto out;
   }
@@ -797,15 +808,7 @@ static unsigned occluded_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr_
         if (!visit_node(&F, b, e.ref, e.mask, stack, &sp, &e)) break;
         continue;
       }
-      int cached = 0;
-      for (unsigned c = 0; c < FR_MFT_OCCLUDERS; c++) cached |= e.ref == skip[c];
-      if (cached) break;
-      unsigned rays[16], m = leaf_rays(&F, &e, e.mask & alive, active, NULL, rays);
-      if (!m) break;
-      fetched += FR_BVH2_LEAF_COUNT(e.ref);
-      const int eager = opt->shrink && fetched > EAGER_FETCHED;
-      const unsigned got = occlude_leaf(&F, b, opt, T, e.ref, m, rays, active, occ, &alive, eager);
-      if (got && cache) best_leaves_add(&best, e.ref, got);
+      shadow_leaf(&F, b, opt, T, &e, e.mask & alive, skip, active, occ, &alive, &fetched, cache ? &best : NULL);
       break;
     }
   }
