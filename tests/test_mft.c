@@ -182,7 +182,7 @@ static void check_shadows_vs(const fr_scene *s, const fr_mft_batch *b, const fr_
           for (size_t q = 0; i == 0 && po && q < po->n && q < 32; q++) {
             if (!((off >> q) & 1u)) continue;
             for (int f = 0; f < 16; f++)
-              for (int k = 0; f < 16 && ((b->valid >> f) & 1) && k < 16; k++) {
+              for (int k = 0; ((b->valid >> f) & 1) && k < 16; k++) {
                 fr_ray r;
                 fr_mft_ray(b, T, f, k, r.org, r.dir);
                 assert_false(fr_plane_occluder_hit(&po->list[q], r.org, r.dir, b->tnear[f], b->tfar[f]));
@@ -796,9 +796,10 @@ static void light_sets_are_nets(void **state) {
 
 /* Soft shadows of a tile go as ray streams where a batch's frusta fetch
  * many triangles each (render/workload.c), and the batch that tells stops
- * short, its rays still open joining the streams. On the kitchen at 64x64
- * every path runs (frusta, streams, a stopped batch): the visibility must
- * match the stream tracer's, pixel by pixel, up to rays grazing an edge. */
+ * short, its rays still open joining the streams. On the kitchen at
+ * 128x128 every path runs (frusta, streams, a stopped batch, tile shafts):
+ * the visibility must match the stream tracer's, pixel by pixel, up to rays
+ * grazing an edge, and be the same without tile shafts. */
 typedef struct ray_counter { fr_tracer inner; size_t rays, batches, stream_rays, stopped, shaft_batches; } ray_counter;
 
 static void counted_occluded(void *ctx, const fr_ray *rays, uint8_t *occ, size_t n, int coherent) {

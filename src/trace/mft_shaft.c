@@ -89,8 +89,8 @@ int fr_mft_shaft_build(const fr_bvh2 *b, const float plo[3], const float phi[3],
   int sp = 0, visits = 0;
   stack[sp++] = b->root;
   while (sp) {
-    const fr_bvh2_node *n = &b->nodes[stack[--sp]];
-    const uint32_t node = (uint32_t)(n - b->nodes);
+    const uint32_t node = stack[--sp];
+    const fr_bvh2_node *n = &b->nodes[node];
     if (++visits > FR_MFT_SHAFT_VISITS) return 0;
     for (int k = 1; k >= 0; k--) { /* child 0 popped first */
       const float lo[3] = {n->lo_x[k], n->lo_y[k], n->lo_z[k]}, hi[3] = {n->hi_x[k], n->hi_y[k], n->hi_z[k]};
