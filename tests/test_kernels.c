@@ -11,6 +11,7 @@
 #include "geom/tri_moller.h"
 #include "geom/tri_shevtsov.h"
 #include "geom/tri_watertight.h"
+#include "trace/kernels.h"
 #include "test_util.h"
 
 static vec3 rnd3(fr_rng *r, float s) { return v3(urand(r, -s, s), urand(r, -s, s), urand(r, -s, s)); }
@@ -398,6 +399,61 @@ static void test_tri4_pair(void **st) {
   assert_true(hits > tested / 4);
 }
 
+typedef int (*stream_setup_fn)(const fr_ray *, int, int *);
+int fr_test_stream_setup_scalar(const fr_ray *rays, int n, int *uniform);
+int fr_test_stream_setup_avx2(const fr_ray *rays, int n, int *uniform);
+int fr_test_stream_setup_avx512(const fr_ray *rays, int n, int *uniform);
+
+/* A ray streams sets its rays up all at once, lane by lane
+ * (stream_rays.h); every value the tests read must be ray_setup's, bit for
+ * bit, on every level: for random directions, for directions with zero,
+ * signed-zero and tiny components (the reciprocal's clamp) and with ties
+ * between components' magnitudes (the shear axis), for invalid rays, and
+ * streams of one octant (uniform) or several. */
+static void test_stream_setup(void **st) {
+  (void)st;
+  const struct { fr_isa isa; stream_setup_fn fn; } levels[] = {{FR_ISA_SCALAR, fr_test_stream_setup_scalar},
+                                                                {FR_ISA_AVX2, fr_test_stream_setup_avx2},
+                                                                {FR_ISA_AVX512, fr_test_stream_setup_avx512}};
+  static const float comp[] = {0.0f, -0.0f, 1e-20f, -1e-20f, 1e-18f, -1e-18f, 1.0f, -1.0f, 0.5f, -2.0f, 3e-5f, -7.0f};
+  enum { NC = sizeof comp / sizeof comp[0] };
+  fr_rng r = fr_rng_seed(47, 3);
+  int tested = 0, uniform_streams = 0;
+  for (int n = 0; n < 3000; n++) {
+    fr_ray rays[FR_STREAM_MAX];
+    const int len = 1 + (int)urand(&r, 0, FR_STREAM_MAX - 1), one_octant = n % 3 == 0;
+    for (int i = 0; i < len; i++) {
+      const vec3 o = rnd3(&r, 5.0f);
+      vec3 d = rnd3(&r, 1.0f);
+      float *dc = &d.x;
+      for (int a = 0; a < 3; a++) { /* special components, and ties in magnitude */
+        const float u = urand(&r, 0, 1);
+        if (u < 0.25f) dc[a] = comp[(int)urand(&r, 0, NC - 0.01f)];
+        else if (u < 0.4f && a > 0) dc[a] = urand(&r, 0, 1) < 0.5f ? dc[a - 1] : -dc[a - 1];
+      }
+      if (one_octant) d = v3(fabsf(d.x) + 1e-3f, -fabsf(d.y) - 1e-3f, fabsf(d.z) + 1e-3f);
+      rays[i] = (fr_ray){{o.x, o.y, o.z}, urand(&r, 0, 1), {d.x, d.y, d.z}, urand(&r, 0, 1) < 0.5f ? 10.0f : INFINITY};
+      const float v = urand(&r, 0, 1); /* now and then an invalid ray */
+      if (v < 0.02f) rays[i].dir[(int)urand(&r, 0, 2.99f)] = NAN;
+      else if (v < 0.04f) rays[i].tnear = 2.0f * rays[i].tfar + 1.0f;
+      else if (v < 0.05f) rays[i].dir[0] = rays[i].dir[1] = rays[i].dir[2] = 0.0f;
+    }
+    for (size_t l = 0; l < sizeof levels / sizeof levels[0]; l++) {
+      if (!fr_isa_supported(levels[l].isa)) continue;
+      int uniform = 0;
+      const int bad = levels[l].fn(rays, len, &uniform);
+      if (bad == -2) fail_msg("level %zu, stream %d: uniform %d is wrong", l, n, uniform);
+      if (bad >= 0)
+        fail_msg("level %zu, stream %d, ray %d (dir %a %a %a): not ray_setup's", l, n, bad, rays[bad].dir[0],
+                 rays[bad].dir[1], rays[bad].dir[2]);
+      uniform_streams += uniform;
+      tested++;
+    }
+  }
+  print_message("stream set-ups: %d across the levels, %d of one octant\n", tested, uniform_streams);
+  assert_true(uniform_streams > tested / 4);
+}
+
 typedef int (*tri4_quad_fn)(const fr_tri4 *, const fr_ray *, int, int *);
 #define QUAD_FNS(p)                                                                  \
   int fr_test_tri4_quad##p##_scalar(const fr_tri4 *, const fr_ray *, int, int *);   \
@@ -470,6 +526,7 @@ int main(void) {
       cmocka_unit_test(test_imin_imax),
       cmocka_unit_test(test_load_records),
       cmocka_unit_test(test_tri4_pair),
+      cmocka_unit_test(test_stream_setup),
       cmocka_unit_test(test_tri4_quad),
       cmocka_unit_test(test_agreement),
       cmocka_unit_test(test_child_sort8),

@@ -12,6 +12,7 @@
 #include "base/simd.h"
 #include "trace/bvhn_single.h"
 #include "trace/kernels.h"
+#include "trace/stream_rays.h"
 
 /* Closest hits: a subtree only one of the stream's rays entered goes to the
  * single-ray traversal, which orders the children by that ray's own
@@ -47,7 +48,7 @@ FR_INLINE void child_dists_add(child_dists *d, vnode tn, int bits) {
  * any-hit loop has none of it) gets per child c the least entry distance over
  * the rays of m: no ray enters c before it (rays that miss c only lower the
  * bound); and mean_tn the mean entry distance of the rays that hit c. */
-FR_INLINE int stream_node(const node_t *n, const ray_pre *pre, const float *tfar, uint64_t m, int uniform,
+FR_INLINE int stream_node(const node_t *n, const stream_rays *s, uint64_t m, int uniform,
                           uint64_t child_rays[8], float *min_tn, float *mean_tn) {
   if (W == 8) __builtin_prefetch(n->child);
   FR_COUNT(nodes, (uint64_t)__builtin_popcountll(m));
@@ -56,10 +57,12 @@ FR_INLINE int stream_node(const node_t *n, const ray_pre *pre, const float *tfar
   child_dists dists = {VN(INFINITY), VN(0.0f), VN(0.0f)};
   int hit = 0;
   if (uniform) {
-    const node_planes p = load_planes(n, &pre[__builtin_ctzll(m)]);
+    const ray_pre r0 = stream_ray(s, __builtin_ctzll(m));
+    const node_planes p = load_planes(n, &r0);
     for (; m; m &= m - 1) {
       int i = __builtin_ctzll(m), bits;
-      vnode tn = planes_test(&p, &pre[i], tfar[i], &bits);
+      const ray_pre ri = stream_ray(s, i);
+      vnode tn = planes_test(&p, &ri, s->tfar[i], &bits);
       if (min_tn) child_dists_add(&dists, tn, bits);
       hit |= bits;
       acc = vb8_or_where(acc, bits, 1ull << i);
@@ -67,7 +70,8 @@ FR_INLINE int stream_node(const node_t *n, const ray_pre *pre, const float *tfar
   } else {
     for (; m; m &= m - 1) {
       int i = __builtin_ctzll(m), bits;
-      vnode tn = box_test(n, &pre[i], tfar[i], &bits);
+      const ray_pre ri = stream_ray(s, i);
+      vnode tn = box_test(n, &ri, s->tfar[i], &bits);
       if (min_tn) child_dists_add(&dists, tn, bits);
       hit |= bits;
       acc = vb8_or_where(acc, bits, 1ull << i);
@@ -81,33 +85,11 @@ FR_INLINE int stream_node(const node_t *n, const ray_pre *pre, const float *tfar
   return hit;
 }
 
-/* Precomputes rays[idx[0..n)] into pre and tfar; returns the valid rays'
- * bits, *uniform whether they all share the direction signs. Inlined: as a
- * call it cost conference ao16 streams 3-4% (512x512, two pairs). */
-FR_INLINE uint64_t group_setup(const fr_ray *rays, const uint32_t *idx, int n, ray_pre *pre, float *tfar, int *uniform) {
-  uint64_t active = 0;
-  int near = -1;
-  *uniform = 1;
-  FR_COUNT(rays, (uint64_t)n);
-  for (int i = 0; i < n; i++) {
-    const fr_ray *r = &rays[idx[i]];
-    if (fr_ray_invalid(r)) continue;
-    ray_setup(&pre[i], r);
-    tfar[i] = r->tfar;
-    active |= 1ull << i;
-    int ni = pre[i].near_x | pre[i].near_y << 8 | pre[i].near_z << 16;
-    if (near >= 0 && ni != near) *uniform = 0;
-    near = ni;
-  }
-  return active;
-}
-
 /* Bits of the rays hit; rays[idx[0..n)], n <= FR_STREAM_MAX. */
 static uint64_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t *idx, int n) {
-  ray_pre pre[FR_STREAM_MAX];
-  float tfar[FR_STREAM_MAX];
+  stream_rays s __attribute__((aligned(64)));
   int uniform;
-  uint64_t active = group_setup(rays, idx, n, pre, tfar, &uniform), occ = 0;
+  uint64_t active = stream_setup(rays, idx, n, &s, &uniform), occ = 0;
   stream_entry stack[STACK_SIZE];
   int sp = 0;
   stack[sp++] = (stream_entry){active, b->root};
@@ -119,7 +101,7 @@ static uint64_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint3
     while (!(ref & FR_BVHN_LEAF)) {
       const node_t *nd = (const node_t *)FR_BVHN_NODE_AT(b, ref);
       uint64_t child_rays[8];
-      int hit = stream_node(nd, pre, tfar, m, uniform, child_rays, NULL, NULL);
+      int hit = stream_node(nd, &s, m, uniform, child_rays, NULL, NULL);
       if (!hit) goto next;
       /* the last hit slot first, as the single-ray any-hit (bvhn_single.c) */
       int last = 31 - __builtin_clz((unsigned)hit);
@@ -144,14 +126,16 @@ static uint64_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint3
           mm &= mm - 1;
           if (!mm) {
             tri4_result res;
-            tri4_test(&b->tris[k], &pre[i], tfar[i], &res);
+            const ray_pre ri = stream_ray(&s, i);
+            tri4_test(&b->tris[k], &ri, s.tfar[i], &res);
             if (res.mask) occ |= 1ull << i;
             break;
           }
           const int i2 = __builtin_ctzll(mm);
           mm &= mm - 1;
           tri4_result ra, rb;
-          tri4_test2(&b->tris[k], &pre[i], tfar[i], &pre[i2], tfar[i2], &ra, &rb);
+          const ray_pre ri = stream_ray(&s, i), ri2 = stream_ray(&s, i2);
+          tri4_test2(&b->tris[k], &ri, s.tfar[i], &ri2, s.tfar[i2], &ra, &rb);
           occ |= (uint64_t)(ra.mask != 0) << i | (uint64_t)(rb.mask != 0) << i2;
         }
         m &= ~occ;
@@ -177,11 +161,11 @@ static uint64_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint3
  * lies before it. Each ray runs exactly the single-ray box and triangle
  * tests, so it finds the same nearest hit. */
 static void intersect_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t *idx, int n, fr_hit *hits) {
-  ray_pre pre[FR_STREAM_MAX];
-  float tfar[FR_STREAM_MAX];
+  stream_rays s __attribute__((aligned(64)));
+  float *const tfar = s.tfar; /* lowered at each hit */
   fr_subtree_hit best[FR_STREAM_MAX];
   int uniform;
-  uint64_t active = group_setup(rays, idx, n, pre, tfar, &uniform), found = 0;
+  uint64_t active = stream_setup(rays, idx, n, &s, &uniform), found = 0;
   for (int i = 0; i < n; i++) fr_hit_miss(&hits[idx[i]]);
   dist_entry stack[STACK_SIZE];
   int sp = 0;
@@ -201,7 +185,7 @@ static void intersect_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t
       const node_t *nd = (const node_t *)FR_BVHN_NODE_AT(b, ref);
       uint64_t child_rays[8];
       float min_tn[W] __attribute__((aligned(32))), mean_tn[W] __attribute__((aligned(32)));
-      int hit = stream_node(nd, pre, tfar, m, uniform, child_rays, min_tn, mean_tn);
+      int hit = stream_node(nd, &s, m, uniform, child_rays, min_tn, mean_tn);
       if (!hit) goto next;
       /* nearest first by mean_tn; slot order on ties */
       int order[W], k = 0;
@@ -231,12 +215,14 @@ static void intersect_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t
           mm &= mm - 1;
           tri4_result ra, rb;
           if (!mm) {
-            tri4_test(&b->tris[k], &pre[i], tfar[i], &ra);
+            const ray_pre ri = stream_ray(&s, i);
+            tri4_test(&b->tris[k], &ri, tfar[i], &ra);
             rb.mask = 0;
           } else {
             const int i2 = __builtin_ctzll(mm);
             mm &= mm - 1;
-            tri4_test2(&b->tris[k], &pre[i], tfar[i], &pre[i2], tfar[i2], &ra, &rb);
+            const ray_pre ri = stream_ray(&s, i), ri2 = stream_ray(&s, i2);
+            tri4_test2(&b->tris[k], &ri, tfar[i], &ri2, tfar[i2], &ra, &rb);
             if (rb.mask) {
               tfar[i2] = tri4_nearest(&rb, k, &best[i2]);
               found |= 1ull << i2;
@@ -251,7 +237,8 @@ static void intersect_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t
     }
   single: {
       int i = __builtin_ctzll(m);
-      if (single_closest(b, &pre[i], ref, tfar[i], &best[i])) {
+      const ray_pre ri = stream_ray(&s, i);
+      if (single_closest(b, &ri, ref, tfar[i], &best[i])) {
         tfar[i] = best[i].t;
         found |= 1ull << i;
       }

@@ -1,0 +1,46 @@
+/* The ray streams' set-up (stream_setup, trace/stream_rays.h) compiled for
+ * one ISA, called by test_kernels through a plain-C signature. Returns the
+ * index of the first ray that stream_setup calls valid or invalid where
+ * fr_ray_invalid does not, or whose values differ in any bit from
+ * ray_setup's (what the node and triangle tests read); -2 when the stream's
+ * uniform verdict is wrong; -1 when all is the same. *uniform gets that
+ * verdict. */
+#include <string.h>
+#include "base/simd.h"
+#include "trace/stream_rays.h"
+
+#define NAME2(isa) fr_test_stream_setup_##isa
+#define NAME(isa) NAME2(isa)
+
+static int same_bits(const void *a, const void *b, size_t n) { return !memcmp(a, b, n); }
+
+int NAME(FR_ISA_SUFFIX)(const fr_ray *rays, int n, int *uniform);
+int NAME(FR_ISA_SUFFIX)(const fr_ray *rays, int n, int *uniform) {
+  uint32_t idx[FR_STREAM_MAX];
+  for (int i = 0; i < n; i++) idx[i] = (uint32_t)(n - 1 - i); /* the gather goes through idx */
+  static stream_rays s __attribute__((aligned(64)));
+  const uint64_t valid = stream_setup(rays, idx, n, &s, uniform);
+  int signs = -1, uniform_want = 1;
+  for (int i = 0; i < n; i++) {
+    if ((int)((valid >> i) & 1) == fr_ray_invalid(&rays[idx[i]])) return (int)idx[i];
+    if (!((valid >> i) & 1)) continue;
+    ray_pre want, got = stream_ray(&s, i);
+    ray_setup(&want, &rays[idx[i]]);
+    const int si = want.near_x | want.near_y << 8 | want.near_z << 16;
+    if (signs >= 0 && si != signs) uniform_want = 0;
+    signs = si;
+    float w[8] __attribute__((aligned(32))), g[8] __attribute__((aligned(32)));
+#define SAME_VN(f) (VN_STORE(w, want.f), VN_STORE(g, got.f), same_bits(w, g, sizeof(float) * W))
+#define SAME_V4(f) (vf4_store(w, want.f), vf4_store(g, got.f), same_bits(w, g, sizeof(float) * 4))
+    const int same = SAME_VN(ox) && SAME_VN(oy) && SAME_VN(oz) && SAME_VN(nrx) && SAME_VN(nry) && SAME_VN(nrz) &&
+                     SAME_VN(nrx_w) && SAME_VN(nry_w) && SAME_VN(nrz_w) && SAME_V4(o_k[0]) && SAME_V4(o_k[1]) &&
+                     SAME_V4(o_k[2]) && SAME_V4(sx) && SAME_V4(sy) && SAME_V4(nsz) && want.kx4 == got.kx4 &&
+                     want.ky4 == got.ky4 && want.kz4 == got.kz4 && want.near_x == got.near_x &&
+                     want.near_y == got.near_y && want.near_z == got.near_z && same_bits(&want.tnear, &got.tnear, 4) &&
+                     same_bits(&rays[idx[i]].tfar, &s.tfar[i], 4);
+#undef SAME_VN
+#undef SAME_V4
+    if (!same) return (int)idx[i];
+  }
+  return *uniform == uniform_want ? -1 : -2;
+}
