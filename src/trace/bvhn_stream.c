@@ -164,6 +164,10 @@ static void intersect_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t
   stream_rays s __attribute__((aligned(64)));
   float *const tfar = s.tfar; /* lowered at each hit */
   fr_subtree_hit best[FR_STREAM_MAX];
+  /* the rays handed to single_closest, made once each (a ray can be handed
+   * off many times where rays part ways early, as on the hairball) */
+  ray_pre single_pre[FR_STREAM_MAX];
+  uint64_t made = 0;
   int uniform;
   uint64_t active = stream_setup(rays, idx, n, &s, &uniform), found = 0;
   for (int i = 0; i < n; i++) fr_hit_miss(&hits[idx[i]]);
@@ -237,8 +241,8 @@ static void intersect_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t
     }
   single: {
       int i = __builtin_ctzll(m);
-      const ray_pre ri = stream_ray(&s, i);
-      if (single_closest(b, &ri, ref, tfar[i], &best[i])) {
+      if (!((made >> i) & 1)) single_pre[i] = stream_ray(&s, i), made |= 1ull << i;
+      if (single_closest(b, &single_pre[i], ref, tfar[i], &best[i])) {
         tfar[i] = best[i].t;
         found |= 1ull << i;
       }
