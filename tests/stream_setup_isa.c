@@ -44,3 +44,43 @@ int NAME(FR_ISA_SUFFIX)(const fr_ray *rays, int n, int *uniform) {
   }
   return *uniform == uniform_want ? -1 : -2;
 }
+
+/* chunk_node against planes_test, per ray of a stream of 16 and child of
+ * a BVH8 node (its six planes as the node stores them, nchildren given):
+ * returns the first ray whose children hit differ, -1 when none does;
+ * *hits gets the ray-child pairs hit. */
+#define CHUNK_NAME2(isa) fr_test_stream_chunk_##isa
+#define CHUNK_NAME(isa) CHUNK_NAME2(isa)
+int CHUNK_NAME(FR_ISA_SUFFIX)(const float planes[6][8], int nchildren, const fr_ray *rays, unsigned lanes, int *hits);
+int CHUNK_NAME(FR_ISA_SUFFIX)(const float planes[6][8], int nchildren, const fr_ray *rays, unsigned lanes, int *hits) {
+  static node_t node;
+  memset(&node, 0, sizeof node);
+  memcpy(&node, planes, sizeof(float) * 48);
+  node.nchildren = (uint32_t)nchildren;
+  uint32_t idx[16];
+  for (int i = 0; i < 16; i++) idx[i] = (uint32_t)i;
+  static stream_rays s __attribute__((aligned(64)));
+  int uniform;
+  stream_setup(rays, idx, 16, &s, &uniform);
+  if (!uniform) return -2;
+  const ray_pre r0 = stream_ray(&s, 0);
+  uint64_t child_rays[8] = {0};
+  int hit = 0;
+  chunk_node(&node, &s, 0, lanes, &r0, child_rays, &hit);
+  *hits = 0;
+  for (int i = 0; i < 16; i++) {
+    int want = 0;
+    if ((lanes >> i) & 1) {
+      const ray_pre ri = stream_ray(&s, i);
+      box_test(&node, &ri, s.tfar[i], &want);
+      want &= (1 << nchildren) - 1;
+    }
+    int got = 0;
+    for (int c = 0; c < 8; c++) got |= (int)((child_rays[c] >> i) & 1) << c;
+    if (got != want) return i;
+    *hits += __builtin_popcount((unsigned)got);
+  }
+  int any = 0;
+  for (int c = 0; c < 8; c++) any |= (child_rays[c] != 0) << c;
+  return any == hit ? -1 : 16;
+}

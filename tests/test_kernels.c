@@ -454,6 +454,76 @@ static void test_stream_setup(void **st) {
   assert_true(uniform_streams > tested / 4);
 }
 
+typedef int (*stream_chunk_fn)(const float[6][8], int, const fr_ray *, unsigned, int *);
+int fr_test_stream_chunk_scalar(const float planes[6][8], int nchildren, const fr_ray *rays, unsigned lanes, int *hits);
+int fr_test_stream_chunk_avx2(const float planes[6][8], int nchildren, const fr_ray *rays, unsigned lanes, int *hits);
+int fr_test_stream_chunk_avx512(const float planes[6][8], int nchildren, const fr_ray *rays, unsigned lanes, int *hits);
+
+/* A stream tests dense chunks of 16 rays child by child (chunk_node,
+ * stream_rays.h); each ray must get exactly the children the one-ray box
+ * test gives it, on every level. The rays' tnear and tfar sit on a child's
+ * entry and exit distances, a rounding either way, so a box is often
+ * decided by the last bit of an end or by the far planes' widening. */
+static void test_stream_chunk(void **st) {
+  (void)st;
+  const struct { fr_isa isa; stream_chunk_fn fn; } levels[] = {{FR_ISA_SCALAR, fr_test_stream_chunk_scalar},
+                                                                {FR_ISA_AVX2, fr_test_stream_chunk_avx2},
+                                                                {FR_ISA_AVX512, fr_test_stream_chunk_avx512}};
+  static const float nudge[] = {1.0f - 0x1p-21f, 1.0f, 1.0f + 0x1p-22f, 1.0f + 0x1p-20f, 1.0f + 0x1p-19f};
+  fr_rng r = fr_rng_seed(53, 7);
+  long tested = 0, hits = 0;
+  for (int n = 0; n < 3000; n++) {
+    float planes[6][8];
+    const int nchildren = 2 + (int)urand(&r, 0, 6.99f);
+    vec3 lo[8], hi[8];
+    for (int c = 0; c < 8; c++) {
+      const vec3 a = rnd3(&r, 2.0f), e = v3(urand(&r, 0, 1), urand(&r, 0, 1), urand(&r, 0, 0.3f));
+      lo[c] = c < nchildren ? a : v3(INFINITY, INFINITY, INFINITY); /* unused: inverted */
+      hi[c] = c < nchildren ? v3_add(a, e) : v3(-INFINITY, -INFINITY, -INFINITY);
+      planes[0][c] = lo[c].x; planes[1][c] = hi[c].x; planes[2][c] = lo[c].y;
+      planes[3][c] = hi[c].y; planes[4][c] = lo[c].z; planes[5][c] = hi[c].z;
+    }
+    const vec3 sgn = v3(urand(&r, 0, 1) < 0.5f ? 1.0f : -1.0f, urand(&r, 0, 1) < 0.5f ? 1.0f : -1.0f, 1.0f);
+    fr_ray rays[16];
+    for (int i = 0; i < 16; i++) {
+      vec3 d = rnd3(&r, 1.0f);
+      d = v3(sgn.x * (fabsf(d.x) + 1e-3f), sgn.y * (fabsf(d.y) + 1e-3f), sgn.z * (fabsf(d.z) + 1e-3f));
+      /* through a point of child c, at t = 4 */
+      const int c = (int)urand(&r, 0, nchildren - 0.01f);
+      const vec3 e = v3_sub(hi[c], lo[c]);
+      const vec3 at = v3_add(lo[c], v3(urand(&r, 0, 1) * e.x, urand(&r, 0, 1) * e.y, urand(&r, 0, 1) * e.z));
+      const vec3 o = v3_sub(at, v3_scale(d, 4.0f));
+      rays[i] = (fr_ray){{o.x, o.y, o.z}, 0.0f, {d.x, d.y, d.z}, INFINITY};
+      /* that child's slab distances (double): tnear or tfar on one of them */
+      const double t0x = ((double)(d.x > 0 ? lo[c].x : hi[c].x) - o.x) / d.x;
+      const double t0y = ((double)(d.y > 0 ? lo[c].y : hi[c].y) - o.y) / d.y;
+      const double t0z = ((double)lo[c].z - o.z) / d.z;
+      const double t1x = ((double)(d.x > 0 ? hi[c].x : lo[c].x) - o.x) / d.x;
+      const double t1y = ((double)(d.y > 0 ? hi[c].y : lo[c].y) - o.y) / d.y;
+      const double t1z = ((double)hi[c].z - o.z) / d.z;
+      const double tin = fmax(fmax(t0x, t0y), t0z), tout = fmin(fmin(t1x, t1y), t1z);
+      const float k = nudge[(int)urand(&r, 0, 4.99f)];
+      const float u = urand(&r, 0, 1);
+      if (u < 0.4f && tin > 0) rays[i].tfar = (float)tin * k;
+      else if (u < 0.8f && tout > 0) rays[i].tnear = (float)tout * k;
+      else if (u < 0.9f) rays[i].tnear = urand(&r, 0, 6), rays[i].tfar = rays[i].tnear + urand(&r, 0, 2);
+    }
+    const unsigned lanes = n % 4 ? 0xFFFFu : (unsigned)(urand(&r, 0, 65535.99f));
+    for (size_t l = 0; l < sizeof levels / sizeof levels[0]; l++) {
+      if (!fr_isa_supported(levels[l].isa)) continue;
+      int h = 0;
+      const int bad = levels[l].fn(planes, nchildren, rays, lanes, &h);
+      if (bad == -2) fail_msg("level %zu, case %d: the rays are not of one octant", l, n);
+      if (bad == 16) fail_msg("level %zu, case %d: the children hit are not the rays' union", l, n);
+      if (bad >= 0) fail_msg("level %zu, case %d, ray %d: chunk_node differs from the box test", l, n, bad);
+      hits += h;
+      tested++;
+    }
+  }
+  print_message("stream chunks: %ld across the levels, %ld ray-child hits\n", tested, hits);
+  assert_true(hits > tested * 8);
+}
+
 typedef int (*tri4_quad_fn)(const fr_tri4 *, const fr_ray *, int, int *);
 #define QUAD_FNS(p)                                                                  \
   int fr_test_tri4_quad##p##_scalar(const fr_tri4 *, const fr_ray *, int, int *);   \
@@ -527,6 +597,7 @@ int main(void) {
       cmocka_unit_test(test_load_records),
       cmocka_unit_test(test_tri4_pair),
       cmocka_unit_test(test_stream_setup),
+      cmocka_unit_test(test_stream_chunk),
       cmocka_unit_test(test_tri4_quad),
       cmocka_unit_test(test_agreement),
       cmocka_unit_test(test_child_sort8),

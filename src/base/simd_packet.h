@@ -51,6 +51,14 @@ FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r = {(fr_vp_kmask)(a.m & b.m)}; return
 FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) { vpf r = {FR_VP_OP(mask_blend_ps)(m.m, f.v, t.v)}; return r; }
 FR_INLINE vpf vp_sqrt(vpf a) { vpf r = {FR_VP_OP(sqrt_ps)(a.v)}; return r; }
 #if P == 16
+/* min and max of the bit patterns as integers (see vf4_imin in base/simd.h) */
+FR_INLINE vpf vp_imin(vpf a, vpf b) { vpf r = {_mm512_castsi512_ps(_mm512_min_epi32(_mm512_castps_si512(a.v), _mm512_castps_si512(b.v)))}; return r; }
+FR_INLINE vpf vp_imax(vpf a, vpf b) { vpf r = {_mm512_castsi512_ps(_mm512_max_epi32(_mm512_castps_si512(a.v), _mm512_castps_si512(b.v)))}; return r; }
+#else
+FR_INLINE vpf vp_imin(vpf a, vpf b) { vpf r = {_mm256_castsi256_ps(_mm256_min_epi32(_mm256_castps_si256(a.v), _mm256_castps_si256(b.v)))}; return r; }
+FR_INLINE vpf vp_imax(vpf a, vpf b) { vpf r = {_mm256_castsi256_ps(_mm256_max_epi32(_mm256_castps_si256(a.v), _mm256_castps_si256(b.v)))}; return r; }
+#endif
+#if P == 16
 FR_INLINE float vp_reduce_min(vpf a) { return _mm512_reduce_min_ps(a.v); }
 FR_INLINE float vp_reduce_max(vpf a) { return _mm512_reduce_max_ps(a.v); }
 #endif
@@ -86,6 +94,9 @@ FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r; for (int h = 0; h < FR_VP_HALVES; h
 FR_VP_BIN(vp_and, _mm256_and_ps) FR_VP_BIN(vp_or, _mm256_or_ps) FR_VP_BIN(vp_xor, _mm256_xor_ps)
 FR_INLINE vpf vp_loadu(const float *p) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_loadu_ps(p + 8 * h); return r; }
 FR_INLINE vpf vp_sqrt(vpf a) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_sqrt_ps(a.v[h]); return r; }
+#define FR_VP_IBIN(name, op) \
+  FR_INLINE vpf name(vpf a, vpf b) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_castsi256_ps(op(_mm256_castps_si256(a.v[h]), _mm256_castps_si256(b.v[h]))); return r; }
+FR_VP_IBIN(vp_imin, _mm256_min_epi32) FR_VP_IBIN(vp_imax, _mm256_max_epi32)
 
 #else /* scalar */
 typedef struct vpf { float f[P]; } vpf;
@@ -127,6 +138,8 @@ FR_VP_BIN(vp_and, fr_vp_bits_and(a.f[i], b.f[i])) FR_VP_BIN(vp_or, fr_vp_bits_or
 FR_VP_BIN(vp_xor, fr_vp_bits_xor(a.f[i], b.f[i]))
 FR_INLINE vpf vp_loadu(const float *p) FR_VP_LANES(p[i])
 FR_INLINE vpf vp_sqrt(vpf a) FR_VP_LANES(sqrtf(a.f[i]))
+FR_VP_BIN(vp_imin, fr_f2i(a.f[i]) < fr_f2i(b.f[i]) ? a.f[i] : b.f[i])
+FR_VP_BIN(vp_imax, fr_f2i(a.f[i]) > fr_f2i(b.f[i]) ? a.f[i] : b.f[i])
 FR_INLINE float vp_reduce_min(vpf a) { float r = a.f[0]; for (int i = 1; i < P; i++) r = a.f[i] < r ? a.f[i] : r; return r; }
 FR_INLINE float vp_reduce_max(vpf a) { float r = a.f[0]; for (int i = 1; i < P; i++) r = a.f[i] > r ? a.f[i] : r; return r; }
 #endif

@@ -49,15 +49,23 @@ FR_INLINE void child_dists_add(child_dists *d, vnode tn, int bits) {
  * the rays of m: no ray enters c before it (rays that miss c only lower the
  * bound); and mean_tn the mean entry distance of the rays that hit c. */
 FR_INLINE int stream_node(const node_t *n, const stream_rays *s, uint64_t m, int uniform,
-                          uint64_t child_rays[8], float *min_tn, float *mean_tn) {
+                          uint64_t child_rays[8], float *min_tn, float *mean_tn, int n_rays) {
   if (W == 8) __builtin_prefetch(n->child);
   FR_COUNT(nodes, (uint64_t)__builtin_popcountll(m));
   FR_COUNT(box_tests, (uint64_t)n->nchildren * (uint64_t)__builtin_popcountll(m));
   vbits8 acc = vb8_zero();
   child_dists dists = {VN(INFINITY), VN(0.0f), VN(0.0f)};
   int hit = 0;
+  uint64_t dense = 0; /* the rays of dense chunks, tested below */
+  const ray_pre r0 = stream_ray(s, __builtin_ctzll(m));
+  if (uniform && !min_tn && __builtin_popcountll(m) >= STREAM_DENSE) {
+    for (int o = 0; o + 16 <= n_rays; o += 16) {
+      const uint64_t lanes = m & 0xFFFFull << o;
+      if (__builtin_popcountll(lanes) >= STREAM_DENSE) dense |= lanes;
+    }
+    m &= ~dense;
+  }
   if (uniform) {
-    const ray_pre r0 = stream_ray(s, __builtin_ctzll(m));
     const node_planes p = load_planes(n, &r0);
     for (; m; m &= m - 1) {
       int i = __builtin_ctzll(m), bits;
@@ -82,6 +90,8 @@ FR_INLINE int stream_node(const node_t *n, const stream_rays *s, uint64_t m, int
     VN_STORE(mean_tn, VN_DIV(dists.sum, dists.cnt)); /* 0 / 0 in the children no ray hit: never read */
   }
   vb8_store(child_rays, acc);
+  for (int o = 0; dense; o += 16, dense >>= 16)
+    if (dense & 0xFFFFu) chunk_node(n, s, o, (unsigned)dense & 0xFFFFu, &r0, child_rays, &hit);
   return hit;
 }
 
@@ -101,7 +111,7 @@ static uint64_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint3
     while (!(ref & FR_BVHN_LEAF)) {
       const node_t *nd = (const node_t *)FR_BVHN_NODE_AT(b, ref);
       uint64_t child_rays[8];
-      int hit = stream_node(nd, &s, m, uniform, child_rays, NULL, NULL);
+      int hit = stream_node(nd, &s, m, uniform, child_rays, NULL, NULL, n);
       if (!hit) goto next;
       /* the last hit slot first, as the single-ray any-hit (bvhn_single.c) */
       int last = 31 - __builtin_clz((unsigned)hit);
@@ -189,7 +199,7 @@ static void intersect_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t
       const node_t *nd = (const node_t *)FR_BVHN_NODE_AT(b, ref);
       uint64_t child_rays[8];
       float min_tn[W] __attribute__((aligned(32))), mean_tn[W] __attribute__((aligned(32)));
-      int hit = stream_node(nd, &s, m, uniform, child_rays, min_tn, mean_tn);
+      int hit = stream_node(nd, &s, m, uniform, child_rays, min_tn, mean_tn, n);
       if (!hit) goto next;
       /* nearest first by mean_tn; slot order on ties */
       int order[W], k = 0;
