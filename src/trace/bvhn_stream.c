@@ -47,7 +47,9 @@ FR_INLINE void child_dists_add(child_dists *d, vnode tn, int bits) {
  * loaded once for all. A non-NULL min_tn (closest hits; inlined, so the
  * any-hit loop has none of it) gets per child c the least entry distance over
  * the rays of m: no ray enters c before it (rays that miss c only lower the
- * bound); and mean_tn the mean entry distance of the rays that hit c. */
+ * bound); and mean_tn the mean entry distance of the rays that hit c.
+ * Any-hit streams of one octant test their dense chunks of 16 (of the
+ * stream's n_rays) child by child (chunk_node, stream_rays.h). */
 FR_INLINE int stream_node(const node_t *n, const stream_rays *s, uint64_t m, int uniform,
                           uint64_t child_rays[8], float *min_tn, float *mean_tn, int n_rays) {
   if (W == 8) __builtin_prefetch(n->child);
@@ -58,7 +60,7 @@ FR_INLINE int stream_node(const node_t *n, const stream_rays *s, uint64_t m, int
   int hit = 0;
   uint64_t dense = 0; /* the rays of dense chunks, tested below */
   const ray_pre r0 = stream_ray(s, __builtin_ctzll(m));
-  if (uniform && !min_tn && __builtin_popcountll(m) >= STREAM_DENSE) {
+  if (STREAM_DENSE && uniform && !min_tn && __builtin_popcountll(m) >= STREAM_DENSE) {
     for (int o = 0; o + 16 <= n_rays; o += 16) {
       const uint64_t lanes = m & 0xFFFFull << o;
       if (__builtin_popcountll(lanes) >= STREAM_DENSE) dense |= lanes;

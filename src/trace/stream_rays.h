@@ -104,7 +104,7 @@ FR_INLINE uint64_t stream_setup(const fr_ray *rays, const uint32_t *idx, int n, 
 #if defined(FR_BUILD_ISA_AVX512)
 #define STREAM_DENSE 12
 #else
-#define STREAM_DENSE 17 /* never */
+#define STREAM_DENSE 0 /* never */
 #endif
 
 /* The rays `lanes` of chunk o (rays o .. o + 15, all < the stream's n)
