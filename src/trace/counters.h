@@ -17,7 +17,9 @@
  * leaves, frustum-triangle pairs before and after the corner-ray cull
  * (each pair left is one 16-ray test), soft-shadow batches traced as rays
  * instead (render/workload.c), tiles' shafts built and given up (too
- * many leaves) and the batches traced through one (mft_shaft*). Large
+ * many leaves), the child boxes their builds tested against a shaft
+ * (mft_shaft_box_tests: one box against one tile's shaft) and the batches
+ * traced through one (mft_shaft*). Large
  * packets (lp_*): packets, stack entries popped, boxes culled for the
  * whole packet, 16-ray box tests, leaves,
  * prims (triangles and spheres) reached, triangles culled for the whole
@@ -31,7 +33,7 @@
   X(pk_tri_lanes) X(pk_quad_tests) X(ia_culled) X(mailbox_hits) X(switches) X(switch_rays)    \
   X(mft_batches) X(mft_nodes) X(mft_box_tests) X(mft_box_lanes) X(mft_tris)   \
   X(mft_tri_frusta) X(mft_tri_left) X(mft_ray_batches) X(mft_stream_batches) X(mft_cached_leaves)  \
-  X(mft_stopped_batches) X(mft_shafts) X(mft_shaft_fails) X(mft_shaft_batches) X(mft_plane_rays) X(mft_plane_frusta) X(mft_plane_whole) X(pk_plane_rays) X(cache_tries) X(cache_hits)                                   \
+  X(mft_stopped_batches) X(mft_shafts) X(mft_shaft_fails) X(mft_shaft_box_tests) X(mft_shaft_batches) X(mft_plane_rays) X(mft_plane_frusta) X(mft_plane_whole) X(pk_plane_rays) X(cache_tries) X(cache_hits)                                   \
   X(lp_packets) X(lp_nodes) X(lp_culled) X(lp_box_chunks) X(lp_leaves) X(lp_tris) \
   X(lp_tri_culled) X(lp_tri_chunks)                                          \
   X(sp_box_tests) X(sp_tests) X(lp_sph_culled) X(lp_sph_chunks)

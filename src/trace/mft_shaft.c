@@ -10,6 +10,7 @@
  */
 #include <math.h>
 #include "accel/plane_occluders.h"
+#include "trace/counters.h"
 #include "trace/mft.h"
 
 /* The shaft as six planes of t: per axis, its low side plo + t dl and its
@@ -92,6 +93,7 @@ int fr_mft_shaft_build(const fr_bvh2 *b, const float plo[3], const float phi[3],
     const uint32_t node = stack[--sp];
     const fr_bvh2_node *n = &b->nodes[node];
     if (++visits > FR_MFT_SHAFT_VISITS) return 0;
+    FR_COUNT(mft_shaft_box_tests, 2);
     for (int k = 1; k >= 0; k--) { /* child 0 popped first */
       const float lo[3] = {n->lo_x[k], n->lo_y[k], n->lo_z[k]}, hi[3] = {n->hi_x[k], n->hi_y[k], n->hi_z[k]};
       if (!shaft_meets(&S, lo, hi)) continue;

@@ -96,14 +96,15 @@ static void report(const fr_workload *w0, const bench_run *r, const char *scene,
   if (fr_counters_enabled() && c.mft_batches)
     printf("counters tracer=%s mode=%s workload=%s batches=%llu per_batch nodes=%.2f box_tests=%.2f "
            "avg_active_frusta=%.2f tris=%.2f tri_frusta=%.2f tri_frusta_left=%.2f ray_batches=%llu stream_batches=%llu cached_leaves=%llu "
-           "stopped_batches=%llu shafts=%llu shaft_fails=%llu shaft_batches=%llu plane_rays=%llu plane_frusta=%llu plane_whole=%llu\n",
+           "stopped_batches=%llu shafts=%llu shaft_fails=%llu shaft_box_tests=%.2f shaft_batches=%llu plane_rays=%llu plane_frusta=%llu plane_whole=%llu\n",
            tracer, mode, fr_workload_name(w0->kind), (unsigned long long)c.mft_batches,
            (double)c.mft_nodes / c.mft_batches, (double)c.mft_box_tests / c.mft_batches,
            c.mft_box_tests ? (double)c.mft_box_lanes / c.mft_box_tests : 0.0, (double)c.mft_tris / c.mft_batches,
            (double)c.mft_tri_frusta / c.mft_batches, (double)c.mft_tri_left / c.mft_batches,
            (unsigned long long)c.mft_ray_batches, (unsigned long long)c.mft_stream_batches,
            (unsigned long long)c.mft_cached_leaves, (unsigned long long)c.mft_stopped_batches,
-           (unsigned long long)c.mft_shafts, (unsigned long long)c.mft_shaft_fails, (unsigned long long)c.mft_shaft_batches,
+           (unsigned long long)c.mft_shafts, (unsigned long long)c.mft_shaft_fails,
+           (double)c.mft_shaft_box_tests / c.mft_batches, (unsigned long long)c.mft_shaft_batches,
            (unsigned long long)c.mft_plane_rays, (unsigned long long)c.mft_plane_frusta,
            (unsigned long long)c.mft_plane_whole);
   if (fr_counters_enabled() && c.packets)
