@@ -399,17 +399,18 @@ static void test_tri4_pair(void **st) {
   assert_true(hits > tested / 4);
 }
 
-typedef int (*stream_setup_fn)(const fr_ray *, int, int *);
-int fr_test_stream_setup_scalar(const fr_ray *rays, int n, int *uniform);
-int fr_test_stream_setup_avx2(const fr_ray *rays, int n, int *uniform);
-int fr_test_stream_setup_avx512(const fr_ray *rays, int n, int *uniform);
+typedef int (*stream_setup_fn)(const fr_ray *, int, int, int *);
+int fr_test_stream_setup_scalar(const fr_ray *rays, int n, int in_row, int *uniform);
+int fr_test_stream_setup_avx2(const fr_ray *rays, int n, int in_row, int *uniform);
+int fr_test_stream_setup_avx512(const fr_ray *rays, int n, int in_row, int *uniform);
 
 /* A ray streams sets its rays up all at once, lane by lane
  * (stream_rays.h); every value the tests read must be ray_setup's, bit for
  * bit, on every level: for random directions, for directions with zero,
  * signed-zero and tiny components (the reciprocal's clamp) and with ties
  * between components' magnitudes (the shear axis), for invalid rays, and
- * streams of one octant (uniform) or several. */
+ * streams of one octant (uniform) or several, their rays in a row (loaded
+ * 16 at a time and checked lane by lane) or not. */
 static void test_stream_setup(void **st) {
   (void)st;
   const struct { fr_isa isa; stream_setup_fn fn; } levels[] = {{FR_ISA_SCALAR, fr_test_stream_setup_scalar},
@@ -441,7 +442,7 @@ static void test_stream_setup(void **st) {
     for (size_t l = 0; l < sizeof levels / sizeof levels[0]; l++) {
       if (!fr_isa_supported(levels[l].isa)) continue;
       int uniform = 0;
-      const int bad = levels[l].fn(rays, len, &uniform);
+      const int bad = levels[l].fn(rays, len, n % 2, &uniform);
       if (bad == -2) fail_msg("level %zu, stream %d: uniform %d is wrong", l, n, uniform);
       if (bad >= 0)
         fail_msg("level %zu, stream %d, ray %d (dir %a %a %a): not ray_setup's", l, n, bad, rays[bad].dir[0],
