@@ -104,8 +104,9 @@ FR_INLINE uint64_t stream_setup(const fr_ray *rays, const uint32_t *idx, int n, 
     s->kx4[i] = 4 * (neg ? k1 : k0); s->ky4[i] = 4 * (neg ? k0 : k1); s->kz4[i] = z0 ? 0 : z1 ? 4 : 8;
   }
   *uniform = 1;
-  for (uint64_t m = active, first = active; m; m &= m - 1) {
-    const int i = __builtin_ctzll(m), f = __builtin_ctzll(first);
+  const int f = active ? __builtin_ctzll(active) : 0; /* the first valid ray */
+  for (uint64_t m = active; m; m &= m - 1) {
+    const int i = __builtin_ctzll(m);
     if (s->near_x[i] != s->near_x[f] || s->near_y[i] != s->near_y[f] || s->near_z[i] != s->near_z[f]) *uniform = 0;
   }
   return active;
