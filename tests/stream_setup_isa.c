@@ -16,7 +16,7 @@ static int same_bits(const void *a, const void *b, size_t n) { return !memcmp(a,
 
 int NAME(FR_ISA_SUFFIX)(const fr_ray *rays, int n, int in_row, int *uniform);
 int NAME(FR_ISA_SUFFIX)(const fr_ray *rays, int n, int in_row, int *uniform) {
-  uint32_t idx[FR_STREAM_MAX]; /* the rays in a row (loaded 16 at a time) or backwards (one by one) */
+  uint32_t idx[FR_STREAM_MAX]; /* the rays in a row or backwards */
   for (int i = 0; i < n; i++) idx[i] = (uint32_t)(in_row ? i : n - 1 - i);
   static stream_rays s __attribute__((aligned(64)));
   const uint64_t valid = stream_setup(rays, idx, n, &s, uniform);

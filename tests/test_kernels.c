@@ -273,17 +273,21 @@ static void test_imin_imax(void **st) {
   print_message("integer-order min/max: %d lane sets, %d node tests exact\n", tested, boxes);
 }
 
-typedef void (*load_records_fn)(const float *, size_t, int, float (*)[16], float (*)[16], float *);
-void fr_test_load_records_scalar(const float *src, size_t stride, int n, float (*out8)[16], float (*out4)[16], float *back4);
-void fr_test_load_records_avx2(const float *src, size_t stride, int n, float (*out8)[16], float (*out4)[16], float *back4);
-void fr_test_load_records_avx512(const float *src, size_t stride, int n, float (*out8)[16], float (*out4)[16], float *back4);
+typedef void (*load_records_fn)(const float *, size_t, const uint32_t *, int, float (*)[16], float (*)[16], float *);
+void fr_test_load_records_scalar(const float *src, size_t stride, const uint32_t *idx, int n, float (*out8)[16],
+                                 float (*out4)[16], float *back4);
+void fr_test_load_records_avx2(const float *src, size_t stride, const uint32_t *idx, int n, float (*out8)[16],
+                                 float (*out4)[16], float *back4);
+void fr_test_load_records_avx512(const float *src, size_t stride, const uint32_t *idx, int n, float (*out8)[16],
+                                 float (*out4)[16], float *back4);
 
 /* The transposing record loads (and the 4-float store) on every level move bits: field k of record
  * i lands in lane i of output k, NaNs and all, at the strides the Whitted
  * shading (12) and the packets (8) use. Loads of the first n records only
  * (the multi-frusta leaves') repeat record n - 1 in the lanes past it and
  * read nothing after the n records: they end right before a page that
- * cannot be read. */
+ * cannot be read. Loads by index (the ray streams') read the records
+ * named, in their order. */
 static void test_load_records(void **st) {
   (void)st;
   const struct { fr_isa isa; load_records_fn fn; } levels[] = {{FR_ISA_SCALAR, fr_test_load_records_scalar},
@@ -308,9 +312,18 @@ static void test_load_records(void **st) {
         float *at = (float *)(map + page - bytes);
         memcpy(at, src, bytes);
         float out8[8][16], out4[4][16], back4[64];
-        levels[l].fn(at, stride, n, out8, out4, back4);
+        levels[l].fn(at, stride, NULL, n, out8, out4, back4);
         for (int i = 0; i < 16; i++) {
           const size_t rec = (size_t)(i < n ? i : n - 1);
+          for (int k = 0; k < 8; k++) assert_memory_equal(&out8[k][i], &src[stride * rec + (size_t)k], 4);
+        }
+        /* by index: the records backwards, the last (by the page) twice */
+        uint32_t idx[16];
+        for (int i = 0; i < n; i++) idx[i] = (uint32_t)(n - 1 - i);
+        if (n > 2) idx[1] = (uint32_t)(n - 1);
+        levels[l].fn(at, stride, idx, n, out8, NULL, NULL);
+        for (int i = 0; i < 16; i++) {
+          const size_t rec = idx[i < n ? i : n - 1];
           for (int k = 0; k < 8; k++) assert_memory_equal(&out8[k][i], &src[stride * rec + (size_t)k], 4);
         }
         if (n == 16) {
@@ -409,8 +422,8 @@ int fr_test_stream_setup_avx512(const fr_ray *rays, int n, int in_row, int *unif
  * bit, on every level: for random directions, for directions with zero,
  * signed-zero and tiny components (the reciprocal's clamp) and with ties
  * between components' magnitudes (the shear axis), for invalid rays, and
- * streams of one octant (uniform) or several, their rays in a row (loaded
- * 16 at a time and checked lane by lane) or not. */
+ * streams of one octant (uniform) or several, their rays in a row or not
+ * (loaded by index, 16 at a time, and checked lane by lane). */
 static void test_stream_setup(void **st) {
   (void)st;
   const struct { fr_isa isa; stream_setup_fn fn; } levels[] = {{FR_ISA_SCALAR, fr_test_stream_setup_scalar},

@@ -275,9 +275,11 @@ FR_INLINE void vp_store_records(float *dst, const vpf *f, int nf) {
   for (int i = 0; i < P; i++)
     for (int k = 0; k < nf; k++) memcpy(dst + nf * i + k, &f[k].f[i], sizeof(float));
 }
-FR_INLINE void vp_load_records8_rows(const float *src, size_t stride, int n, vpf f[8]) {
-  for (int i = 0; i < P; i++)
-    for (int k = 0; k < 8; k++) memcpy(&f[k].f[i], src + stride * (size_t)(i < n ? i : n - 1) + k, sizeof(float));
+FR_INLINE void vp_load_records8_at(const float *src, size_t stride, const uint32_t *idx, int n, vpf f[8]) {
+  for (int i = 0; i < P; i++) {
+    const size_t row = (size_t)(i < n ? i : n - 1);
+    for (int k = 0; k < 8; k++) memcpy(&f[k].f[i], src + stride * (idx ? idx[row] : row) + k, sizeof(float));
+  }
 }
 FR_INLINE void vp_load_records4(const float *src, vpf f[4]) {
   for (int i = 0; i < P; i++)
@@ -329,12 +331,13 @@ FR_INLINE vpf fr_vp_from_halves(const __m256 *halves) {
   return f;
 }
 /* The inverse for the first 8 floats of records `stride` floats apart:
- * f[k] gets field k of records 0..n-1, 1 <= n <= P, lanes past n repeating
+ * f[k] gets field k of records 0..n-1 (record i at src + stride * idx[i],
+ * or stride * i where idx is NULL), 1 <= n <= P, lanes past n repeating
  * record n - 1, so nothing after the n records is read (and with n <= 8
  * only one half is loaded and transposed). Eight rows are loaded and
  * transposed at a time, where a gather per field loads each float on its
  * own. */
-FR_INLINE void vp_load_records8_rows(const float *src, size_t stride, int n, vpf f[8]) {
+FR_INLINE void vp_load_records8_at(const float *src, size_t stride, const uint32_t *idx, int n, vpf f[8]) {
   __m256 r[8][P / 8];
   for (int h = 0; h < P / 8; h++) {
     __m256 row[8];
@@ -342,7 +345,10 @@ FR_INLINE void vp_load_records8_rows(const float *src, size_t stride, int n, vpf
       for (int k = 0; k < 8; k++) r[k][h] = _mm256_permutevar8x32_ps(r[k][0], _mm256_set1_epi32(n - 1));
       continue;
     }
-    for (int i = 0; i < 8; i++) row[i] = _mm256_loadu_ps(src + stride * (size_t)(8 * h + i < n ? 8 * h + i : n - 1));
+    for (int i = 0; i < 8; i++) {
+      const size_t r = (size_t)(8 * h + i < n ? 8 * h + i : n - 1);
+      row[i] = _mm256_loadu_ps(src + stride * (idx ? idx[r] : r));
+    }
     fr_transpose8(row);
     for (int k = 0; k < 8; k++) r[k][h] = row[k];
   }
@@ -409,6 +415,9 @@ FR_INLINE void vp_store_records(float *dst, const vpf *f, int nf) {
 #endif
 
 /* P records of 8 floats in a row (n = P folds the row clamps away) */
+FR_INLINE void vp_load_records8_rows(const float *src, size_t stride, int n, vpf f[8]) {
+  vp_load_records8_at(src, stride, NULL, n, f);
+}
 FR_INLINE void vp_load_records8(const float *src, vpf f[8]) { vp_load_records8_rows(src, 8, P, f); }
 
 #if !(defined(FR_BUILD_ISA_AVX512) && P == 16) && !defined(FR_BUILD_ISA_SCALAR)
