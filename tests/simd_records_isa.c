@@ -1,8 +1,9 @@
 /* The transposing record loads of base/simd_packet.h compiled for one ISA
  * (16 lanes), called by test_kernels through a plain-C signature: out8[k]
  * gets field k of the first n records `stride` floats apart at src, or of
- * records idx[0..n) where idx is not NULL (lanes past n: the n-th), out4[k] field k of 16 records of 4 floats; back4
- * gets those 16 records stored again from out4's fields. */
+ * records idx[0..n) where idx is not NULL (lanes past n: the n-th);
+ * without idx, out4[k] gets field k of 16 records of 4 floats and back4
+ * those 16 records stored again from out4's fields. */
 #define FR_PACKET 16
 #include "base/simd_packet.h"
 

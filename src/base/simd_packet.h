@@ -414,10 +414,11 @@ FR_INLINE void vp_store_records(float *dst, const vpf *f, int nf) {
 }
 #endif
 
-/* P records of 8 floats in a row (n = P folds the row clamps away) */
+/* The first n records `stride` floats apart at src (vp_load_records8_at without indices) */
 FR_INLINE void vp_load_records8_rows(const float *src, size_t stride, int n, vpf f[8]) {
   vp_load_records8_at(src, stride, NULL, n, f);
 }
+/* P records of 8 floats in a row (n = P folds the row clamps away) */
 FR_INLINE void vp_load_records8(const float *src, vpf f[8]) { vp_load_records8_rows(src, 8, P, f); }
 
 #if !(defined(FR_BUILD_ISA_AVX512) && P == 16) && !defined(FR_BUILD_ISA_SCALAR)
