@@ -494,6 +494,38 @@ static uint64_t run_tile(const fr_workload *w, const fr_tracer *t, buffers *B, i
   return rays;
 }
 
+/* order[i]: the i-th tile to trace (y * tiles_x + x), in Morton order of
+ * (x, y), so that the tiles in flight at a time, and those traced one
+ * after another, lie close together and share the tree's nodes in the
+ * caches. Row order sent both threads along a row 64 tiles long at
+ * 1024 x 1024, which on dragon (a 48 MB tree) kept fetching the same
+ * nodes anew. Interleaved pairs, 2 threads, 1024 x 1024 (session 61):
+ * dragon soft16 mft 1.046x, packet16 1.016x, Embree's stream mode
+ * 1.024x; blocks of 8 x 8 tiles read 1.051x on mft, Morton against
+ * those 1.008x. The codes of the enclosing power-of-two square are
+ * walked in order and those outside the grid skipped: no sort (a qsort
+ * of 4,096 tiles cost conference primary 2.7%). NULL, the caller
+ * keeping row order, for grids so long and thin that the square would be
+ * mostly outside (their rows are short anyway) and without memory. */
+static uint32_t *tile_order(int tiles_x, int tiles_y) {
+  const size_t n = (size_t)tiles_x * (size_t)tiles_y;
+  size_t side = 1;
+  while (side < (size_t)tiles_x || side < (size_t)tiles_y) side *= 2;
+  if (side * side > 4 * n) return NULL;
+  uint32_t *order = malloc(n * sizeof *order);
+  if (!order) return NULL;
+  size_t k = 0;
+  for (size_t code = 0; code < side * side; code++) {
+    uint32_t x = 0, y = 0;
+    for (int bit = 0; (side >> bit) > 1; bit++) {
+      x |= (uint32_t)((code >> (2 * bit)) & 1u) << bit;
+      y |= (uint32_t)((code >> (2 * bit + 1)) & 1u) << bit;
+    }
+    if (x < (uint32_t)tiles_x && y < (uint32_t)tiles_y) order[k++] = y * (uint32_t)tiles_x + x;
+  }
+  return order;
+}
+
 fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
   /* the ray sets of this frame, shared by every tile */
   fr_workload run = *w0, *w = &run;
@@ -512,13 +544,15 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
   double stage[FR_STAGES] = {0};
   int done = 0, last_pct = -1;
   double t0 = fr_seconds();
+  uint32_t *order = tile_order(tiles_x, tiles_y);
 #pragma omp parallel num_threads(w->threads) reduction(+ : total)
   {
     buffers *B = whitted ? NULL : malloc(sizeof(buffers));
     fr_whitted_scratch *WS = whitted ? fr_whitted_scratch_new() : NULL;
 #pragma omp for schedule(dynamic, 1)
     for (int i = 0; i < ntiles; i++) {
-      int tx = (i % tiles_x) * tile, ty = (i / tiles_x) * tile;
+      const int k = order ? (int)order[i] : i;
+      const int tx = (k % tiles_x) * tile, ty = (k / tiles_x) * tile;
       if (WS) total += fr_whitted_tile(w, t, WS, tx, ty);
       else if (B) total += run_tile(w, t, B, tx, ty);
       if (w->progress) {
@@ -543,6 +577,7 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
 #endif
   }
   fr_workload_result r = {total, fr_seconds() - t0, {0}};
+  free(order);
   memcpy(r.stage, stage, sizeof stage);
   if (w->progress && last_pct >= 0) fprintf(stderr, "\n");
   fr_free_aligned(sets);
