@@ -54,13 +54,11 @@ FR_INLINE vpf vp_sqrt(vpf a) { vpf r = {FR_VP_OP(sqrt_ps)(a.v)}; return r; }
 /* min and max of the bit patterns as integers (see vf4_imin in base/simd.h) */
 FR_INLINE vpf vp_imin(vpf a, vpf b) { vpf r = {_mm512_castsi512_ps(_mm512_min_epi32(_mm512_castps_si512(a.v), _mm512_castps_si512(b.v)))}; return r; }
 FR_INLINE vpf vp_imax(vpf a, vpf b) { vpf r = {_mm512_castsi512_ps(_mm512_max_epi32(_mm512_castps_si512(a.v), _mm512_castps_si512(b.v)))}; return r; }
+FR_INLINE float vp_reduce_min(vpf a) { return _mm512_reduce_min_ps(a.v); }
+FR_INLINE float vp_reduce_max(vpf a) { return _mm512_reduce_max_ps(a.v); }
 #else
 FR_INLINE vpf vp_imin(vpf a, vpf b) { vpf r = {_mm256_castsi256_ps(_mm256_min_epi32(_mm256_castps_si256(a.v), _mm256_castps_si256(b.v)))}; return r; }
 FR_INLINE vpf vp_imax(vpf a, vpf b) { vpf r = {_mm256_castsi256_ps(_mm256_max_epi32(_mm256_castps_si256(a.v), _mm256_castps_si256(b.v)))}; return r; }
-#endif
-#if P == 16
-FR_INLINE float vp_reduce_min(vpf a) { return _mm512_reduce_min_ps(a.v); }
-FR_INLINE float vp_reduce_max(vpf a) { return _mm512_reduce_max_ps(a.v); }
 #endif
 
 #elif defined(FR_BUILD_ISA_AVX2)

@@ -19,10 +19,9 @@
  * instead (render/workload.c), tiles' shafts built and given up (too
  * many leaves), the child boxes their builds tested against a shaft
  * (mft_shaft_box_tests: one box against one tile's shaft) and the batches
- * traced through one (mft_shaft*). Large
- * packets (lp_*): packets, stack entries popped, boxes culled for the
- * whole packet, 16-ray box tests, leaves,
- * prims (triangles and spheres) reached, triangles culled for the whole
+ * traced through one (mft_shaft*). Large packets (lp_*): packets, stack
+ * entries popped, boxes culled for the whole packet, 16-ray box tests,
+ * leaves, prims (triangles and spheres) reached, triangles culled for the whole
  * packet, 16-ray triangle tests. Spheres: single-ray box and sphere tests
  * in the sphere tree (sp_*), spheres culled for a whole large packet,
  * 16-ray sphere tests. Single-ray streams' occluder cache: rays that tried
