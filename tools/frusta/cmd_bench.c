@@ -63,6 +63,8 @@ typedef struct bench_run {
   double stage[64][FR_STAGES]; /* Whitted: each repetition's stage times */
   uint64_t rays;
   fr_counters c;      /* summed over the repetitions */
+  ebr_flag flag;      /* Embree: the context flag and packing traced */
+  ebr_packing packing;
 } bench_run;
 
 static void report(const fr_workload *w0, const bench_run *r, const char *scene, size_t tris, int repeat) {
@@ -72,9 +74,12 @@ static void report(const fr_workload *w0, const bench_run *r, const char *scene,
   double best = secs[0], med = secs[repeat / 2];
   const char *tracer = r->tracer, *mode = r->name;
   uint64_t rays = r->rays;
-  printf("scene=%s tris=%zu workload=%s tracer=%s mode=%s threads=%d rays=%llu seconds=%.4f mrays=%.2f median_seconds=%.4f median_mrays=%.2f\n",
+  char embree[64] = "";
+  if (r->tracer[0] == 'e')
+    snprintf(embree, sizeof embree, " flag=%s packing=%s", ebr_flag_name(r->flag), ebr_packing_name(r->packing));
+  printf("scene=%s tris=%zu workload=%s tracer=%s mode=%s threads=%d rays=%llu seconds=%.4f mrays=%.2f median_seconds=%.4f median_mrays=%.2f%s\n",
          scene, tris, fr_workload_name(w0->kind), tracer, mode, w0->threads, (unsigned long long)rays, best,
-         (double)rays / best * 1e-6, med, (double)rays / med * 1e-6);
+         (double)rays / best * 1e-6, med, (double)rays / med * 1e-6, embree);
   if (w0->kind == FR_WL_WHITTED) {
     /* the stages of the fastest repetition, in thread-seconds: which part of
      * a Whitted frame the tracer speeds up, and how much is the renderer's */
@@ -157,12 +162,46 @@ static int parse_modes(const char *list, int use_frusta, int use_embree, unsigne
   return 0;
 }
 
+/* Embree at its best: every context flag and packing the run may use
+ * (flag < 0, packing < 0: all that apply) traced twice, interleaved; the
+ * run keeps the fastest. Packing by samples applies where the workload's
+ * rays come in runs of 16 per pixel (soft16, ao16) and packets or streams
+ * group them. */
+static void choose_embree_variant(const fr_workload *w, ebr_scene *e, bench_run *r, int flag, int packing) {
+  const int runs16 = w->kind == FR_WL_SOFT16 || w->kind == FR_WL_AO16;
+  const int grouped = r->mode != EBR_SINGLE;
+  double best[EBR_FLAG_COUNT][EBR_PACK_COUNT];
+  int use[EBR_FLAG_COUNT][EBR_PACK_COUNT], n = 0;
+  for (int f = 0; f < EBR_FLAG_COUNT; f++)
+    for (int p = 0; p < EBR_PACK_COUNT; p++) {
+      use[f][p] = (flag < 0 || flag == f) && (packing < 0 ? p == EBR_PACK_RAYS || (runs16 && grouped) : packing == p);
+      best[f][p] = 1e30;
+      n += use[f][p];
+    }
+  r->flag = flag < 0 ? EBR_FLAG_HINT : (ebr_flag)flag;
+  r->packing = packing < 0 ? EBR_PACK_RAYS : (ebr_packing)packing;
+  if (n > 1)
+    for (int rep = 0; rep < 2; rep++)
+      for (int f = 0; f < EBR_FLAG_COUNT; f++)
+        for (int p = 0; p < EBR_PACK_COUNT; p++) {
+          if (!use[f][p]) continue;
+          fr_tracer t = ebr_tracer(e, (ebr_mode)r->mode, (ebr_flag)f, (ebr_packing)p);
+          fr_workload_result res = fr_workload_run(w, &t);
+          if (res.seconds < best[f][p]) best[f][p] = res.seconds;
+          if (best[f][p] < best[r->flag][r->packing] || !use[r->flag][r->packing]) {
+            r->flag = (ebr_flag)f;
+            r->packing = (ebr_packing)p;
+          }
+        }
+  r->t = ebr_tracer(e, (ebr_mode)r->mode, r->flag, r->packing);
+}
+
 int cmd_bench(int argc, char **argv) {
   const char *scene = NULL, *workload = NULL, *mode = NULL, *tracer = "frusta";
   cli_view v;
   memset(&v, 0, sizeof v);
   v.width = 1024; v.height = 1024;
-  int threads = omp_get_num_procs(), repeat = 3;
+  int threads = omp_get_num_procs(), repeat = 3, embree_flag = -1, embree_packing = -1;
   fr_trace_options topt;
   fr_trace_options_default(&topt);
   fr_mft_opts mopt = fr_mft_opts_default();
@@ -237,10 +276,21 @@ int cmd_bench(int argc, char **argv) {
         return CLI_USAGE_ERROR;
       continue;
     }
-    if (!strcmp(a, "--workload") || !strcmp(a, "--mode") || !strcmp(a, "--tracer") || !strcmp(a, "--threads") || !strcmp(a, "--repeat") || !strcmp(a, "--isa")) {
+    if (!strcmp(a, "--workload") || !strcmp(a, "--mode") || !strcmp(a, "--tracer") || !strcmp(a, "--threads") ||
+        !strcmp(a, "--repeat") || !strcmp(a, "--isa") || !strcmp(a, "--embree-flag") || !strcmp(a, "--embree-packing")) {
       if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
       const char *val = argv[++i];
-      if (!strcmp(a, "--workload")) workload = val;
+      ebr_flag ef;
+      ebr_packing ep;
+      if (!strcmp(a, "--embree-flag")) {
+        if (!strcmp(val, "best")) embree_flag = -1;
+        else if (ebr_flag_parse(val, &ef)) embree_flag = (int)ef;
+        else return cli_error(CLI_USAGE_ERROR, "--embree-flag is best, hint, coherent or incoherent, not '%s'", val);
+      } else if (!strcmp(a, "--embree-packing")) {
+        if (!strcmp(val, "best")) embree_packing = -1;
+        else if (ebr_packing_parse(val, &ep)) embree_packing = (int)ep;
+        else return cli_error(CLI_USAGE_ERROR, "--embree-packing is best, rays or samples, not '%s'", val);
+      } else if (!strcmp(a, "--workload")) workload = val;
       else if (!strcmp(a, "--mode")) mode = val;
       else if (!strcmp(a, "--tracer")) tracer = val;
       else if (!strcmp(a, "--isa")) { if (cli_set_isa(val)) return 1; }
@@ -359,7 +409,7 @@ int cmd_bench(int argc, char **argv) {
       r->tracer = "embree";
       r->mode = m;
       snprintf(r->name, sizeof r->name, "%s", ebr_mode_name((ebr_mode)m));
-      r->t = ebr_tracer(e, (ebr_mode)m);
+      choose_embree_variant(&w, e, r, embree_flag, embree_packing);
     }
     for (int rep = 0; rep < repeat; rep++)
       for (int i = 0; i < nruns; i++) {

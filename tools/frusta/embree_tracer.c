@@ -15,7 +15,12 @@ struct ebr_scene {
   double build_seconds;
   uint32_t sphere_base;   /* frusta's prim of Embree's sphere 0 (geometry 1) */
   _Atomic long long bytes;
-  struct ebr_ctx { struct ebr_scene *e; ebr_mode mode; } ctx[EBR_MODE_COUNT];
+  struct ebr_ctx {
+    struct ebr_scene *e;
+    ebr_mode mode;
+    ebr_flag flag;
+    ebr_packing packing;
+  } ctx[EBR_MODE_COUNT][EBR_FLAG_COUNT][EBR_PACK_COUNT];
 };
 
 static const char *mode_names[EBR_MODE_COUNT] = {"single", "packet4", "packet8", "packet16", "stream"};
@@ -76,7 +81,10 @@ fr_error ebr_create(const fr_scene *s, ebr_options opt, ebr_scene **out) {
   rtcCommitScene(e->scene);
   e->build_seconds = fr_seconds() - t0;
   if (rtcGetDeviceError(e->dev) != RTC_ERROR_NONE) { ebr_release(e); return FR_ERR_UNSUPPORTED; }
-  for (int i = 0; i < EBR_MODE_COUNT; i++) { e->ctx[i].e = e; e->ctx[i].mode = (ebr_mode)i; }
+  for (int i = 0; i < EBR_MODE_COUNT; i++)
+    for (int f = 0; f < EBR_FLAG_COUNT; f++)
+      for (int p = 0; p < EBR_PACK_COUNT; p++)
+        e->ctx[i][f][p] = (struct ebr_ctx){e, (ebr_mode)i, (ebr_flag)f, (ebr_packing)p};
   *out = e;
   return FR_OK;
 }
@@ -169,29 +177,29 @@ PACKET_FUNCS(4)
 PACKET_FUNCS(8)
 PACKET_FUNCS(16)
 
-static struct RTCIntersectContext make_context(int coherent) {
+static struct RTCIntersectContext make_context(ebr_flag flag, int coherent) {
   struct RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  ctx.flags = coherent > 0 ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  const int c = flag == EBR_FLAG_HINT ? coherent > 0 : flag == EBR_FLAG_COHERENT;
+  ctx.flags = c ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
   return ctx;
 }
 
-static void ebr_intersect(void *c, const fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
-  struct ebr_ctx *x = c;
-  ebr_scene *e = x->e;
-  struct RTCIntersectContext ctx = make_context(coherent);
-  switch (x->mode) {
-  case EBR_PACKET4: intersect_p4(e, &ctx, rays, hits, n); return;
-  case EBR_PACKET8: intersect_p8(e, &ctx, rays, hits, n); return;
-  case EBR_PACKET16: intersect_p16(e, &ctx, rays, hits, n); return;
+static void intersect_rays(ebr_scene *e, ebr_mode mode, struct RTCIntersectContext *ctx, const fr_ray *rays,
+                           fr_hit *hits, size_t n) {
+  switch (mode) {
+  case EBR_PACKET4: intersect_p4(e, ctx, rays, hits, n); return;
+  case EBR_PACKET8: intersect_p8(e, ctx, rays, hits, n); return;
+  case EBR_PACKET16: intersect_p16(e, ctx, rays, hits, n); return;
   case EBR_STREAM: {
     struct RTCRayHit rh[64];
     for (size_t b = 0; b < n; b += 64) {
       size_t m = n - b < 64 ? n - b : 64;
       for (size_t i = 0; i < m; i++) to_rayhit1(&rays[b + i], &rh[i]);
-      rtcIntersect1M(e->scene, &ctx, rh, (unsigned)m, sizeof(struct RTCRayHit));
+      rtcIntersect1M(e->scene, ctx, rh, (unsigned)m, sizeof(struct RTCRayHit));
       for (size_t i = 0; i < m; i++)
-        from_hit(e, rh[i].ray.tfar, rh[i].hit.geomID, rh[i].hit.primID, rh[i].hit.u, rh[i].hit.v, rh[i].hit.Ng_x, rh[i].hit.Ng_y, rh[i].hit.Ng_z, &hits[b + i]);
+        from_hit(e, rh[i].ray.tfar, rh[i].hit.geomID, rh[i].hit.primID, rh[i].hit.u, rh[i].hit.v, rh[i].hit.Ng_x,
+                 rh[i].hit.Ng_y, rh[i].hit.Ng_z, &hits[b + i]);
     }
     return;
   }
@@ -199,26 +207,25 @@ static void ebr_intersect(void *c, const fr_ray *rays, fr_hit *hits, size_t n, i
     for (size_t i = 0; i < n; i++) {
       struct RTCRayHit rh;
       to_rayhit1(&rays[i], &rh);
-      rtcIntersect1(e->scene, &ctx, &rh);
-      from_hit(e, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z, &hits[i]);
+      rtcIntersect1(e->scene, ctx, &rh);
+      from_hit(e, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z,
+               &hits[i]);
     }
   }
 }
 
-static void ebr_occluded(void *c, const fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
-  struct ebr_ctx *x = c;
-  ebr_scene *e = x->e;
-  struct RTCIntersectContext ctx = make_context(coherent);
-  switch (x->mode) {
-  case EBR_PACKET4: occluded_p4(e, &ctx, rays, occ, n); return;
-  case EBR_PACKET8: occluded_p8(e, &ctx, rays, occ, n); return;
-  case EBR_PACKET16: occluded_p16(e, &ctx, rays, occ, n); return;
+static void occluded_rays(ebr_scene *e, ebr_mode mode, struct RTCIntersectContext *ctx, const fr_ray *rays,
+                          uint8_t *occ, size_t n) {
+  switch (mode) {
+  case EBR_PACKET4: occluded_p4(e, ctx, rays, occ, n); return;
+  case EBR_PACKET8: occluded_p8(e, ctx, rays, occ, n); return;
+  case EBR_PACKET16: occluded_p16(e, ctx, rays, occ, n); return;
   case EBR_STREAM: {
     struct RTCRay r[64];
     for (size_t b = 0; b < n; b += 64) {
       size_t m = n - b < 64 ? n - b : 64;
       for (size_t i = 0; i < m; i++) { struct RTCRayHit t; to_rayhit1(&rays[b + i], &t); r[i] = t.ray; }
-      rtcOccluded1M(e->scene, &ctx, r, (unsigned)m, sizeof(struct RTCRay));
+      rtcOccluded1M(e->scene, ctx, r, (unsigned)m, sizeof(struct RTCRay));
       for (size_t i = 0; i < m; i++) occ[b + i] = r[i].tfar < 0.0f;
     }
     return;
@@ -227,15 +234,72 @@ static void ebr_occluded(void *c, const fr_ray *rays, uint8_t *occ, size_t n, in
     for (size_t i = 0; i < n; i++) {
       struct RTCRayHit rh;
       to_rayhit1(&rays[i], &rh);
-      rtcOccluded1(e->scene, &ctx, &rh.ray);
+      rtcOccluded1(e->scene, ctx, &rh.ray);
       occ[i] = rh.ray.tfar < 0.0f;
     }
   }
 }
 
-fr_tracer ebr_tracer(ebr_scene *e, ebr_mode m) {
-  fr_tracer t = {&e->ctx[m], ebr_intersect, ebr_occluded, NULL, NULL, 0, NULL};
+/* EBR_PACK_SAMPLES: the rays come in runs of 16 per pixel (soft16, ao16);
+ * each chunk of up to 16 runs is traced sample by sample, so that a packet
+ * holds one sample of up to 16 neighbouring pixels. perm[j] is the call's
+ * ray that goes j-th in a chunk of runs runs. */
+#define EBR_CHUNK 256
+static void sample_order(size_t runs, uint16_t *perm) {
+  for (size_t k = 0; k < 16; k++)
+    for (size_t p = 0; p < runs; p++) perm[k * runs + p] = (uint16_t)(16 * p + k);
+}
+
+static void ebr_intersect(void *c, const fr_ray *rays, fr_hit *hits, size_t n, int coherent) {
+  struct ebr_ctx *x = c;
+  struct RTCIntersectContext ctx = make_context(x->flag, coherent);
+  if (x->packing != EBR_PACK_SAMPLES || n % 16) { intersect_rays(x->e, x->mode, &ctx, rays, hits, n); return; }
+  fr_ray r[EBR_CHUNK];
+  fr_hit h[EBR_CHUNK];
+  uint16_t perm[EBR_CHUNK];
+  for (size_t b = 0; b < n; b += EBR_CHUNK) {
+    const size_t m = n - b < EBR_CHUNK ? n - b : EBR_CHUNK;
+    sample_order(m / 16, perm);
+    for (size_t j = 0; j < m; j++) r[j] = rays[b + perm[j]];
+    intersect_rays(x->e, x->mode, &ctx, r, h, m);
+    for (size_t j = 0; j < m; j++) hits[b + perm[j]] = h[j];
+  }
+}
+
+static void ebr_occluded(void *c, const fr_ray *rays, uint8_t *occ, size_t n, int coherent) {
+  struct ebr_ctx *x = c;
+  struct RTCIntersectContext ctx = make_context(x->flag, coherent);
+  if (x->packing != EBR_PACK_SAMPLES || n % 16) { occluded_rays(x->e, x->mode, &ctx, rays, occ, n); return; }
+  fr_ray r[EBR_CHUNK];
+  uint8_t o[EBR_CHUNK];
+  uint16_t perm[EBR_CHUNK];
+  for (size_t b = 0; b < n; b += EBR_CHUNK) {
+    const size_t m = n - b < EBR_CHUNK ? n - b : EBR_CHUNK;
+    sample_order(m / 16, perm);
+    for (size_t j = 0; j < m; j++) r[j] = rays[b + perm[j]];
+    occluded_rays(x->e, x->mode, &ctx, r, o, m);
+    for (size_t j = 0; j < m; j++) occ[b + perm[j]] = o[j];
+  }
+}
+
+fr_tracer ebr_tracer(ebr_scene *e, ebr_mode m, ebr_flag flag, ebr_packing packing) {
+  fr_tracer t = {&e->ctx[m][flag][packing], ebr_intersect, ebr_occluded, NULL, NULL, 0, NULL};
   return t;
+}
+
+static const char *flag_names[EBR_FLAG_COUNT] = {"hint", "coherent", "incoherent"};
+static const char *packing_names[EBR_PACK_COUNT] = {"rays", "samples"};
+const char *ebr_flag_name(ebr_flag f) { return f < EBR_FLAG_COUNT ? flag_names[f] : "?"; }
+const char *ebr_packing_name(ebr_packing p) { return p < EBR_PACK_COUNT ? packing_names[p] : "?"; }
+int ebr_flag_parse(const char *name, ebr_flag *f) {
+  for (int i = 0; i < EBR_FLAG_COUNT; i++)
+    if (strcmp(name, flag_names[i]) == 0) { *f = (ebr_flag)i; return 1; }
+  return 0;
+}
+int ebr_packing_parse(const char *name, ebr_packing *p) {
+  for (int i = 0; i < EBR_PACK_COUNT; i++)
+    if (strcmp(name, packing_names[i]) == 0) { *p = (ebr_packing)i; return 1; }
+  return 0;
 }
 
 /* ---- Embree's builder on its own, for the SAH comparison ----------------- */
