@@ -22,7 +22,7 @@ mkdir -p bench/results
 for s in $SCENES; do
   for wl in primary shadow soft16 ao16 diffuse8 specular8; do
     case $wl in primary|shadow|soft16) size=1024x1024 ;; *) size=512x512 ;; esac
-    ./build/frusta bench "../shared/scenes/$s/$s.ply.zst" --workload "$wl" --tracer both \
+    ${FRUSTA:-./build/frusta} bench "../shared/scenes/$s/$s.ply.zst" --workload "$wl" --tracer both \
       --mode "$FRUSTA_MODES,$EMBREE_MODES" --threads 2 --size "$size" --repeat "$REPEAT" | grep '^scene=' >>"$RAW"
   done
 done
