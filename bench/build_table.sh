@@ -1,16 +1,16 @@
 #!/usr/bin/env bash
-# Build time, SAH and memory, frusta against Embree (issue 2): `frusta stats
+# Build time, SAH and memory, frusta against Embree: `frusta stats
 # SCENE --embree` K times per scene at 2 threads (this VM's speed drifts
 # between runs, so the table takes each builder's fastest run). Raw lines go
-# to bench/results/build-raw.txt, a markdown table to stdout.
+# to bench/results/build-vs-embree.txt, a markdown table to stdout.
 # usage: bench/build_table.sh [K] [SCENES...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 K=${1:-5}; shift || true
 SCENES=${*:-conference kitchen dragon hairball}
 mkdir -p bench/results
-RAW=bench/results/build-raw.txt
-: >"$RAW"
+RAW=bench/results/build-vs-embree.txt
+printf "# commit %s\n# %s\n" "$(git rev-parse --short HEAD)" "bench/$(basename "$0") $*" >"$RAW"
 for s in $SCENES; do
   for _ in $(seq "$K"); do
     ./build/frusta stats "../shared/scenes/$s/$s.ply.zst" --threads 2 --embree >>"$RAW"

@@ -13,9 +13,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 SIZE=${SIZE:-1024x1024}; REPEAT=${REPEAT:-3}; THREADS=${THREADS:-2}; ROUNDS=${ROUNDS:-5}
 SCENES=${SCENES:-conference kitchen sibenik dragon}; SETS=${SETS:-spread cells}
-RAW=bench/results/mft-shrink-raw.txt
+RAW=bench/results/mft-table2-shrink.txt
 mkdir -p bench/results
-: >"$RAW"
+printf "# commit %s\n# %s\n" "$(git rev-parse --short HEAD)" "bench/$(basename "$0") $*" >"$RAW"
 run() { # binary scene sets shrink repeat: the bench's result and counters lines
   "$1" bench "../shared/scenes/$2/$2.ply.zst" --workload soft16 --mode mft --light-sets "$3" --shrink "$4" \
     --threads "$THREADS" --size "$SIZE" --repeat "$5" | grep -E '^(scene=|counters)' | sed "s/^/sets=$3 shrink=$4 /; s/^\(.*\)counters /scene=$2 \1/"

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# The multi-frusta benchmark (issue 4): mft next to frusta's packet modes and
+# The multi-frusta benchmark: mft next to frusta's packet modes and
 # Embree's modes, one process per scene and workload, 2 threads, 1024x1024;
 # soft16 with the light's samples dealt out "spread" (the workload's per-pixel
 # stratification) and by "cells" (the paper's narrow frusta); shallow BVHs
-# (leaves of 8 and 12); shrinking off. Raw lines go to bench/results/mft-raw.txt.
+# (leaves of 8 and 12); shrinking off. Raw lines go to bench/results/mft-vs-embree.txt.
 # With a counters build in build-count/ (cmake -DFRUSTA_COUNTERS=ON) it also
-# records the counters for the paper's Table 1 in bench/results/mft-counters.txt.
+# records the counters for the paper's Table 1 in bench/results/mft-table1-counters.txt.
 # Table 1's multi-frusta rows trace every ray as frusta (--mft-fallback off)
 # and cull every triangle with the corner rays (--corner-cost 0), as the
 # paper's do.
@@ -15,14 +15,14 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 SIZE=${SIZE:-1024x1024}; REPEAT=${REPEAT:-3}; THREADS=${THREADS:-2}
 SCENES=${SCENES:-conference kitchen sibenik dragon}
-RAW=bench/results/mft-raw.txt
+RAW=bench/results/mft-vs-embree.txt
 bench() { # binary tag scene args...
   local bin=$1 tag=$2 s=$3; shift 3
   "$bin" bench "../shared/scenes/$s/$s.ply.zst" --threads "$THREADS" --size "$SIZE" --repeat "$REPEAT" "$@" |
     grep -E '^(scene=|counters|mft_bvh)' | sed "s/^/$tag /"
 }
 mkdir -p bench/results
-[ "${COUNTERS_ONLY:-0}" = 1 ] || : >"$RAW"
+[ "${COUNTERS_ONLY:-0}" = 1 ] || printf "# commit %s\n# %s\n" "$(git rev-parse --short HEAD)" "bench/$(basename "$0") $*" >"$RAW"
 for s in $SCENES; do
   [ "${COUNTERS_ONLY:-0}" = 1 ] && break
   bench ./build/frusta main "$s" --workload primary --mode all --tracer both >>"$RAW"
@@ -36,8 +36,8 @@ for s in $SCENES; do
   for leaf in 8 12; do bench ./build/frusta "leaf=$leaf" "$s" --workload primary --mode mft --mft-leaf "$leaf" >>"$RAW"; done
 done
 if [ -x build-count/frusta ]; then
-  CNT=bench/results/mft-counters.txt
-  : >"$CNT"
+  CNT=bench/results/mft-table1-counters.txt
+  printf "# commit %s\n# COUNTERS_ONLY=1 bench/%s\n" "$(git rev-parse --short HEAD)" "$(basename "$0")" >"$CNT"
   for s in $SCENES; do
     for m in mft packet16; do
       cc=(); [ "$m" = mft ] && cc=(--corner-cost 0)

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# The Whitted benchmark (issue 5): large packets of 2x2 .. 32x32 rays with
+# The Whitted benchmark: large packets of 2x2 .. 32x32 rays with
 # each traversal (masked, ranged, partition), the culls (off, ia, planes,
 # corners) at 2x2 and 16x16, frusta's hybrid16, auto and mft, and Embree's modes,
 # all on the same Whitted rays, 2 threads, 1024x1024. kitchen and museum
 # with their MTL mirrors and glass, spd_rings with every surface a mirror,
 # and the analytic sphereflake (--builtin=sphereflake: 820 mirror spheres).
-# Raw lines go to bench/results/whitted-raw.txt; with a counters build in
+# Raw lines go to bench/results/whitted-vs-embree.txt; with a counters build in
 # build-count/ the packet counters go to bench/results/whitted-counters.txt.
 # env: SIZE (1024x1024) REPEAT (3) THREADS (2) SCENES ("kitchen museum
 # spd_rings sphereflake") RAW COUNT (the output files)
@@ -13,7 +13,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 SIZE=${SIZE:-1024x1024}; REPEAT=${REPEAT:-3}; THREADS=${THREADS:-2}
 SCENES=${SCENES:-kitchen museum spd_rings sphereflake}
-RAW=${RAW:-bench/results/whitted-raw.txt}
+RAW=${RAW:-bench/results/whitted-vs-embree.txt}
 COUNT=${COUNT:-bench/results/whitted-counters.txt}
 scene_file() {
   case $1 in
@@ -30,7 +30,7 @@ bench() { # binary scene args...
     $(scene_args "$s") "$@" | grep -E '^(scene=|counters|whitted)'
 }
 mkdir -p bench/results
-: >"$RAW"
+printf "# commit %s\n# %s\n" "$(git rev-parse --short HEAD)" "bench/$(basename "$0") $*" >"$RAW"
 [ -x build-count/frusta ] && : >"$COUNT"
 for s in $SCENES; do
   bench ./build/frusta "$s" --mode hybrid16 --tracer both >>"$RAW"

@@ -135,21 +135,13 @@ typedef struct fr_bvh_stats {
   size_t bvh2_inner, bvh2_leaves;
   double bvh2_sah, bvh2_leaf_fill;
   size_t bvh2_bytes;
-  fr_wide_stats bvh4, bvh8;      /* bvh4: zeros until the BVH4 is built, which happens when a
-                                    4-wide mode is chosen (fr_scene_set_bvh_width, packet_bvh_width) */
+  fr_wide_stats bvh4, bvh8;      /* bvh4: zeros unless a 4-wide layout was asked for */
   size_t references;             /* triangles in the BVHs' leaves: more than the scene's where
                                     long thin ones were split into pieces before the build */
   double build_seconds;          /* fr_scene_commit: SAH build + the layouts it makes */
-  int single_width;              /* the BVH fr_intersect1 uses: 4 or 8 */
+  int single_width;              /* the BVH width fr_intersect1 traverses: 8 (4 for measurements) */
 } fr_bvh_stats;
 fr_error fr_scene_stats(const fr_scene *s, fr_bvh_stats *out);
-
-/* Which BVH the single-ray calls traverse: 8-wide (default, fastest on AVX2
- * and AVX-512) or 4-wide (the MIC paper's). FRUSTA_BVH_WIDTH=4|8 sets the
- * default. The BVH4 is built when first chosen, here or by packet_bvh_width
- * (after the commit that is a second SAH build: choose it before the
- * commit, or while no thread traces the scene). */
-fr_error fr_scene_set_bvh_width(fr_scene *s, int width);
 
 /* ---- single rays ----------------------------------------------------------- */
 typedef struct fr_ray {
@@ -174,11 +166,9 @@ int fr_occluded1(const fr_scene *s, const fr_ray *ray);
 /* ---- packets of 16 rays ------------------------------------------------------
  * Structure of arrays, one lane per ray. valid has bit i set for each ray i
  * to trace; lanes not in valid are neither read nor written. The packet
- * traverses the BVH together (8-wide by default, see packet_bvh_width) and,
+ * traverses the 8-wide BVH together and,
  * when few of its rays are left in a subtree, continues them one by one (the
- * hybrid of Benthin et al.); the threshold is fr_trace_options.hybrid_threshold (or 16, see
- * hybrid_tune), or for a packet whose rays share a direction octant coherent_threshold if
- * smaller. Answers agree with
+ * hybrid of Benthin et al.). Answers agree with
  * fr_intersect1's ray by ray (same t; the packet's triangle test is not
  * watertight, so a ray exactly through a shared edge may report either
  * triangle, or, rarely, miss where fr_intersect1 hits). See
@@ -201,76 +191,32 @@ unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays);
 /* ---- streams ------------------------------------------------------------------
  * n independent rays. In FR_TRACE_AUTO mode the rays are sorted by direction
  * octant (in chunks of 1024, keeping their order within an octant) and each
- * group of 16 whose directions are coherent (stream_spread) is traced as a
- * hybrid packet (coherent_threshold); the other rays of the octant go as
- * ray streams of up to 64.
+ * group of 16 whose directions are coherent is traced as a hybrid packet;
+ * the other rays of the octant go as ray streams of up to 64.
  * Order rays so that neighbours are coherent to profit (for example, pixels
  * in 4x4 blocks). The other modes trace consecutive rays together, unsorted. */
 void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n);
 void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occluded, size_t n);
 
-/* How the stream and packet calls trace; for measurement and tuning. Set it
- * while no thread traces the scene. */
+/* How fr_intersect_stream, fr_occluded_stream and fr_intersect16 trace: the
+ * choice of Table VIII of the MIC paper. Every mode gives the same answers
+ * (t, and the triangle up to which of two a ray exactly through their shared
+ * edge reports); only speed differs. Set it while no thread traces the
+ * scene. */
 typedef enum fr_trace_mode {
-  FR_TRACE_AUTO,      /* sorted by octant, then hybrid packets of 16 or ray streams */
-  FR_TRACE_SINGLE,    /* every ray alone (BVH of fr_scene_set_bvh_width) */
-  FR_TRACE_PACKET8,   /* packets of 8 on the BVH4, no single-ray phase */
-  FR_TRACE_PACKET16,  /* packets of 16 on the BVH4, no single-ray phase */
-  FR_TRACE_HYBRID16,  /* packets of 16 dropping to single rays (hybrid_threshold) */
-  FR_TRACE_RAYSTREAM  /* sorted by octant, then groups of up to 64 rays traverse together,
-                         each ray tested alone (ray streams); any hit and closest hit */
+  FR_TRACE_AUTO,      /* default: coherent groups of 16 as hybrid packets, the rest sorted by
+                         octant into hybrid packets or ray streams */
+  FR_TRACE_SINGLE,    /* every ray alone */
+  FR_TRACE_PACKET8,   /* packets of 8 consecutive rays, no single-ray phase */
+  FR_TRACE_PACKET16,  /* packets of 16 consecutive rays, no single-ray phase */
+  FR_TRACE_HYBRID16,  /* packets of 16 dropping to single rays when few rays are left in a subtree */
+  FR_TRACE_RAYSTREAM  /* sorted by octant, then groups of up to 64 rays traverse together, each
+                         ray tested alone (ray streams) */
 } fr_trace_mode;
 
-typedef struct fr_trace_options {
-  fr_trace_mode mode;     /* default FR_TRACE_AUTO */
-  int hybrid_threshold;   /* 0..16, default 7 (the MIC paper's) */
-  int packet_bvh_width;   /* 8 (default, measured faster) or 4 (the MIC paper's) */
-  int mailbox;            /* inverse mailboxing in packet leaves (default off, see README) */
-  int axis_aligned;       /* Shevtsov's axis-aligned fast path (default on) */
-  int ia_cull;            /* interval-arithmetic culling of nodes for whole packets (default on) */
-  int quad_leaves;        /* packet leaves reached by only a few active rays test four of them against
-                             four triangles at once, with the single-ray kernel's watertight test
-                             (default on, see docs/performance-log.md) */
-  int prefetch;           /* rays and packets prefetch the children they defer: 1 on, 0 off, -1
-                             (default) on for rays when the BVH and triangles exceed 32 MB, for
-                             packets when the BVH and their triangle records exceed 32 MB (see
-                             docs/performance-log.md) */
-  float stream_spread;    /* FR_TRACE_AUTO: a group of 16 goes as a packet when its unit directions
-                             lie within this distance of its first ray's (probed at 3 rays), else
-                             in a ray stream; 0..2: 0 streams every group, 2 none (default
-                             FR_STREAM_SPREAD_DEFAULT) */
-  int coherent_threshold; /* packets known to be coherent drop to single rays at this many active
-                             rays, 0..16 (default 2, as Embree's coherent packets): FR_TRACE_AUTO's
-                             coherent groups, and FR_TRACE_HYBRID16's packets whose rays share a
-                             direction octant (those take the smaller of the two thresholds) */
-  int hybrid_tune;        /* 1 (default): FR_TRACE_HYBRID16's and fr_intersect16/fr_occluded16's
-                             packets whose rays span several direction octants switch either at
-                             hybrid_threshold or at once (every ray alone), whichever each thread
-                             has measured to cost fewer cycles per ray on this scene; 0: always at
-                             hybrid_threshold. Only speed depends on the choice, and the last
-                             bits of u and v (t and the triangle are fr_intersect1's either way) */
-  int occluder_cache;     /* 1 (default): FR_TRACE_SINGLE's fr_occluded_stream tests each ray that
-                             ends (finite tfar: shadow rays) against the four triangles that
-                             occluded the stream's last occluded ray before it traverses, while
-                             that keeps paying; 0: never. Answers do not depend on it */
-  int anyhit_order;       /* FR_TRACE_SINGLE's fr_occluded_stream: the order a ray's any-hit walk
-                             visits the children it hits. -1 (default): rays that end (shadow
-                             rays) go in chunks of 32, each by whichever order the thread has
-                             measured to cost fewer cycles per ray on this scene (nearest first
-                             only where it measured 10% cheaper), other rays by rank; 0: by the
-                             builder's occlusion rank; 1: nearest first. Answers do not depend
-                             on it */
-} fr_trace_options;
-#define FR_STREAM_SPREAD_DEFAULT 0.1f
-
-void fr_trace_options_default(fr_trace_options *o);
-fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o);
-void fr_scene_get_trace_options(const fr_scene *s, fr_trace_options *o);
-
-/* ---- reference paths (for tests and measurement, not speed) ---------------- */
-/* Plain scalar traversal of the binary BVH with the scalar watertight test. */
-void fr_intersect1_reference(const fr_scene *s, const fr_ray *ray, fr_hit *hit);
-int fr_occluded1_reference(const fr_scene *s, const fr_ray *ray);
+/* FR_ERR_ARG for a NULL scene or an unknown mode. */
+fr_error fr_scene_set_trace_mode(fr_scene *s, fr_trace_mode mode);
+fr_trace_mode fr_scene_get_trace_mode(const fr_scene *s);
 
 #ifdef __cplusplus
 }

@@ -1,6 +1,6 @@
 /* fr_child_sort8 compiled for one ISA (FR_BUILD_ISA_AVX2 or _AVX512), called
  * by test_kernels through a plain-C signature. */
-#include "trace/child_sort8.h"
+#include "trace/wide/child_sort8.h"
 
 #define NAME2(isa) fr_test_child_sort8_##isa
 #define NAME(isa) NAME2(isa)

@@ -7,7 +7,7 @@
  * verdict. */
 #include <string.h>
 #include "base/simd.h"
-#include "trace/stream_rays.h"
+#include "trace/wide/stream_rays.h"
 
 #define NAME2(isa) fr_test_stream_setup_##isa
 #define NAME(isa) NAME2(isa)

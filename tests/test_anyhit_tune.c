@@ -6,7 +6,7 @@
  * (That the order never changes an answer is test_occluder_cache's.)
  */
 #include "test_util.h"
-#include "trace/anyhit_tune.h"
+#include "trace/wide/anyhit_tune.h"
 
 /* Runs n chunks; a probe's 32 rays cost cost[arm] cycles each, alternating.
  * Returns the chunks that went nearest-first, *probes the probes. */

@@ -9,8 +9,8 @@
  * packets make them (in float, 16 lanes at a time) on every ISA.
  */
 #include "test_util.h"
-#include "trace/lpacket.h"
-#include "trace/packet_bounds.h"
+#include "trace/lpacket/lpacket.h"
+#include "trace/lpacket/packet_bounds.h"
 
 #define MAXR 256
 

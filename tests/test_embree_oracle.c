@@ -72,10 +72,10 @@ static long check_packet_modes(fr_scene *s, const fr_ray *rays, size_t n, const 
     if (!fr_isa_supported((fr_isa)isa)) continue;
     fr_set_isa((fr_isa)isa);
     for (int m = 0; m < 5; m++) {
-      fr_trace_options o;
-      fr_trace_options_default(&o);
+      fr_tuning o;
+      fr_tuning_default(&o);
       o.mode = modes[m];
-      assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+      assert_int_equal(fr_scene_set_tuning(s, &o), FR_OK);
       memset(h, 0x5A, n * sizeof *h); /* every ray must be answered */
       memset(occ, 0x5A, n);
       fr_intersect_stream(s, rays, h, n);
@@ -90,9 +90,9 @@ static long check_packet_modes(fr_scene *s, const fr_ray *rays, size_t n, const 
       if (bad > total) total = bad;
     }
   }
-  fr_trace_options o;
-  fr_trace_options_default(&o);
-  fr_scene_set_trace_options(s, &o);
+  fr_tuning o;
+  fr_tuning_default(&o);
+  fr_scene_set_tuning(s, &o);
   print_message("%s\n", line);
   free(h);
   free(occ);
@@ -115,10 +115,10 @@ static void check_scene(const char *path) {
   long bad_hit[6] = {0}, bad_occ[6] = {0}, hits = 0;
   fr_hit *ehits = malloc(n * sizeof *ehits);
   uint8_t *eoccs = malloc(n);
-  fr_trace_options single;
-  fr_trace_options_default(&single);
+  fr_tuning single;
+  fr_tuning_default(&single);
   single.mode = FR_TRACE_SINGLE;
-  fr_scene_set_trace_options(s, &single);
+  fr_scene_set_tuning(s, &single);
   for (size_t i = 0; i < n; i++) {
     fr_hit eh;
     ebr_intersect1(eb, &rays[i], &eh);

@@ -5,7 +5,7 @@
  * changes an answer is test_packet's: its hybrid configurations tune.)
  */
 #include "test_util.h"
-#include "trace/hybrid_tune.h"
+#include "trace/wide/hybrid_tune.h"
 
 /* Runs n packets of 16 rays whose arm a costs cost[a] cycles per ray;
  * returns how many took arm 1, and counts the timed ones in *timed. */

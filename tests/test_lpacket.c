@@ -15,7 +15,7 @@
 #include "base/alloc.h"
 #include "render/camera.h"
 #include "test_util.h"
-#include "trace/lpacket.h"
+#include "trace/lpacket/lpacket.h"
 
 static const fr_lp_fns *isa_fns[] = {&fr_lp_scalar, &fr_lp_avx2, &fr_lp_avx512};
 static const fr_isa isas[] = {FR_ISA_SCALAR, FR_ISA_AVX2, FR_ISA_AVX512};

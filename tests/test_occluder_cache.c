@@ -1,12 +1,12 @@
 /*
- * The single-ray streams' occluder cache (fr_trace_options.occluder_cache):
+ * The single-ray streams' occluder cache (fr_tuning.occluder_cache):
  * on the built-in scene and every scene of ../shared/scenes, soft-shadow
  * rays from the camera's hit points to the scene's quad light, pixel by
  * pixel as the workloads make them, with hemisphere rays (no end, so never
  * cached) and an invalid ray mixed in. At every ISA, fr_occluded_stream in
  * single mode must give the same answer for every ray with the cache on
  * and off, with the any-hit walk by occlusion rank, nearest child first and
- * chosen by measurement (fr_trace_options.anyhit_order), and the same as
+ * chosen by measurement (fr_tuning.anyhit_order), and the same as
  * fr_occluded1 ray by ray. A counters build also
  * checks that the cache was tried and hit (on the built-in scene, and over
  * the shared scenes).
@@ -67,8 +67,8 @@ static void check_scene(fr_scene *s, const fr_view *v) {
   fr_ray *rays = malloc((size_t)SZ * SZ * (SAMPLES + 1) * sizeof *rays);
   const size_t n = make_rays(s, v, rays);
   uint8_t *on = malloc(n), *off = malloc(n), *one = malloc(n), *ordered = malloc(n);
-  fr_trace_options o;
-  fr_trace_options_default(&o);
+  fr_tuning o;
+  fr_tuning_default(&o);
   assert_int_equal(o.occluder_cache, 1);
   o.mode = FR_TRACE_SINGLE;
   long occluded = 0;
@@ -78,11 +78,11 @@ static void check_scene(fr_scene *s, const fr_view *v) {
     assert_int_equal(fr_set_isa((fr_isa)isa), FR_OK);
     for (size_t i = 0; i < n; i++) one[i] = (uint8_t)fr_occluded1(s, &rays[i]);
     o.occluder_cache = 0;
-    assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+    assert_int_equal(fr_scene_set_tuning(s, &o), FR_OK);
     memset(off, 0x5A, n);
     fr_occluded_stream(s, rays, off, n);
     o.occluder_cache = 1;
-    assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+    assert_int_equal(fr_scene_set_tuning(s, &o), FR_OK);
     fr_counters_reset();
     memset(on, 0x5A, n);
     fr_occluded_stream(s, rays, on, n);
@@ -94,7 +94,7 @@ static void check_scene(fr_scene *s, const fr_view *v) {
     tally_hits += (long)c.cache_hits;
     for (int order = 0; order <= 1; order++) {
       o.anyhit_order = order;
-      assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+      assert_int_equal(fr_scene_set_tuning(s, &o), FR_OK);
       memset(ordered, 0x5A, n);
       fr_occluded_stream(s, rays, ordered, n);
       for (size_t i = 0; i < n; i++)
@@ -103,7 +103,7 @@ static void check_scene(fr_scene *s, const fr_view *v) {
                    order ? "nearest" : "rank", ordered[i], one[i]);
     }
     o.anyhit_order = -1;
-    assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+    assert_int_equal(fr_scene_set_tuning(s, &o), FR_OK);
     occluded = 0;
     for (size_t i = 0; i < n; i++) {
       if (on[i] != off[i] || on[i] != one[i])
@@ -162,12 +162,12 @@ static void option(void **st) {
   (void)st;
   fr_scene *s;
   assert_int_equal(fr_scene_builtin(&s), FR_OK);
-  fr_trace_options o;
-  fr_trace_options_default(&o);
+  fr_tuning o;
+  fr_tuning_default(&o);
   o.occluder_cache = 2;
-  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  assert_int_equal(fr_scene_set_tuning(s, &o), FR_ERR_ARG);
   o.occluder_cache = 0;
-  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+  assert_int_equal(fr_scene_set_tuning(s, &o), FR_OK);
   fr_scene_release(s);
 }
 

@@ -88,8 +88,8 @@ static const config configs[] = {
 #define NCONFIGS (sizeof configs / sizeof configs[0])
 
 static void set_config(fr_scene *s, const config *c) {
-  fr_trace_options o;
-  fr_trace_options_default(&o);
+  fr_tuning o;
+  fr_tuning_default(&o);
   o.mode = c->mode;
   o.hybrid_threshold = c->threshold;
   o.packet_bvh_width = c->width;
@@ -101,7 +101,31 @@ static void set_config(fr_scene *s, const config *c) {
   o.prefetch = c->prefetch ? 1 : -1;
   if (c->spread > 0.0f) o.stream_spread = c->spread;
   if (c->coherent > 0) o.coherent_threshold = c->coherent;
-  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+  assert_int_equal(fr_scene_set_tuning(s, &o), FR_OK);
+}
+
+/* The single-ray answers of a packet's 16 rays (scalar ISA, default
+ * tuning), checked against brute force where a ray is clear of edges
+ * (clear[i]); returns how many valid rays hit. */
+static long single_answers(fr_scene *s, const scene_data *sd, float size, const fr_ray rays[16], unsigned valid, int p,
+                           fr_hit single[16], int occ1[16], int clear[16]) {
+  long hits = 0;
+  assert_int_equal(fr_set_isa(FR_ISA_SCALAR), FR_OK);
+  fr_tuning dflt;
+  fr_tuning_default(&dflt);
+  fr_scene_set_tuning(s, &dflt);
+  for (int i = 0; i < 16; i++) {
+    fr_intersect1(s, &rays[i], &single[i]);
+    occ1[i] = fr_occluded1(s, &rays[i]);
+    uint32_t bp;
+    double margin;
+    double bt = brute_force(sd->pos, sd->idx, sd->nt, &rays[i], &bp, &margin, 1);
+    clear[i] = margin >= 1e-4 && (rays[i].tnear == 0.0f || single[i].prim == FR_INVALID_ID || single[i].t > 1e-3f * size);
+    if (clear[i] && !(isinf(bt) ? single[i].prim == FR_INVALID_ID : fabs(single[i].t - bt) <= 1e-4 * fmax(1.0, fabs(bt))))
+      fail_msg("single-ray kernel disagrees with brute force (packet %d ray %d)", p, i);
+    hits += (valid >> i & 1) && single[i].prim != FR_INVALID_ID;
+  }
+  return hits;
 }
 
 static void check_scene(vec3 center, float size, uint64_t seed) {
@@ -115,24 +139,9 @@ static void check_scene(vec3 center, float size, uint64_t seed) {
     make_packet(&r, kind, center, size, &sd, rays);
     unsigned valid = (p % 3 == 0) ? 0xFFFFu : (fr_rng_u32(&r) & 0xFFFFu);
     if (p % 7 == 0) { rays[3].dir[0] = NAN; rays[5].dir[0] = rays[5].dir[1] = rays[5].dir[2] = 0.0f; }
-    /* the single-ray answers, and which rays are clear of edges for brute force */
     fr_hit single[16];
     int occ1[16], clear[16];
-    assert_int_equal(fr_set_isa(FR_ISA_SCALAR), FR_OK);
-    fr_trace_options dflt;
-    fr_trace_options_default(&dflt);
-    fr_scene_set_trace_options(s, &dflt);
-    for (int i = 0; i < 16; i++) {
-      fr_intersect1(s, &rays[i], &single[i]);
-      occ1[i] = fr_occluded1(s, &rays[i]);
-      uint32_t bp;
-      double margin;
-      double bt = brute_force(sd.pos, sd.idx, sd.nt, &rays[i], &bp, &margin, 1);
-      clear[i] = margin >= 1e-4 && (rays[i].tnear == 0.0f || single[i].prim == FR_INVALID_ID || single[i].t > 1e-3f * size);
-      if (clear[i] && !(isinf(bt) ? single[i].prim == FR_INVALID_ID : fabs(single[i].t - bt) <= 1e-4 * fmax(1.0, fabs(bt))))
-        fail_msg("single-ray kernel disagrees with brute force (packet %d ray %d)", p, i);
-      hits += (valid >> i & 1) && single[i].prim != FR_INVALID_ID;
-    }
+    hits += single_answers(s, &sd, size, rays, valid, p, single, occ1, clear);
     fr_ray16 r16;
     to_ray16(rays, &r16);
     /* every ISA runs the same arithmetic: bit-identical packet answers */
@@ -320,10 +329,10 @@ static void test_raystream(void **st) {
     for (int isa = 0; isa < 3; isa++) {
       if (!fr_isa_supported((fr_isa)isa)) continue;
       assert_int_equal(fr_set_isa((fr_isa)isa), FR_OK);
-      fr_trace_options o;
-      fr_trace_options_default(&o);
+      fr_tuning o;
+      fr_tuning_default(&o);
       o.mode = FR_TRACE_RAYSTREAM;
-      assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+      assert_int_equal(fr_scene_set_tuning(s, &o), FR_OK);
       memset(occ, 0x5A, sizeof occ);
       fr_occluded_stream(s, rays, occ, N);
       for (int i = 0; i < N; i++)
@@ -358,37 +367,37 @@ static void test_options(void **st) {
   (void)st;
   fr_scene *s;
   assert_int_equal(fr_scene_builtin(&s), FR_OK);
-  fr_trace_options o;
-  fr_trace_options_default(&o);
+  fr_tuning o;
+  fr_tuning_default(&o);
   assert_int_equal(o.hybrid_threshold, 7);
   o.hybrid_threshold = 17;
-  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  assert_int_equal(fr_scene_set_tuning(s, &o), FR_ERR_ARG);
   o.hybrid_threshold = 7;
   o.packet_bvh_width = 6;
-  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  assert_int_equal(fr_scene_set_tuning(s, &o), FR_ERR_ARG);
   o.packet_bvh_width = 8;
   assert_int_equal(o.prefetch, -1);
   o.prefetch = 2;
-  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  assert_int_equal(fr_scene_set_tuning(s, &o), FR_ERR_ARG);
   o.prefetch = -1;
   assert_true(o.stream_spread == FR_STREAM_SPREAD_DEFAULT);
   o.stream_spread = NAN;
-  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  assert_int_equal(fr_scene_set_tuning(s, &o), FR_ERR_ARG);
   o.stream_spread = 2.5f;
-  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  assert_int_equal(fr_scene_set_tuning(s, &o), FR_ERR_ARG);
   o.stream_spread = 0.0f;
-  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+  assert_int_equal(fr_scene_set_tuning(s, &o), FR_OK);
   assert_int_equal(o.hybrid_tune, 1);
   o.hybrid_tune = 2;
-  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  assert_int_equal(fr_scene_set_tuning(s, &o), FR_ERR_ARG);
   o.hybrid_tune = 0;
-  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+  assert_int_equal(fr_scene_set_tuning(s, &o), FR_OK);
   o.hybrid_tune = 1;
   assert_int_equal(o.coherent_threshold, 2);
   o.coherent_threshold = -1;
-  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  assert_int_equal(fr_scene_set_tuning(s, &o), FR_ERR_ARG);
   o.coherent_threshold = 17;
-  assert_int_equal(fr_scene_set_trace_options(s, &o), FR_ERR_ARG);
+  assert_int_equal(fr_scene_set_tuning(s, &o), FR_ERR_ARG);
   o.coherent_threshold = 2;
   /* an uncommitted scene: misses, nothing occluded */
   fr_ray16 r16;

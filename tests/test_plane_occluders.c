@@ -113,10 +113,10 @@ static void check_rays(const scene_data *sd, vec3 centre, float size, long *clai
   uint8_t single[16];
   int np = 0;
   const mesh_ref m = scene_mesh(s);
-  fr_trace_options topt;
-  fr_trace_options_default(&topt);
+  fr_tuning topt;
+  fr_tuning_default(&topt);
   topt.mode = FR_TRACE_PACKET16;
-  assert_int_equal(fr_scene_set_trace_options(s, &topt), FR_OK);
+  assert_int_equal(fr_scene_set_tuning(s, &topt), FR_OK);
   for (int i = 0; i < 20000; i++) {
     /* from below to above the plane, aimed anywhere over twice the patch */
     vec3 o = v3_add(centre, v3((fr_rng_float(&r) - 0.5f) * 4 * size, -size * (0.01f + fr_rng_float(&r)),
@@ -236,10 +236,10 @@ static void ranges_behind_the_origin(void **state) {
     rays[i] = ray;
   }
   for (size_t k = 0; k < sizeof modes / sizeof modes[0]; k++) {
-    fr_trace_options o;
-    fr_trace_options_default(&o);
+    fr_tuning o;
+    fr_tuning_default(&o);
     o.mode = modes[k];
-    assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+    assert_int_equal(fr_scene_set_tuning(s, &o), FR_OK);
     fr_hit hits[N];
     uint8_t occ[N];
     fr_intersect_stream(s, rays, hits, N);

@@ -211,10 +211,10 @@ static void test_packets_and_streams(void **state) {
     if (!fr_isa_supported((fr_isa)isa)) continue;
     fr_set_isa((fr_isa)isa);
     for (int m = 0; m < 5; m++) {
-      fr_trace_options o;
-      fr_trace_options_default(&o);
+      fr_tuning o;
+      fr_tuning_default(&o);
       o.mode = modes[m];
-      assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+      assert_int_equal(fr_scene_set_tuning(s, &o), FR_OK);
       fr_intersect_stream(s, rays, h, N);
       fr_occluded_stream(s, rays, occ, N);
       for (int i = 0; i < N; i++) {
@@ -247,9 +247,9 @@ static void test_packets_and_streams(void **state) {
     assert_int_equal(h16.prim[15], 0x5A5A5A5Au);
     assert_int_equal(o16 >> 15, 0);
   }
-  fr_trace_options o;
-  fr_trace_options_default(&o);
-  fr_scene_set_trace_options(s, &o);
+  fr_tuning o;
+  fr_tuning_default(&o);
+  fr_scene_set_tuning(s, &o);
   fr_set_isa(fr_isa_supported(FR_ISA_AVX512) ? FR_ISA_AVX512 : FR_ISA_SCALAR);
   fr_scene_release(s);
 }

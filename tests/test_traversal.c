@@ -53,10 +53,10 @@ static void check_rays(fr_scene *s, const scene_data *sd, vec3 center, float siz
       assert_int_equal(fr_set_isa((fr_isa)isa), FR_OK);
       assert_int_equal(fr_scene_set_bvh_width(s, k < 3 ? 4 : 8), FR_OK);
       /* the BVH8 once more with prefetching, which this small scene leaves off by default */
-      fr_trace_options o;
-      fr_scene_get_trace_options(s, &o);
+      fr_tuning o;
+      fr_scene_get_tuning(s, &o);
       o.prefetch = k < 6 ? -1 : 1;
-      assert_int_equal(fr_scene_set_trace_options(s, &o), FR_OK);
+      assert_int_equal(fr_scene_set_tuning(s, &o), FR_OK);
       fr_hit h;
       fr_intersect1(s, &ray, &h);
       /* every ISA and width runs the same triangle arithmetic: bit-identical answers */

@@ -15,6 +15,7 @@
 #include "base/rng.h"
 #include "base/vec3.h"
 #include "frusta.h"
+#include "api/scene.h"
 
 static inline float urand(fr_rng *r, float lo, float hi) { return lo + (hi - lo) * fr_rng_float(r); }
 
@@ -62,6 +63,15 @@ typedef struct mesh_ref { const float *pos; const uint32_t *idx; size_t nt; } me
 static inline mesh_ref scene_mesh(const fr_scene *s) {
   mesh_ref m = {fr_scene_vertices(s), fr_scene_indices(s), fr_scene_triangle_count(s)};
   return m;
+}
+
+/* A random point of a random triangle of m. */
+static inline vec3 random_surface_point(fr_rng *r, const mesh_ref *m) {
+  uint32_t t = fr_rng_u32(r) % (uint32_t)m->nt;
+  vec3 a = v3_load(m->pos + 3 * m->idx[3 * t]), b = v3_load(m->pos + 3 * m->idx[3 * t + 1]),
+       c = v3_load(m->pos + 3 * m->idx[3 * t + 2]);
+  float u = fr_rng_float(r) * 0.5f, v = fr_rng_float(r) * 0.5f;
+  return v3_add(a, v3_add(v3_scale(v3_sub(b, a), u), v3_scale(v3_sub(c, a), v)));
 }
 
 /* 1 if a disagreement on this ray is excusable: its nearest hit (in double

@@ -5,7 +5,7 @@
  * and 1/det in those lanes; 0 otherwise. */
 #include <string.h>
 #include "base/simd.h"
-#include "trace/bvhn_ray.h"
+#include "trace/wide/bvhn_ray.h"
 
 #define NAME2(isa) fr_test_tri4_pair_##isa
 #define NAME(isa) NAME2(isa)

@@ -9,9 +9,9 @@
  * test). */
 #include <string.h>
 #include "base/simd.h"
-#include "trace/bvhn_ray.h"
+#include "trace/wide/bvhn_ray.h"
 #include "base/simd_packet.h"
-#include "trace/tri4_quad.h"
+#include "trace/wide/tri4_quad.h"
 
 #define NAME3(p, isa) fr_test_tri4_quad##p##_##isa
 #define NAME2(p, isa) NAME3(p, isa)

@@ -10,24 +10,14 @@ typedef struct conv { const fr_build_tree *t; fr_bvh2 *b; const uint8_t *leaf; }
 /* Where a triangle tree's leaves are cut, by SAH: a node visit costs 1 per
  * unit of its box's half area, a leaf LEAF_COST plus a cost per triangle,
  * and a subtree of at most max_leaf triangles becomes a leaf only where
- * that costs no more than its nodes. Until session 50 every such subtree
- * became a leaf (a cost of 0 per triangle): conference's room box (ceiling
- * and one wall, four triangles) was then one leaf whose box held every hit
- * point, and 12,793 of its 16,240 shadow batches at 512x512 fetched it.
- *
- * TRI_COST cuts the shadow frusta's tree. Against 0.3 and 0.8, soft16 mft
- * (3 interleaved pairs each, both trees cut alike): conference 0.986x
- * and 1.022x, kitchen 1.049x and 1.053x, dragon 0.978x and 1.048x; 1.5
- * had cost dragon a quarter.
- * SHALLOW_TRI_COST cuts the camera frusta's shallow tree (fr_bvh2_shallow),
- * where a larger leaf pays; primary mft against 0.5: dragon 1.171x (3/3),
- * conference 0.972x, kitchen 0.986x, sibenik 0.959x; 0 against 0.5: dragon
- * 1.143x, conference 0.941x; 0.1 against 0.2: dragon 0.972x, conference
- * 0.956x. Both against the old rule, mft, 2 threads, 1024x1024, 3 pairs
- * each: soft16 conference 1.151x, kitchen 1.093x, sibenik 1.015x (3/3
- * each), dragon 0.983x; primary sibenik 1.047x (3/3), conference 1.011x,
- * kitchen 1.013x, dragon 0.978x; Whitted kitchen 1.052x (3/3), museum
- * 1.049x, spd_rings 0.980x (bench/results/session50-bvh2-sah-leaves.txt). */
+ * that costs no more than its nodes. Without it (a cost of 0 per
+ * triangle), conference's room box (ceiling and one wall, four triangles)
+ * was one leaf whose box held every hit point, and most of its shadow
+ * batches fetched it.
+ * TRI_COST cuts the shadow frusta's tree; SHALLOW_TRI_COST the camera
+ * frusta's shallow tree (fr_bvh2_shallow), where a larger leaf pays. Both
+ * are where soft16 and primary mft measured fastest across the shared
+ * scenes. */
 #define LEAF_COST 1.0f
 #define TRI_COST 0.5f
 #define SHALLOW_TRI_COST 0.2f

@@ -5,6 +5,7 @@
 #include <string.h>
 #include "base/alloc.h"
 #include "base/error.h"
+#include "base/tuning.h"
 
 typedef struct conv {
   const fr_build_tree *t;
@@ -104,9 +105,8 @@ static uint32_t *node_children(conv *c, uint32_t ref) { return (uint32_t *)(node
  * so the slots hold the children in rising rank. That collapse's order
  * tried upper halves first, which suits dragon's light above it and no
  * other light: from below, dragon soft16 took 11.7 node visits per ray
- * with it and 8.8 with a factor-2 step. Unrounded, the rank gained most on
- * hairball and lost 9% on dragon; steps of 2 lost least on dragon and
- * gained least on hairball (docs/performance-log.md, session 45). */
+ * with it and 8.8 with a factor-2 step. Steps of sqrt(2) sit between the
+ * unrounded rank (best on hairball, worst on dragon) and steps of 2. */
 static int occlusion_rank(const conv *c, int32_t bi) {
   const fr_build_node *n = &c->t->nodes[bi];
   double a = c->area[n->first + n->count] - c->area[n->first], h = aabb_half_area(n->box);
@@ -300,16 +300,13 @@ fr_error fr_bvhn_from_build(const fr_build_tree *t, const fr_mesh *m, int width,
     return fr_fail(FR_ERR_NOMEM, "BVH%d: out of memory", width);
   }
   out->bounds = t->nodes[0].box;
-  /* FRUSTA_LEAF_BLOCKS=1..8 overrides the default, for measurements */
-  const char *env = getenv("FRUSTA_LEAF_BLOCKS");
-  int mb = FR_BVHN_DEFAULT_LEAF_BLOCKS;
-  if (env && env[0] >= '1' && env[0] <= '0' + FR_BVHN_MAX_LEAF_BLOCKS && !env[1]) mb = env[0] - '0';
+  fr_env_tuning env; /* FRUSTA_LEAF_BLOCKS, FRUSTA_COLLAPSE, FRUSTA_CHILD_ORDER: for measurements */
+  fr_env_tuning_read(&env);
+  const int mb = env.leaf_blocks ? env.leaf_blocks : FR_BVHN_DEFAULT_LEAF_BLOCKS;
   conv c = {t, m, out, node_bytes, mb, NULL, NULL, NULL, 1, NULL, 0};
-  const char *how = getenv("FRUSTA_COLLAPSE"); /* greedy: the old rule, for measurements */
-  if ((how && !strcmp(how, "greedy")) || !t->nprims) c.dp = 0; /* no triangles: one empty leaf */
-  const char *order = getenv("FRUSTA_CHILD_ORDER"); /* tree: the collapse's order, for measurements */
+  if (env.greedy_collapse || !t->nprims) c.dp = 0; /* no triangles: one empty leaf */
   fr_error e = FR_OK;
-  if (t->nprims && !(order && !strcmp(order, "tree"))) e = area_prefix(&c);
+  if (t->nprims && !env.tree_child_order) e = area_prefix(&c);
   if (!e && c.dp) e = plan_tables(&c);
   if (e) { free(c.area); fr_bvhn_free(out); return e; }
   if (c.dp) plan_node(&c, 0);

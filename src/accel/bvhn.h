@@ -27,10 +27,8 @@
 #define FR_BVHN_EMPTY 0x7FFFFFFFu  /* unused slot; its box is inverted and never hit */
 #define FR_BVHN_MAX_LEAF_BLOCKS 8
 /* The most blocks the builder puts in a leaf; it ends a node of up to 12
- * triangles as a leaf when that costs no more by SAH than splitting it. Same
- * binary, 1 thread, 512x512, interleaved against 1 block: hairball single
- * diffuse8 +14%, shadow +13%; conference diffuse8 +3%, primary packet16 +7%;
- * dragon +0-1%. 4 measured the same as 3. */
+ * triangles as a leaf when that costs no more by SAH than splitting it
+ * (docs/design.md, "Leaves by SAH"); 4 measured the same as 3. */
 #define FR_BVHN_DEFAULT_LEAF_BLOCKS 3
 #define FR_BVHN_MAX_BLOCKS (1u << 28)
 #define FR_BVHN_LEAF_REF(first, blocks) (FR_BVHN_LEAF | ((uint32_t)(blocks) - 1u) << 28 | (uint32_t)(first))
@@ -74,20 +72,12 @@ typedef struct fr_bvhn {
   /* Traversals prefetch the children they push (trace/bvhn_node.h). That
    * hides memory latency once the tree outgrows the caches and only costs
    * instructions while it fits: by default (fr_bvhn_prefetch_auto) it is on
-   * above FR_BVHN_PREFETCH_BYTES, this host's L3. Single rays on dragon (48
-   * MB), on against off, same binary (3/3 interleaved pairs each, 2
-   * threads, 1024x1024): primary 1.020x and 1.018x, diffuse8 1.016x,
-   * specular8 1.014x (2/3), ao16 1.023x, soft16 1.016x, shadow 1.006x;
-   * below it, conference primary 0.970x and shadow 0.965x, kitchen shadow
-   * 0.976x. The bound was 64 MB while only every other line of a deferred
-   * child was prefetched, which cost dragon's primary and diffuse8 rays. */
+   * above FR_BVHN_PREFETCH_BYTES, the benchmark host's L3: dragon's 48 MB
+   * tree gains on every workload, conference's and kitchen's lose. */
   int prefetch;
   /* The same for the packet kernels, whose leaves read the Shevtsov
    * records: on by default (fr_bvhn_packet_prefetch_auto) above
-   * FR_BVHN_PACKET_PREFETCH_BYTES of nodes and records. Dragon (55 MB of
-   * them, 48 MB of nodes and blocks) gained 6% on primary packet16 with
-   * it, where single rays lose (docs/performance-log.md, "Packets prefetch on
-   * a lower bound"). */
+   * FR_BVHN_PACKET_PREFETCH_BYTES of nodes and records. */
   int packet_prefetch;
   /* the scene's planar occluders, which the packets' and single rays'
    * any-hit kernels test before the tree (accel/plane_occluders.h); NULL:

@@ -7,6 +7,7 @@
 #include "base/alloc.h"
 #include "base/error.h"
 #include "base/timer.h"
+#include "base/tuning.h"
 #include "geom/builtin_scene.h"
 #include "io/import.h"
 #include "trace/bvh2_reference.h"
@@ -18,9 +19,10 @@ static fr_scene *scene_new(void) {
   fr_scene *s = calloc(1, sizeof *s);
   if (!s) return NULL;
   fr_mesh_init(&s->mesh);
-  const char *w = getenv("FRUSTA_BVH_WIDTH");
-  s->single_width = (w && strcmp(w, "4") == 0) ? 4 : 8;
-  fr_trace_options_default(&s->trace);
+  fr_env_tuning env;
+  fr_env_tuning_read(&env);
+  s->single_width = env.bvh_width;
+  fr_tuning_default(&s->trace);
   return s;
 }
 
@@ -31,6 +33,27 @@ void fr_scene_apply_prefetch(fr_scene *s) {
     b[i]->packet_prefetch = s->trace.prefetch < 0 ? fr_bvhn_packet_prefetch_auto(b[i]) : s->trace.prefetch;
   }
 }
+
+fr_error fr_scene_set_tuning(fr_scene *s, const fr_tuning *t) {
+  if (!s || !t) return fr_fail(FR_ERR_ARG, "fr_scene_set_tuning: NULL argument");
+  fr_error e = fr_tuning_check(t);
+  if (e) return e;
+  if (t->packet_bvh_width == 4 && (e = fr_scene_need_bvh4(s))) return e;
+  s->trace = *t;
+  fr_scene_apply_prefetch(s);
+  return FR_OK;
+}
+
+void fr_scene_get_tuning(const fr_scene *s, fr_tuning *t) { *t = s->trace; }
+
+fr_error fr_scene_set_trace_mode(fr_scene *s, fr_trace_mode mode) {
+  if (!s) return fr_fail(FR_ERR_ARG, "fr_scene_set_trace_mode: NULL scene");
+  if (mode < FR_TRACE_AUTO || mode > FR_TRACE_RAYSTREAM) return fr_fail(FR_ERR_ARG, "unknown trace mode %d", (int)mode);
+  s->trace.mode = mode;
+  return FR_OK;
+}
+
+fr_trace_mode fr_scene_get_trace_mode(const fr_scene *s) { return s ? s->trace.mode : FR_TRACE_AUTO; }
 
 fr_error fr_scene_set_bvh_width(fr_scene *s, int width) {
   if (!s || (width != 4 && width != 8)) return fr_fail(FR_ERR_ARG, "BVH width must be 4 or 8");
@@ -160,15 +183,14 @@ static fr_error build_tree(fr_scene *s, fr_build_tree *tree, size_t *count) {
   }
   /* FRUSTA_PRESPLIT=off|on overrides the choice (below), for measurements
    * and tests */
-  const char *env = getenv("FRUSTA_PRESPLIT");
-  const int off = env && !strcmp(env, "off"), on = env && !strcmp(env, "on");
+  fr_env_tuning env;
+  fr_env_tuning_read(&env);
+  const int off = env.presplit == 0, on = env.presplit == 1;
   fr_error e = fr_build_sah(boxes, ids, n, tree);
   size_t refs = n;
   /* Keep the presplit tree only where it wins clearly: its duplicated
-   * references cost memory and build time (hairball: SAH 3% lower, 70% more
-   * memory, 5% slower; SPD gears: SAH 20% lower, no faster; SPD rings: SAH
-   * 3.9x lower, single rays 2.1x faster). Running out of memory on the way
-   * just keeps the plain tree. */
+   * references cost memory and build time (docs/design.md, "Presplitting").
+   * Running out of memory on the way just keeps the plain tree. */
   if (!e && !off &&
       fr_presplit(m, s->bounds, FR_PRESPLIT_BUDGET, on ? 0.0 : FR_PRESPLIT_MIN_SHARE, &boxes, &ids, &refs) == FR_OK &&
       refs != n) {
@@ -258,8 +280,9 @@ fr_error fr_scene_commit(fr_scene *s) {
     return e;
   }
   /* FRUSTA_PLANES=off leaves them out, for measurements */
-  const char *pe = getenv("FRUSTA_PLANES");
-  if (!(pe && !strcmp(pe, "off"))) {
+  fr_env_tuning env;
+  fr_env_tuning_read(&env);
+  if (env.planes) {
     e = fr_plane_occluders_find(m, &s->planes);
     if (e) {
       free_trees(s);

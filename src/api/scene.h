@@ -5,6 +5,7 @@
 #include "accel/bvh2.h"
 #include "accel/bvhn.h"
 #include "accel/plane_occluders.h"
+#include "base/tuning.h"
 #include "geom/mesh.h"
 #include "geom/sphere.h"
 
@@ -17,7 +18,7 @@ struct fr_scene {
   fr_bvhn bvh4, bvh8;
   fr_plane_occluders planes; /* for occlusion queries (accel/plane_occluders.h); bvh2, bvh4 and bvh8 point here */
   int single_width;     /* 4 or 8: the BVH fr_intersect1 traverses */
-  fr_trace_options trace; /* how packets and streams are traced */
+  fr_tuning trace; /* how packets and streams are traced */
   int committed;
   size_t skipped;       /* degenerate triangles left out of the BVH */
   aabb bounds;
@@ -25,6 +26,20 @@ struct fr_scene {
   char name[64];        /* scene name for views and reports */
 };
 
+/* How the scene's packets and streams are traced (base/tuning.h): for
+ * measurements and tests. FR_ERR_ARG for a field out of range; a 4-wide
+ * packet BVH is built here if the scene has none. Call while no thread
+ * traces the scene. */
+fr_error fr_scene_set_tuning(fr_scene *s, const fr_tuning *t);
+void fr_scene_get_tuning(const fr_scene *s, fr_tuning *t);
+/* Which BVH the single-ray calls traverse: 8-wide (default) or 4-wide (the
+ * MIC paper's; FRUSTA_BVH_WIDTH=4 for new scenes). A 4-wide BVH is built
+ * on first need: choose it before the commit, or while no thread traces. */
+fr_error fr_scene_set_bvh_width(fr_scene *s, int width);
+/* Plain scalar traversal of the binary BVH with the scalar watertight test:
+ * the reference the kernels are tested against. */
+void fr_intersect1_reference(const fr_scene *s, const fr_ray *ray, fr_hit *hit);
+int fr_occluded1_reference(const fr_scene *s, const fr_ray *ray);
 /* Sets the BVH4's and BVH8's prefetching from the trace options. */
 void fr_scene_apply_prefetch(fr_scene *s);
 fr_error fr_scene_need_bvh4(fr_scene *s); /* builds the BVH4 on first need (scene.c) */
@@ -32,15 +47,11 @@ fr_error fr_scene_need_bvh4(fr_scene *s); /* builds the BVH4 on first need (scen
  * triangles (the shallow trees multi-frusta tracing may prefer); the caller
  * frees it with fr_bvh2_free. */
 fr_error fr_scene_build_bvh2(fr_scene *s, int max_leaf, fr_bvh2 *out);
-/* Leaves of the camera frusta's tree. The paper traces frusta through a
- * shallower tree than packets. Against leaves of 4, interleaved, one thread,
- * 1024x1024 (CONCURRENT=1 bench/ab.sh): dragon primary 1.15x (4/5 pairs),
- * 1.06x (3/4), 1.01x (6/8) in three runs; kitchen 1.04x (2/5), sibenik
- * 1.01x (3/5), conference 0.985x (3/5); Whitted kitchen 1.015x (3/4).
- * Shadow frusta stay on leaves of 4: with 8, more tiles' first batches
- * fetch enough triangles to fall back to rays (sibenik 0.4% -> 1.9% of
- * batches) and sibenik soft16 measured 0.91x (3/6). Overbeck's large
- * packets lost 10% with 8 (Whitted kitchen 16x16, museum 32x32). */
+/* Leaves of the camera frusta's tree: the paper traces frusta through a
+ * shallower tree than packets, and camera frusta run fastest on leaves of
+ * 8. Shadow frusta stay on leaves of 4: with 8, more tiles' first batches
+ * fetch enough triangles to fall back to rays. Large packets too lose with
+ * 8. */
 #define FR_MFT_LEAF 8
 /* fr_occluded_stream as ray streams (FR_TRACE_RAYSTREAM) whatever the
  * scene's trace mode: for callers that know their rays diverge at the

@@ -11,56 +11,6 @@
 #include "trace/kernels.h"
 #include "trace/sphere_traverse.h"
 
-void fr_trace_options_default(fr_trace_options *o) {
-  o->mode = FR_TRACE_AUTO;
-  o->hybrid_threshold = 7;
-  o->packet_bvh_width = 8;
-  o->mailbox = 0;
-  o->axis_aligned = 1;
-  o->ia_cull = 1;
-  o->quad_leaves = 1;
-  o->prefetch = -1;
-  o->stream_spread = FR_STREAM_SPREAD_DEFAULT;
-  /* 2 against the MIC paper's 7 for auto's coherent packets: 2 threads,
-   * 1024x1024, two pairs each, primary +2-5% on conference and dragon, +11%
-   * on hairball; shadow +2-5.5% on all four scenes; specular8, diffuse8 and
-   * Whitted within 1.5%. (At 512x512 dragon's primary packets lose
-   * coherence sooner and 7 read 4-10% faster; docs/performance-log.md.) */
-  o->coherent_threshold = 2;
-  o->hybrid_tune = 1;
-  o->occluder_cache = 1;
-  o->anyhit_order = -1;
-}
-
-fr_error fr_scene_set_trace_options(fr_scene *s, const fr_trace_options *o) {
-  if (!s || !o) return fr_fail(FR_ERR_ARG, "fr_scene_set_trace_options: NULL argument");
-  if (o->mode < FR_TRACE_AUTO || o->mode > FR_TRACE_RAYSTREAM) return fr_fail(FR_ERR_ARG, "unknown trace mode %d", (int)o->mode);
-  if (o->hybrid_threshold < 0 || o->hybrid_threshold > 16)
-    return fr_fail(FR_ERR_ARG, "hybrid threshold %d (0..16)", o->hybrid_threshold);
-  if (o->packet_bvh_width != 4 && o->packet_bvh_width != 8)
-    return fr_fail(FR_ERR_ARG, "packet BVH width %d (4 or 8)", o->packet_bvh_width);
-  if (o->quad_leaves != 0 && o->quad_leaves != 1) return fr_fail(FR_ERR_ARG, "quad leaves %d (0 or 1)", o->quad_leaves);
-  if (o->prefetch < -1 || o->prefetch > 1) return fr_fail(FR_ERR_ARG, "prefetch %d (-1, 0 or 1)", o->prefetch);
-  if (!(o->stream_spread >= 0.0f && o->stream_spread <= 2.0f))
-    return fr_fail(FR_ERR_ARG, "stream spread %g (0..2)", (double)o->stream_spread);
-  if (o->coherent_threshold < 0 || o->coherent_threshold > 16)
-    return fr_fail(FR_ERR_ARG, "coherent threshold %d (0..16)", o->coherent_threshold);
-  if (o->hybrid_tune != 0 && o->hybrid_tune != 1) return fr_fail(FR_ERR_ARG, "hybrid tune %d (0 or 1)", o->hybrid_tune);
-  if (o->occluder_cache != 0 && o->occluder_cache != 1)
-    return fr_fail(FR_ERR_ARG, "occluder cache %d (0 or 1)", o->occluder_cache);
-  if (o->anyhit_order < -1 || o->anyhit_order > 1)
-    return fr_fail(FR_ERR_ARG, "any-hit order %d (-1, 0 or 1)", o->anyhit_order);
-  if (o->packet_bvh_width == 4) {
-    fr_error e = fr_scene_need_bvh4(s);
-    if (e) return e;
-  }
-  s->trace = *o;
-  fr_scene_apply_prefetch(s);
-  return FR_OK;
-}
-
-void fr_scene_get_trace_options(const fr_scene *s, fr_trace_options *o) { *o = s->trace; }
-
 /* The single-ray kernels and BVH of the chosen width. */
 static inline const fr_trace_fns *single_fns(const fr_scene *s, const fr_bvhn **b) {
   const fr_kernels *k = fr_kernels_active();
@@ -109,8 +59,8 @@ static fr_ray lane_ray(const fr_ray16 *r, int i) {
 /* Rays whose range starts behind the origin (tnear < 0) take the scalar
  * reference traversal: the SIMD kernels' box tests widen an exit distance
  * tf as tf * (1 + 2^-20), which narrows it when tf < 0, so they could miss
- * a flat box behind the origin; widening by |tf| there cost single rays 2%
- * on every ray (docs/performance-log.md, session 53). Such rays are rare. */
+ * a flat box behind the origin; widening by |tf| there would cost every
+ * ray. Such rays are rare. */
 static int behind(const fr_ray *r) { return r->tnear < 0.0f; }
 
 /* (a scene of spheres alone has no triangle tree) */
@@ -260,12 +210,10 @@ static const uint32_t identity_idx[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 
 /* Whether a packet of these rays pays: their unit directions lie within
  * chord length spread of the first ray's. A packet's rays then visit nearly
  * the same nodes; past that, lanes die early and a ray stream, which tests
- * each ray alone but shares the node fetches, does better
- * (docs/performance-log.md, "`auto` chooses packets or ray streams per
- * group").
+ * each ray alone but shares the node fetches, does better.
  * Three rays spread over the group stand for it: a primary ray takes only
- * ~36 ns of a core here (55 Mrays/s on 2 threads), and normalizing all 16
- * directions cost 6% of conference primary (1024x1024, two pairs). No
+ * ~36 ns of a core, and normalizing all 16 directions would cost more
+ * than the probe saves. No
  * square root: with c = 1 - spread^2 / 2 the cosine test
  * dot >= c |d0| |di| is squared. */
 static int group_coherent(const fr_ray *rays, const uint32_t *idx, size_t m, float spread) {

@@ -6,7 +6,7 @@
 #define FR_RENDER_MFT_RAYS_H
 #include <stdint.h>
 #include "render/camera.h"
-#include "trace/mft.h"
+#include "trace/mft/mft.h"
 
 /* One set: the 4x4 pixels of a block, ray k = pixel (k % 4, k / 4). */
 void fr_mft_sets_camera(fr_mft_sets *t, const fr_camera *c);

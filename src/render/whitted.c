@@ -234,24 +234,13 @@ static void trace_runs(const fr_tracer *t, wgen g, fr_hit *hits, uint8_t *occ, s
   }
 }
 
-/* Shadow frusta from a point light pay where they pass little geometry
- * on the way. Per frustum, inner nodes visited, and the shadow stage
- * against the same rays as 16-wide packets with every batch as frusta
- * (interleaved, whitted mft, 1 thread, 1024x1024): museum 2.1 (0.0225 ->
- * 0.018 s), sibenik 4.9 (0.0214 -> 0.0173), but conference 7.9 (0.0151 ->
- * 0.024), kitchen 8.3 (0.026 -> 0.031), hairball 114 (2x slower), spd_balls
- * 346 (17x): frusta fanning out from a light among dense geometry
- * (conference's ceiling lamps, kitchen's table lamps), where packets in the
- * 8-wide BVH take fewer, cheaper steps. Nodes per frustum vary too much
- * over a frame for a few probe tiles to tell (3x3 of them read conference
- * 3.7, sibenik 7.1), so each batch gets a budget of this many visits per
- * frustum, and a batch over it sends the rest of its tile's shadow rays to
- * the packets. With it, against packets, 2 pairs: museum 0.79x, sibenik
- * 0.79x, conference 0.83x, kitchen 0.88x of the time, but dragon 1.11-1.14x,
- * spd_balls 1.08-1.10x, spd_tree 1.03x (budget 4: museum, kitchen and sibenik
- * 4-9% slower than 6; 8 and 10 no better than 6, and hairball worse; adding
- * the triangles fetched to the count, or a bound on them as the soft
- * shadows have, helped none). */
+/* Shadow frusta from a point light pay where they pass little geometry on
+ * the way (museum: 2 inner nodes per frustum) and lose where they fan out
+ * among dense geometry (hairball: over 100), where packets in the 8-wide
+ * BVH take fewer, cheaper steps. Nodes per frustum vary too much over a
+ * frame for a few probe tiles to tell, so each batch gets a budget of this
+ * many visits per frustum, and a batch over it sends the rest of its tile's
+ * shadow rays to the streams. */
 #define SHADOW_FRUSTA_MAX_NODES 6u
 
 /* Shadow rays [0, n) of a generation through a multi-frusta tracer: 16
@@ -296,10 +285,44 @@ static inline unsigned frustum_pix(unsigned i) {
   return (((i >> 4) & 12u) + ((i >> 2) & 3u)) * WT + ((i >> 2) & 12u) + (i & 3u);
 }
 
+/* What each hit needs from memory, its material and normal, in a loop
+ * short enough that the cache misses of many hits overlap; the arithmetic
+ * follows 16 hits at a time. */
+static void fetch_surfaces(const fr_workload *w, fr_whitted_scratch *S, size_t n) {
+  for (size_t i = 0; i < n; i++) {
+    const fr_hit *h = &S->hits[i];
+    fr_whitted_tri *sf = &S->surf[i];
+    if (h->prim < w->mats->ntris) {
+      *sf = w->mats->tri[h->prim];
+      continue;
+    }
+    *sf = (fr_whitted_tri){{0.0f, 0.0f, 0.0f}, 0};
+    if (h->prim == FR_INVALID_ID) continue;
+    const float *o = S->cur.r[i].org, *d = S->cur.r[i].dir; /* a sphere: the normal is p - c */
+    float pp[3] = {o[0] + d[0] * h->t, o[1] + d[1] * h->t, o[2] + d[2] * h->t};
+    fr_scene_geometric_normal(w->scene, h->prim, pp, sf->ng);
+    sf->mat = (int32_t)mat_index(w->scene, w->mats, h->prim);
+  }
+}
+
+/* The next generation's nn rays into S->cur, grouped by key (a counting
+ * sort, stable): the reflection and the refraction packets of each of the
+ * per x per blocks. */
+static void group_by_key(fr_whitted_scratch *S, size_t nn, int per) {
+  size_t count[2 * WT_PIX + 1];
+  memset(count, 0, (2 * (size_t)(per * per) + 1) * sizeof count[0]);
+  for (size_t i = 0; i < nn; i++) count[S->next.p[i].key + 1]++;
+  for (int k = 1; k <= 2 * per * per; k++) count[k] += count[k - 1];
+  for (size_t i = 0; i < nn; i++) {
+    size_t j = count[S->next.p[i].key]++;
+    S->cur.r[j] = S->next.r[i];
+    S->cur.p[j] = S->next.p[i];
+  }
+}
+
 uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_scratch *S, int tx, int ty) {
   const int W = w->cam.width, H = w->cam.height;
   const int side = t->packet_side > 0 && t->packet_side <= WT ? t->packet_side : WT, per = WT / side;
-  const fr_scene *sc = w->scene;
   const int max_depth = w->max_depth > 0 ? w->max_depth : 4;
   if (!reserve(S, 2 * WT_PIX)) return 0;
   /* a few clock reads per generation: stage times for bench (fr_workload_result) */
@@ -343,23 +366,7 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
     /* room for two new rays per ray, and a whole group of 16 past them */
     if (!reserve(S, 2 * n + 2 * FR_WS_LANES)) return rays;
     fr_wsink shadow = {S->shadow.r, S->shadow.p, 0}, next = {S->next.r, S->next.p, 0};
-    /* First what each hit needs from memory, its material and normal, in a
-     * loop short enough that the cache misses of many hits overlap; then the
-     * arithmetic 16 hits at a time, and the new rays each group spawns. */
-    for (size_t i = 0; i < n; i++) {
-      const fr_hit *h = &S->hits[i];
-      fr_whitted_tri *sf = &S->surf[i];
-      if (h->prim < w->mats->ntris) {
-        *sf = w->mats->tri[h->prim];
-        continue;
-      }
-      *sf = (fr_whitted_tri){{0.0f, 0.0f, 0.0f}, 0};
-      if (h->prim == FR_INVALID_ID) continue;
-      const float *o = S->cur.r[i].org, *d = S->cur.r[i].dir; /* a sphere: the normal is p - c */
-      float pp[3] = {o[0] + d[0] * h->t, o[1] + d[1] * h->t, o[2] + d[2] * h->t};
-      fr_scene_geometric_normal(sc, h->prim, pp, sf->ng);
-      sf->mat = (int32_t)mat_index(sc, w->mats, h->prim);
-    }
+    fetch_surfaces(w, S, n);
     fr_wshade_in in = {.mats = w->mats->soa, .mat_count = w->mats->count, .bounce = depth < max_depth};
     memcpy(in.light, &w->view.light, sizeof in.light);
     for (size_t i0 = 0; i0 < n; i0 += FR_WS_LANES) {
@@ -379,10 +386,8 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
       }
       /* Shadow rays are traced from the light to just short of the
        * surface, so that a block's shadow rays share an origin and a large
-       * packet's frustum one apex (whitted packet16x16: museum's shadow
-       * stage -20%, kitchen's -12%; the stream kernels and Embree don't
-       * mind). The light's own end skips 1e-4 of the way, for a light on a
-       * surface. */
+       * packet's frustum one apex. The light's own end skips 1e-4 of the
+       * way, for a light on a surface. */
       fr_whitted_emit16(&out, in.light, w->eps, &shadow, &next);
     }
     const size_t ns = shadow.n, nn = next.n;
@@ -398,16 +403,7 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
       const fr_wpath *g = &S->shadow.p[i];
       if (!S->occ[i]) S->colour[g->pix] = v3_add(S->colour[g->pix], v3_load(g->w));
     }
-    /* the next generation grouped by key: reflection and refraction packets of each block */
-    size_t count[2 * WT_PIX + 1];
-    memset(count, 0, (2 * (size_t)(per * per) + 1) * sizeof count[0]);
-    for (size_t i = 0; i < nn; i++) count[S->next.p[i].key + 1]++;
-    for (int k = 1; k <= 2 * per * per; k++) count[k] += count[k - 1];
-    for (size_t i = 0; i < nn; i++) {
-      size_t j = count[S->next.p[i].key]++;
-      S->cur.r[j] = S->next.r[i];
-      S->cur.p[j] = S->next.p[i];
-    }
+    group_by_key(S, nn, per);
     n = nn;
   }
   S->stage[FR_STAGE_SHADE] += fr_seconds() - t_tile - traced_s;

@@ -15,6 +15,7 @@
 #define FR_RENDER_WHITTED_H
 #include <stdint.h>
 #include "frusta.h"
+#include "render/workload.h"
 
 #define FR_WHITTED_MAX_DEPTH 8
 
@@ -59,4 +60,12 @@ void fr_whitted_mats_free(fr_whitted_mats *m);
 void fr_whitted_mats_soa(fr_whitted_mats *m);
 /* How many prims (triangles and spheres) are mirrors and glass. */
 void fr_whitted_mats_census(const fr_scene *s, const fr_whitted_mats *m, size_t *mirror_prims, size_t *glass_prims);
+/* The Whitted workload's tiles (render/whitted.c): 32x32 pixels. */
+#define FR_WHITTED_TILE 32
+typedef struct fr_whitted_scratch fr_whitted_scratch;
+fr_whitted_scratch *fr_whitted_scratch_new(void);
+void fr_whitted_scratch_free(fr_whitted_scratch *s);
+/* Adds the time s's tiles spent in each stage to stage[]. */
+void fr_whitted_scratch_stages(const fr_whitted_scratch *s, double stage[FR_STAGES]);
+uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_scratch *s, int tx, int ty);
 #endif

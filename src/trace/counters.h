@@ -16,7 +16,7 @@
  * box, 16 frusta) and the active frusta in them, triangles fetched by
  * leaves, frustum-triangle pairs before and after the corner-ray cull
  * (each pair left is one 16-ray test), soft-shadow batches traced as rays
- * instead (render/workload.c), tiles' shafts built and given up (too
+ * instead (render/soft_tile.c), tiles' shafts built and given up (too
  * many leaves), the child boxes their builds tested against a shaft
  * (mft_shaft_box_tests: one box against one tile's shaft) and the batches
  * traced through one (mft_shaft*). Large packets (lp_*): packets, stack

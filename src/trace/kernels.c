@@ -1,4 +1,5 @@
 #include "kernels.h"
+#include "base/tuning.h"
 #include <cpuid.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -52,12 +53,10 @@ static const fr_kernels *table(fr_isa isa) {
 }
 
 static const fr_kernels *choose(void) {
-  const char *env = getenv("FRUSTA_ISA");
-  if (env && *env) {
-    for (int i = FR_ISA_SCALAR; i <= FR_ISA_AVX512; i++)
-      if (strcmp(env, fr_isa_name((fr_isa)i)) == 0 && fr_isa_supported((fr_isa)i)) return table((fr_isa)i);
-    /* an unknown or unsupported request falls through to the best level */
-  }
+  fr_env_tuning env;
+  fr_env_tuning_read(&env);
+  /* an unknown or unsupported request falls through to the best level */
+  if (env.isa_given > 0 && fr_isa_supported(env.isa)) return table(env.isa);
   for (int i = FR_ISA_AVX512; i >= FR_ISA_SCALAR; i--)
     if (fr_isa_supported((fr_isa)i)) return table((fr_isa)i);
   return &kernels_scalar;

@@ -22,8 +22,8 @@ typedef struct fr_trace_fns {
   void (*intersect1)(const fr_bvhn *b, const fr_ray *ray, fr_hit *hit);
   int (*occluded1)(const fr_bvhn *b, const fr_ray *ray);
   void (*intersect_stream)(const fr_bvhn *b, const fr_ray *rays, fr_hit *hits, size_t n);
-  /* cache: the stream's shadow rays try its last occluder first (fr_trace_options.occluder_cache);
-   * order: the any-hit walk's order (fr_trace_options.anyhit_order) */
+  /* cache: the stream's shadow rays try its last occluder first (fr_tuning.occluder_cache);
+   * order: the any-hit walk's order (fr_tuning.anyhit_order) */
   void (*occluded_stream)(const fr_bvhn *b, const fr_ray *rays, uint8_t *occ, size_t n, int cache, int order);
   /* The hybrid's single-ray phase: one valid ray through the subtree at ref.
    * intersect_subtree looks for hits before ray->tfar; on one it fills *best

@@ -62,60 +62,46 @@ int cli_parse_size(const char *s, int *w, int *h) {
   return cli_parse_int(buf, 1, 32768, w) && cli_parse_int(x + 1, 1, 32768, h);
 }
 
-static int need_value(int argc, char **argv, int i) {
-  if (i + 1 >= argc) { cli_error(CLI_USAGE_ERROR, "%s needs a value", argv[i]); return 0; }
-  return 1;
-}
-
-int cli_view_flag(int argc, char **argv, int *i, cli_view *v) {
-  const char *f = argv[*i];
-  static const char *vecs[] = {"--eye", "--at", "--up", "--light"};
+int cli_view_from_args(const cli_args *a, cli_view *v) {
+  memset(v, 0, sizeof *v);
+  v->width = v->height = 1024;
+  static const cli_flag_id vecs[] = {F_EYE, F_AT, F_UP, F_LIGHT};
+  vec3 *dst[] = {&v->eye, &v->at, &v->up, &v->light};
+  int *has[] = {&v->has_eye, &v->has_at, &v->has_up, &v->has_light};
   for (int k = 0; k < 4; k++) {
-    if (strcmp(f, vecs[k]) != 0) continue;
-    if (!need_value(argc, argv, *i)) return -1;
-    vec3 *dst = k == 0 ? &v->eye : k == 1 ? &v->at : k == 2 ? &v->up : &v->light;
-    if (!cli_parse_vec3(argv[*i + 1], dst)) { cli_error(CLI_USAGE_ERROR, "%s wants x,y,z, got '%s'", f, argv[*i + 1]); return -1; }
-    *(k == 0 ? &v->has_eye : k == 1 ? &v->has_at : k == 2 ? &v->has_up : &v->has_light) = 1;
-    (*i)++;
-    return 1;
+    const char *s = a->val[vecs[k]];
+    if (!s) continue;
+    if (!cli_parse_vec3(s, dst[k])) return cli_error(CLI_USAGE_ERROR, "%s wants x,y,z, got '%s'", cli_flags[vecs[k]].name, s);
+    *has[k] = 1;
   }
-  if (strcmp(f, "--fov") == 0) {
-    if (!need_value(argc, argv, *i)) return -1;
-    if (!cli_parse_float(argv[*i + 1], &v->fov) || !(v->fov > 0 && v->fov < 180)) {
-      cli_error(CLI_USAGE_ERROR, "--fov wants degrees in (0, 180), got '%s'", argv[*i + 1]);
-      return -1;
-    }
+  if (a->val[F_FOV]) {
+    if (!cli_parse_float(a->val[F_FOV], &v->fov) || !(v->fov > 0 && v->fov < 180))
+      return cli_error(CLI_USAGE_ERROR, "--fov wants degrees in (0, 180), got '%s'", a->val[F_FOV]);
     v->has_fov = 1;
-    (*i)++;
-    return 1;
   }
-  if (strcmp(f, "--area") == 0) {
-    if (!need_value(argc, argv, *i)) return -1;
+  if (a->val[F_AREA]) {
     char buf[512];
-    snprintf(buf, sizeof buf, "%s", argv[*i + 1]);
-    float a[9];
+    snprintf(buf, sizeof buf, "%s", a->val[F_AREA]);
+    float f[9];
     int n = 0;
     char *save = NULL;
     for (char *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-      if (n == 9 || !cli_parse_float(tok, &a[n])) { n = -1; break; }
+      if (n == 9 || !cli_parse_float(tok, &f[n])) { n = -1; break; }
       n++;
     }
-    if (n != 9) { cli_error(CLI_USAGE_ERROR, "--area wants cx,cy,cz,e1x,e1y,e1z,e2x,e2y,e2z"); return -1; }
-    for (int k = 0; k < 3; k++) v->area[k] = v3(a[3 * k], a[3 * k + 1], a[3 * k + 2]);
+    if (n != 9) return cli_error(CLI_USAGE_ERROR, "--area wants cx,cy,cz,e1x,e1y,e1z,e2x,e2y,e2z");
+    for (int k = 0; k < 3; k++) v->area[k] = v3(f[3 * k], f[3 * k + 1], f[3 * k + 2]);
     v->has_area = 1;
-    (*i)++;
-    return 1;
   }
-  if (strcmp(f, "--size") == 0) {
-    if (!need_value(argc, argv, *i)) return -1;
-    if (!cli_parse_size(argv[*i + 1], &v->width, &v->height)) {
-      cli_error(CLI_USAGE_ERROR, "--size wants WxH with 1 <= W, H <= 32768, got '%s'", argv[*i + 1]);
-      return -1;
-    }
-    (*i)++;
-    return 1;
-  }
+  if (a->val[F_SIZE] && !cli_parse_size(a->val[F_SIZE], &v->width, &v->height))
+    return cli_error(CLI_USAGE_ERROR, "--size wants WxH with 1 <= W, H <= 32768, got '%s'", a->val[F_SIZE]);
   return 0;
+}
+
+int cli_common_from_args(const cli_args *a, int *threads) {
+  int rc = cli_arg_int(a, F_THREADS, 1, 1024, threads);
+  if (!rc && a->val[F_ISA]) rc = cli_set_isa(a->val[F_ISA]);
+  return rc;
 }
 
 fr_view cli_resolve_view(const fr_scene *s, const cli_view *v) {
@@ -180,35 +166,24 @@ void cli_whitted_default(cli_whitted *o) {
   memset(o, 0, sizeof *o);
   o->depth = 4;
   o->lp.traversal = FR_LP_RANGED;
-  o->lp.cull = FR_CULL_OFF; /* measured: the culls cost more than they save (docs/performance-log.md) */
+  o->lp.cull = FR_CULL_OFF; /* the culls cost more than they save on the Whitted scenes */
   o->packet = 16;
 }
 
-int cli_whitted_flag(int argc, char **argv, int *i, cli_whitted *o) {
-  const char *a = argv[*i];
-  if (strcmp(a, "--mirror") && strcmp(a, "--glass") && strcmp(a, "--depth") && strcmp(a, "--traversal") &&
-      strcmp(a, "--cull") && strcmp(a, "--packet"))
-    return 0;
-  if (*i + 1 >= argc) { cli_error(CLI_USAGE_ERROR, "%s needs a value", a); return -1; }
-  const char *val = argv[++*i];
-  int ok = 1;
-  o->large_flags |= !strcmp(a, "--traversal") || !strcmp(a, "--cull") || !strcmp(a, "--packet");
-  if (!strcmp(a, "--mirror")) o->mirror = val;
-  else if (!strcmp(a, "--glass")) o->glass = val;
-  else if (!strcmp(a, "--depth")) {
-    if (!(ok = cli_parse_int(val, 1, FR_WHITTED_MAX_DEPTH, &o->depth)))
-      cli_error(CLI_USAGE_ERROR, "--depth wants 1..%d, got '%s'", FR_WHITTED_MAX_DEPTH, val);
-  } else if (!strcmp(a, "--traversal")) {
-    if (!(ok = fr_lp_traversal_parse(val, &o->lp.traversal)))
-      cli_error(CLI_USAGE_ERROR, "--traversal is masked, ranged or partition, not '%s'", val);
-  } else if (!strcmp(a, "--cull")) {
-    if (!(ok = fr_cull_parse(val, &o->lp.cull)))
-      cli_error(CLI_USAGE_ERROR, "--cull is off, ia, planes or corners, not '%s'", val);
-  } else {
-    ok = cli_parse_int(val, 2, 32, &o->packet) && (o->packet & (o->packet - 1)) == 0;
-    if (!ok) cli_error(CLI_USAGE_ERROR, "--packet is 2, 4, 8, 16 or 32, not '%s'", val);
-  }
-  return ok ? 1 : -1;
+int cli_whitted_from_args(const cli_args *a, cli_whitted *o) {
+  cli_whitted_default(o);
+  o->mirror = a->val[F_MIRROR];
+  o->glass = a->val[F_GLASS];
+  o->large_flags = a->val[F_TRAVERSAL] || a->val[F_CULL] || a->val[F_PACKET];
+  int rc = cli_arg_int(a, F_DEPTH, 1, FR_WHITTED_MAX_DEPTH, &o->depth);
+  if (!rc && a->val[F_TRAVERSAL] && !fr_lp_traversal_parse(a->val[F_TRAVERSAL], &o->lp.traversal))
+    rc = cli_error(CLI_USAGE_ERROR, "--traversal is masked, ranged or partition, not '%s'", a->val[F_TRAVERSAL]);
+  if (!rc && a->val[F_CULL] && !fr_cull_parse(a->val[F_CULL], &o->lp.cull))
+    rc = cli_error(CLI_USAGE_ERROR, "--cull is off, ia, planes or corners, not '%s'", a->val[F_CULL]);
+  if (!rc && a->val[F_PACKET] &&
+      !(cli_parse_int(a->val[F_PACKET], 2, 32, &o->packet) && (o->packet & (o->packet - 1)) == 0))
+    rc = cli_error(CLI_USAGE_ERROR, "--packet is 2, 4, 8, 16 or 32, not '%s'", a->val[F_PACKET]);
+  return rc;
 }
 
 int cli_whitted_setup(const fr_scene *s, const cli_whitted *o, fr_whitted_mats *mats, fr_workload *w) {

@@ -2,6 +2,7 @@
 #ifndef FR_TOOL_CLI_H
 #define FR_TOOL_CLI_H
 #include "base/vec3.h"
+#include "flags.h"
 #include "frusta.h"
 #include "render/views.h"
 
@@ -23,9 +24,10 @@ typedef struct cli_view {
   int width, height;
 } cli_view;
 
-/* Consumes argv[*i] (and its value) if it is a view flag: 1 consumed, 0 not a
- * view flag, -1 error (already reported). */
-int cli_view_flag(int argc, char **argv, int *i, cli_view *v);
+/* The view flags (1024x1024 and the scene's view where not given), and
+ * --threads and --isa; 0, or 2 after reporting a usage error. */
+int cli_view_from_args(const cli_args *a, cli_view *v);
+int cli_common_from_args(const cli_args *a, int *threads);
 /* The scene's own view with the flags applied. */
 fr_view cli_resolve_view(const fr_scene *s, const cli_view *v);
 
@@ -47,7 +49,7 @@ const char *cli_scene_name(const fr_scene *s);
 /* Whitted and large-packet flags shared by render and bench:
  * --mirror NAMES --glass NAMES --depth N --traversal T --cull C --packet N */
 #include "render/whitted.h"
-#include "trace/lpacket.h"
+#include "trace/lpacket/lpacket.h"
 /* The scene's trees as the large-packet kernels take them. */
 fr_lp_scene cli_lp_scene(const fr_scene *s);
 typedef struct cli_whitted {
@@ -58,8 +60,8 @@ typedef struct cli_whitted {
   int large_flags;            /* --packet, --traversal or --cull given */
 } cli_whitted;
 void cli_whitted_default(cli_whitted *o);
-/* As cli_view_flag: 1 consumed, 0 not one of these flags, -1 error (reported). */
-int cli_whitted_flag(int argc, char **argv, int *i, cli_whitted *o);
+/* The Whitted and large-packet flags; 0, or 2 after reporting. */
+int cli_whitted_from_args(const cli_args *a, cli_whitted *o);
 /* Builds the Whitted materials into w (w->mats must point at *mats); reports
  * errors itself and prints how many triangles mirror and refract. */
 int cli_whitted_setup(const fr_scene *s, const cli_whitted *o, struct fr_whitted_mats *mats, struct fr_workload *w);

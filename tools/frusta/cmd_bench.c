@@ -1,11 +1,10 @@
 /*
- * frusta bench: the workloads of ../shared/spec/workloads.md, frusta and Embree
- * side by side in one process, on the same scene, rays and threads. Each
- * (tracer, mode) run is repeated K times; the line reports the best and the
- * median. The repetitions are interleaved, round-robin over every run
- * selected for a workload: this VM's speed drifts by up to 2x within one
- * process, and runs done one after the other each saw a different stretch
- * of it, so their ratios measured the host as much as the tracers.
+ * frusta bench: the workloads of docs/workloads.md, frusta and Embree side by
+ * side in one process, on the same scene, rays and threads. Each (tracer,
+ * mode) run is repeated K times; the line reports the best and the median.
+ * The repetitions are interleaved, round-robin over every run selected for
+ * a workload, so that every run samples the same stretches of a host whose
+ * speed drifts.
  */
 #include <omp.h>
 #include <stdio.h>
@@ -30,20 +29,13 @@ static const char *frusta_modes[] = {"single", "single4", "packet8", "packet16",
 #define MODE_MFT 6
 #define MODE_LARGE 8 /* packet2x2 .. packet32x32 */
 
-static void set_frusta_mode(fr_scene *s, int m, const fr_trace_options *base, int single_width) {
+static void set_frusta_mode(fr_scene *s, int m, const fr_tuning *base, int single_width) {
   static const fr_trace_mode modes[] = {FR_TRACE_SINGLE, FR_TRACE_SINGLE, FR_TRACE_PACKET8, FR_TRACE_PACKET16,
                                         FR_TRACE_HYBRID16, FR_TRACE_AUTO, FR_TRACE_AUTO, FR_TRACE_RAYSTREAM};
-  fr_trace_options o = *base;
+  fr_tuning o = *base;
   o.mode = m < MODE_LARGE ? modes[m] : FR_TRACE_AUTO;
-  fr_scene_set_trace_options(s, &o);
+  fr_scene_set_tuning(s, &o);
   fr_scene_set_bvh_width(s, m == 0 ? 8 : m == 1 ? 4 : single_width);
-}
-
-static int parse_onoff(const char *flag, const char *val, int *out) {
-  if (!strcmp(val, "on")) *out = 1;
-  else if (!strcmp(val, "off")) *out = 0;
-  else return cli_error(CLI_USAGE_ERROR, "%s is on or off, not '%s'", flag, val);
-  return 0;
 }
 
 static int cmp_double(const void *a, const void *b) {
@@ -196,240 +188,241 @@ static void choose_embree_variant(const fr_workload *w, ebr_scene *e, bench_run 
   r->t = ebr_tracer(e, (ebr_mode)r->mode, r->flag, r->packing);
 }
 
-int cmd_bench(int argc, char **argv) {
-  const char *scene = NULL, *workload = NULL, *mode = NULL, *tracer = "frusta";
-  cli_view v;
-  memset(&v, 0, sizeof v);
-  v.width = 1024; v.height = 1024;
-  int threads = omp_get_num_procs(), repeat = 3, embree_flag = -1, embree_packing = -1;
-  fr_trace_options topt;
-  fr_trace_options_default(&topt);
-  fr_mft_opts mopt = fr_mft_opts_default();
-  int mft_leaf = FR_MFT_LEAF, mft_leaf_set = 0, mft_no_fallback = 0, mft_no_shaft = 0;
-  fr_light_sets light_sets = FR_LIGHT_SETS_SPREAD;
-  cli_whitted wo;
-  cli_whitted_default(&wo);
-  for (int i = 0; i < argc; i++) {
-    int r = cli_view_flag(argc, argv, &i, &v);
-    if (r == 0) r = cli_whitted_flag(argc, argv, &i, &wo);
-    if (r < 0) return CLI_USAGE_ERROR;
-    if (r > 0) continue;
-    const char *a = argv[i];
-    if (!strcmp(a, "--threshold") || !strcmp(a, "--mailbox") || !strcmp(a, "--axis-aligned") || !strcmp(a, "--ia") ||
-        !strcmp(a, "--packet-width") || !strcmp(a, "--corner-rays") || !strcmp(a, "--shrink") || !strcmp(a, "--mft-leaf") ||
-        !strcmp(a, "--corner-cost") || !strcmp(a, "--mft-fallback") || !strcmp(a, "--mft-shaft") ||
-        !strcmp(a, "--light-sets") || !strcmp(a, "--prefetch") || !strcmp(a, "--stream-spread") ||
-        !strcmp(a, "--coherent-threshold") || !strcmp(a, "--quad") || !strcmp(a, "--hybrid-tune") ||
-        !strcmp(a, "--occluder-cache") || !strcmp(a, "--anyhit-order")) {
-      if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
-      const char *val = argv[++i];
-      if (!strcmp(a, "--light-sets")) {
-        if (!strcmp(val, "spread")) light_sets = FR_LIGHT_SETS_SPREAD;
-        else if (!strcmp(val, "cells")) light_sets = FR_LIGHT_SETS_CELLS;
-        else return cli_error(CLI_USAGE_ERROR, "--light-sets is spread or cells, not '%s'", val);
-      } else if (!strcmp(a, "--shrink")) {
-        /* on: corner rays and intervals (the default); corners: the paper's CR alone */
-        if (!strcmp(val, "off")) mopt.shrink = FR_MFT_SHRINK_OFF;
-        else if (!strcmp(val, "corners")) mopt.shrink = FR_MFT_SHRINK_CORNERS;
-        else if (!strcmp(val, "on")) mopt.shrink = FR_MFT_SHRINK_ALL;
-        else return cli_error(CLI_USAGE_ERROR, "--shrink is on, corners or off, not '%s'", val);
-      } else if (!strcmp(a, "--corner-rays")) {
-        if (parse_onoff(a, val, &mopt.corner_rays)) return CLI_USAGE_ERROR;
-      } else if (!strcmp(a, "--mft-fallback")) {
-        int on = 1;
-        if (parse_onoff(a, val, &on)) return CLI_USAGE_ERROR;
-        mft_no_fallback = !on;
-      } else if (!strcmp(a, "--mft-shaft")) {
-        int on = 1;
-        if (parse_onoff(a, val, &on)) return CLI_USAGE_ERROR;
-        mft_no_shaft = !on;
-      } else if (!strcmp(a, "--corner-cost")) {
-        if (!cli_parse_float(val, &mopt.corner_cost) || !(mopt.corner_cost >= 0.0f && mopt.corner_cost <= 16.0f))
-          return cli_error(CLI_USAGE_ERROR, "--corner-cost wants 0..16, got '%s'", val);
-      } else if (!strcmp(a, "--mft-leaf")) {
-        if (!cli_parse_int(val, 1, FR_BVH2_MAX_LEAF, &mft_leaf))
-          return cli_error(CLI_USAGE_ERROR, "--mft-leaf wants 1..%d, got '%s'", FR_BVH2_MAX_LEAF, val);
-        mft_leaf_set = 1;
-      } else if (!strcmp(a, "--prefetch")) {
-        if (!strcmp(val, "auto")) topt.prefetch = -1;
-        else if (!strcmp(val, "on") || !strcmp(val, "off")) topt.prefetch = !strcmp(val, "on");
-        else return cli_error(CLI_USAGE_ERROR, "--prefetch is on, off or auto, not '%s'", val);
-      } else if (!strcmp(a, "--anyhit-order")) {
-        if (!strcmp(val, "auto")) topt.anyhit_order = -1;
-        else if (!strcmp(val, "rank") || !strcmp(val, "nearest")) topt.anyhit_order = !strcmp(val, "nearest");
-        else return cli_error(CLI_USAGE_ERROR, "--anyhit-order is auto, rank or nearest, not '%s'", val);
-      } else if (!strcmp(a, "--stream-spread")) {
-        if (!cli_parse_float(val, &topt.stream_spread) || !(topt.stream_spread >= 0.0f && topt.stream_spread <= 2.0f))
-          return cli_error(CLI_USAGE_ERROR, "--stream-spread wants 0..2, got '%s'", val);
-      } else if (!strcmp(a, "--threshold")) {
-        if (!cli_parse_int(val, 0, 16, &topt.hybrid_threshold)) return cli_error(CLI_USAGE_ERROR, "--threshold wants 0..16, got '%s'", val);
-      } else if (!strcmp(a, "--coherent-threshold")) {
-        if (!cli_parse_int(val, 0, 16, &topt.coherent_threshold))
-          return cli_error(CLI_USAGE_ERROR, "--coherent-threshold wants 0..16, got '%s'", val);
-      } else if (!strcmp(a, "--packet-width")) {
-        if (!cli_parse_int(val, 4, 8, &topt.packet_bvh_width) || (topt.packet_bvh_width != 4 && topt.packet_bvh_width != 8))
-          return cli_error(CLI_USAGE_ERROR, "--packet-width is 4 or 8, not '%s'", val);
-      } else if (parse_onoff(a, val, !strcmp(a, "--mailbox") ? &topt.mailbox : !strcmp(a, "--ia") ? &topt.ia_cull
-                                     : !strcmp(a, "--quad") ? &topt.quad_leaves
-                                     : !strcmp(a, "--hybrid-tune") ? &topt.hybrid_tune
-                                     : !strcmp(a, "--occluder-cache") ? &topt.occluder_cache : &topt.axis_aligned))
-        return CLI_USAGE_ERROR;
-      continue;
-    }
-    if (!strcmp(a, "--workload") || !strcmp(a, "--mode") || !strcmp(a, "--tracer") || !strcmp(a, "--threads") ||
-        !strcmp(a, "--repeat") || !strcmp(a, "--isa") || !strcmp(a, "--embree-flag") || !strcmp(a, "--embree-packing")) {
-      if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
-      const char *val = argv[++i];
-      ebr_flag ef;
-      ebr_packing ep;
-      if (!strcmp(a, "--embree-flag")) {
-        if (!strcmp(val, "best")) embree_flag = -1;
-        else if (ebr_flag_parse(val, &ef)) embree_flag = (int)ef;
-        else return cli_error(CLI_USAGE_ERROR, "--embree-flag is best, hint, coherent or incoherent, not '%s'", val);
-      } else if (!strcmp(a, "--embree-packing")) {
-        if (!strcmp(val, "best")) embree_packing = -1;
-        else if (ebr_packing_parse(val, &ep)) embree_packing = (int)ep;
-        else return cli_error(CLI_USAGE_ERROR, "--embree-packing is best, rays or samples, not '%s'", val);
-      } else if (!strcmp(a, "--workload")) workload = val;
-      else if (!strcmp(a, "--mode")) mode = val;
-      else if (!strcmp(a, "--tracer")) tracer = val;
-      else if (!strcmp(a, "--isa")) { if (cli_set_isa(val)) return 1; }
-      else if (!strcmp(a, "--threads")) { if (!cli_parse_int(val, 1, 1024, &threads)) return cli_error(CLI_USAGE_ERROR, "--threads wants 1..1024, got '%s'", val); }
-      else if (!cli_parse_int(val, 1, 64, &repeat)) return cli_error(CLI_USAGE_ERROR, "--repeat wants 1..64, got '%s'", val);
-    } else if (cli_is_builtin(a) || a[0] != '-') {
-      if (scene) return cli_error(CLI_USAGE_ERROR, "bench takes one scene");
-      scene = a;
-    } else return cli_error(CLI_USAGE_ERROR, "bench: unknown option '%s'", a);
-  }
-  if (!scene || !workload || !mode)
-    return cli_error(CLI_USAGE_ERROR, "usage: frusta bench SCENE --workload W|all --mode M|all [--tracer frusta|embree|both] ...");
-  int use_frusta = !strcmp(tracer, "frusta") || !strcmp(tracer, "both");
-  int use_embree = !strcmp(tracer, "embree") || !strcmp(tracer, "both");
-  if (!use_frusta && !use_embree) return cli_error(CLI_USAGE_ERROR, "--tracer is frusta, embree or both, not '%s'", tracer);
-  fr_workload_kind wk = FR_WL_PRIMARY;
-  int all_wl = !strcmp(workload, "all");
-  if (!all_wl && !fr_workload_parse(workload, &wk))
-    return cli_error(CLI_USAGE_ERROR, "unknown workload '%s' (primary, shadow, soft16, ao16, diffuse8, specular8, whitted, all)", workload);
-  int all_modes = !strcmp(mode, "all");
-  unsigned fsel, esel;
-  if (parse_modes(mode, use_frusta, use_embree, &fsel, &esel)) return CLI_USAGE_ERROR;
-  const int want_mft = (fsel >> MODE_MFT) & 1;
+/* Everything the flags decide. */
+typedef struct bench_opts {
+  const char *scene;
+  unsigned workloads;   /* bit k: fr_workload_kind k */
+  unsigned fsel, esel;  /* frusta's modes (bits of frusta_modes) and Embree's (bits of ebr_mode) */
+  int all_modes;
+  int threads, repeat, embree_flag, embree_packing;
+  fr_tuning tuning;
+  fr_mft_opts mopt;
+  int mft_leaf;         /* 0: the scene's own trees */
+  int mft_no_fallback, mft_no_shaft;
+  fr_light_sets light_sets;
+  cli_view view;
+  cli_whitted whitted;
+} bench_opts;
 
-  omp_set_num_threads(threads);
+/* --workload: all, or a comma-separated list */
+static int parse_workloads(const char *list, unsigned *sel) {
+  *sel = 0;
+  if (!strcmp(list, "all")) { *sel = (1u << FR_WL_COUNT) - 1; return 0; }
+  char buf[256];
+  if (strlen(list) >= sizeof buf) return cli_error(CLI_USAGE_ERROR, "--workload: list too long");
+  memcpy(buf, list, strlen(list) + 1);
+  for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+    fr_workload_kind k;
+    if (!fr_workload_parse(tok, &k))
+      return cli_error(CLI_USAGE_ERROR, "unknown workload '%s' (primary, shadow, soft16, ao16, diffuse8, specular8, "
+                                        "whitted, all)", tok);
+    *sel |= 1u << k;
+  }
+  return *sel ? 0 : cli_error(CLI_USAGE_ERROR, "--workload: none given");
+}
+
+/* The kernel switches (fr_tuning) and the multi-frusta ones. */
+static int kernel_options(const cli_args *a, bench_opts *o) {
+  fr_tuning *t = &o->tuning;
+  static const char *const prefetch[] = {"auto", "off", "on"}, *const order[] = {"auto", "rank", "nearest"};
+  static const char *const shrink[] = {"off", "corners", "on"}; /* FR_MFT_SHRINK_* order */
+  static const char *const sets[] = {"spread", "cells"};
+  int pf = t->prefetch + 1, ao = t->anyhit_order + 1, sets_i = 0, fallback = 1, shaft = 1, rc;
+  if ((rc = cli_arg_int(a, F_THRESHOLD, 0, 16, &t->hybrid_threshold)) ||
+      (rc = cli_arg_int(a, F_COHERENT_THRESHOLD, 0, 16, &t->coherent_threshold)) ||
+      (rc = cli_arg_int(a, F_PACKET_WIDTH, 4, 8, &t->packet_bvh_width)) ||
+      (rc = cli_arg_onoff(a, F_MAILBOX, &t->mailbox)) || (rc = cli_arg_onoff(a, F_AXIS_ALIGNED, &t->axis_aligned)) ||
+      (rc = cli_arg_onoff(a, F_IA, &t->ia_cull)) || (rc = cli_arg_onoff(a, F_QUAD, &t->quad_leaves)) ||
+      (rc = cli_arg_onoff(a, F_HYBRID_TUNE, &t->hybrid_tune)) ||
+      (rc = cli_arg_onoff(a, F_OCCLUDER_CACHE, &t->occluder_cache)) ||
+      (rc = cli_arg_float(a, F_STREAM_SPREAD, 0.0f, 2.0f, &t->stream_spread)) ||
+      (rc = cli_arg_choice(a, F_PREFETCH, prefetch, 3, &pf)) || (rc = cli_arg_choice(a, F_ANYHIT_ORDER, order, 3, &ao)) ||
+      (rc = cli_arg_onoff(a, F_CORNER_RAYS, &o->mopt.corner_rays)) ||
+      (rc = cli_arg_float(a, F_CORNER_COST, 0.0f, 16.0f, &o->mopt.corner_cost)) ||
+      (rc = cli_arg_choice(a, F_SHRINK, shrink, 3, &o->mopt.shrink)) ||
+      (rc = cli_arg_int(a, F_MFT_LEAF, 1, FR_BVH2_MAX_LEAF, &o->mft_leaf)) ||
+      (rc = cli_arg_onoff(a, F_MFT_FALLBACK, &fallback)) || (rc = cli_arg_onoff(a, F_MFT_SHAFT, &shaft)) ||
+      (rc = cli_arg_choice(a, F_LIGHT_SETS, sets, 2, &sets_i)))
+    return rc;
+  if (t->packet_bvh_width != 4 && t->packet_bvh_width != 8)
+    return cli_error(CLI_USAGE_ERROR, "--packet-width is 4 or 8, not '%s'", a->val[F_PACKET_WIDTH]);
+  t->prefetch = pf == 0 ? -1 : pf == 2;
+  t->anyhit_order = ao == 0 ? -1 : ao == 2;
+  o->mft_no_fallback = !fallback;
+  o->mft_no_shaft = !shaft;
+  o->light_sets = sets_i ? FR_LIGHT_SETS_CELLS : FR_LIGHT_SETS_SPREAD;
+  return 0;
+}
+
+static int bench_options(const cli_args *a, bench_opts *o) {
+  memset(o, 0, sizeof *o);
+  o->scene = a->pos[0];
+  o->threads = omp_get_num_procs();
+  o->repeat = 3;
+  fr_tuning_default(&o->tuning);
+  o->mopt = fr_mft_opts_default();
+  static const char *const flags[] = {"best", "hint", "coherent", "incoherent"}; /* best, then ebr_flag order */
+  static const char *const packings[] = {"best", "rays", "samples"};            /* best, then ebr_packing order */
+  static const char *const tracers[] = {"frusta", "embree", "both"};
+  int ef = 0, ep = 0, tracer = 0, rc;
+  if ((rc = cli_view_from_args(a, &o->view)) || (rc = cli_whitted_from_args(a, &o->whitted)) ||
+      (rc = cli_common_from_args(a, &o->threads)) || (rc = cli_arg_int(a, F_REPEAT, 1, 64, &o->repeat)) ||
+      (rc = cli_arg_choice(a, F_EMBREE_FLAG, flags, 4, &ef)) ||
+      (rc = cli_arg_choice(a, F_EMBREE_PACKING, packings, 3, &ep)) ||
+      (rc = cli_arg_choice(a, F_TRACER, tracers, 3, &tracer)) || (rc = kernel_options(a, o)))
+    return rc;
+  o->embree_flag = ef - 1;
+  o->embree_packing = ep - 1;
+  if (!o->scene || !a->val[F_WORKLOAD] || !a->val[F_MODE])
+    return cli_error(CLI_USAGE_ERROR, "usage: frusta bench SCENE --workload W|all --mode M|all [flags] "
+                                      "(see frusta bench --help)");
+  if ((rc = parse_workloads(a->val[F_WORKLOAD], &o->workloads))) return rc;
+  o->all_modes = !strcmp(a->val[F_MODE], "all");
+  return parse_modes(a->val[F_MODE], tracer != 1, tracer != 0, &o->fsel, &o->esel);
+}
+
+/* What every workload of a call traces on. */
+typedef struct bench_setup {
   fr_scene *s;
   fr_workload w;
-  memset(&w, 0, sizeof w);
-  int rc = cli_workload_setup(scene, &v, threads, &s, &w);
-  if (rc) return rc;
-  w.seed = 7;
-  w.light_sets_kind = light_sets;
-  w.mft_no_fallback = mft_no_fallback;
-  w.mft_no_shaft = mft_no_shaft;
-  size_t tris = fr_scene_triangle_count(s);
-  /* the BVH4 is built on demand: now, before any run, when a 4-wide mode wants it */
-  if ((topt.packet_bvh_width == 4 || ((fsel >> 1) & 1)) && fr_scene_need_bvh4(s) != FR_OK) {
-    fr_scene_release(s);
-    return cli_error(1, "%s", fr_last_error());
-  }
+  fr_bvh2 shallow;        /* --mft-leaf's tree */
+  fr_mft_tracer mctx;
+  fr_whitted_mats mats;
+  ebr_scene *e;
+  int width;              /* the single-ray BVH width */
+} bench_setup;
+
+static void setup_free(bench_setup *b) {
+  ebr_release(b->e);
+  fr_bvh2_free(&b->shallow);
+  fr_whitted_mats_free(&b->mats);
+  fr_scene_release(b->s);
+}
+
+static void print_frusta_build(const bench_opts *o, const fr_scene *s) {
   fr_bvh_stats st;
   fr_scene_stats(s, &st);
   const fr_wide_stats *ws = st.single_width == 4 ? &st.bvh4 : &st.bvh8;
   /* packets traverse the packet BVH and test its Shevtsov records */
-  const fr_wide_stats *wp = topt.packet_bvh_width == 4 ? &st.bvh4 : &st.bvh8;
+  const int pw = o->tuning.packet_bvh_width;
+  const fr_wide_stats *wp = pw == 4 ? &st.bvh4 : &st.bvh8;
   /* the prefetch switches as the scene applies them (fr_scene_apply_prefetch) */
-  if (fr_scene_set_trace_options(s, &topt) != FR_OK) {
-    fr_scene_release(s);
-    return cli_error(1, "%s", fr_last_error());
-  }
   const int prefetch = (st.single_width == 4 ? &s->bvh4 : &s->bvh8)->prefetch;
-  const int packet_prefetch = (topt.packet_bvh_width == 4 ? &s->bvh4 : &s->bvh8)->packet_prefetch;
+  const int packet_prefetch = (pw == 4 ? &s->bvh4 : &s->bvh8)->packet_prefetch;
+  const size_t tris = fr_scene_triangle_count(s);
   printf("build_seconds=%.3f tracer=frusta scene=%s tris=%zu threads=%d isa=%s bvh_width=%d sah=%.2f bytes_per_tri=%.1f "
          "prefetch=%s packet_bvh_width=%d packet_bytes_per_tri=%.1f packet_prefetch=%s\n",
-         st.build_seconds, s->name, tris, threads, fr_isa_name(fr_get_isa()), st.single_width, ws->sah,
-         (double)(ws->node_bytes + ws->tri_bytes) / (double)tris, prefetch ? "on" : "off", topt.packet_bvh_width,
+         st.build_seconds, s->name, tris, o->threads, fr_isa_name(fr_get_isa()), st.single_width, ws->sah,
+         (double)(ws->node_bytes + ws->tri_bytes) / (double)tris, prefetch ? "on" : "off", pw,
          (double)(wp->node_bytes + wp->tri_bytes + wp->packet_tri_bytes) / (double)tris, packet_prefetch ? "on" : "off");
-  if (want_mft && !all_modes && fr_scene_sphere_count(s)) {
-    size_t ns = fr_scene_sphere_count(s);
-    fr_scene_release(s);
-    return cli_error(CLI_USAGE_ERROR, "--mode mft: multi-frusta tracing does not trace spheres (this scene has %zu)", ns);
-  }
+}
+
+/* Loads and commits the scene, builds what the modes need and prints the
+ * build lines; 0, or an exit code after reporting. */
+static int bench_prepare(const bench_opts *o, bench_setup *b) {
+  memset(b, 0, sizeof *b);
+  omp_set_num_threads(o->threads);
+  int rc = cli_workload_setup(o->scene, &o->view, o->threads, &b->s, &b->w);
+  if (rc) return rc;
+  fr_scene *s = b->s;
+  b->w.seed = 7;
+  b->w.light_sets_kind = o->light_sets;
+  b->w.mft_no_fallback = o->mft_no_fallback;
+  b->w.mft_no_shaft = o->mft_no_shaft;
+  /* the BVH4 is built on demand: now, before any run, when a 4-wide mode wants it */
+  if ((o->tuning.packet_bvh_width == 4 || ((o->fsel >> 1) & 1)) && fr_scene_need_bvh4(s) != FR_OK)
+    return cli_error(1, "%s", fr_last_error());
+  if (fr_scene_set_tuning(s, &o->tuning) != FR_OK) return cli_error(1, "%s", fr_last_error());
+  b->width = s->single_width;
+  print_frusta_build(o, s);
+  const int want_mft = (o->fsel >> MODE_MFT) & 1;
+  if (want_mft && !o->all_modes && fr_scene_sphere_count(s))
+    return cli_error(CLI_USAGE_ERROR, "--mode mft: multi-frusta tracing does not trace spheres (this scene has %zu)",
+                     fr_scene_sphere_count(s));
   /* multi-frusta tracing: the scene's binary BVH, or a shallower one */
-  fr_bvh2 shallow;
-  memset(&shallow, 0, sizeof shallow);
-  fr_mft_tracer mctx = fr_mft_tracer_of(s, mopt);
-  if (want_mft && mft_leaf_set) { /* --mft-leaf: one tree of that leaf size for camera and shadow frusta */
-    if (fr_scene_build_bvh2(s, mft_leaf, &shallow)) { fr_scene_release(s); return cli_error(1, "%s", fr_last_error()); }
-    mctx.bvh = mctx.shadow_bvh = &shallow;
+  b->mctx = fr_mft_tracer_of(s, o->mopt);
+  if (want_mft && o->mft_leaf) { /* --mft-leaf: one tree of that leaf size for camera and shadow frusta */
+    if (fr_scene_build_bvh2(s, o->mft_leaf, &b->shallow)) return cli_error(1, "%s", fr_last_error());
+    b->mctx.bvh = b->mctx.shadow_bvh = &b->shallow;
   }
+  const fr_mft_opts *m = &o->mopt;
   if (want_mft)
-    printf("mft_bvh leaf=%d shadow_leaf=%d inner=%zu leaves=%zu sah=%.2f corner_rays=%s corner_cost=%g shrink=%s fallback=%s shaft=%s\n",
-           mctx.bvh->max_leaf, mctx.shadow_bvh->max_leaf, mctx.bvh->nnodes, mctx.bvh->nleaves, fr_bvh2_sah(mctx.bvh), mopt.corner_rays ? "on" : "off",
-           (double)mopt.corner_cost, mopt.shrink == FR_MFT_SHRINK_ALL ? "on" : mopt.shrink == FR_MFT_SHRINK_CORNERS ? "corners" : "off", mft_no_fallback ? "off" : "on", mft_no_shaft ? "off" : "on");
-  fr_whitted_mats mats = {0};
-  if ((all_wl || wk == FR_WL_WHITTED) && (rc = cli_whitted_setup(s, &wo, &mats, &w))) {
-    fr_bvh2_free(&shallow);
-    fr_scene_release(s);
-    return rc;
-  }
-  ebr_scene *e = NULL;
-  if (esel) {
-    ebr_options o = {.threads = threads, .quality = 2}; /* high quality, not robust: Embree's fastest tracing */
-    if (ebr_create(s, o, &e)) {
-      fr_bvh2_free(&shallow);
-      fr_whitted_mats_free(&mats);
-      fr_scene_release(s);
-      return cli_error(1, "embree: cannot build the scene");
-    }
+    printf("mft_bvh leaf=%d shadow_leaf=%d inner=%zu leaves=%zu sah=%.2f corner_rays=%s corner_cost=%g shrink=%s "
+           "fallback=%s shaft=%s\n",
+           b->mctx.bvh->max_leaf, b->mctx.shadow_bvh->max_leaf, b->mctx.bvh->nnodes, b->mctx.bvh->nleaves,
+           fr_bvh2_sah(b->mctx.bvh), m->corner_rays ? "on" : "off", (double)m->corner_cost,
+           m->shrink == FR_MFT_SHRINK_ALL ? "on" : m->shrink == FR_MFT_SHRINK_CORNERS ? "corners" : "off",
+           o->mft_no_fallback ? "off" : "on", o->mft_no_shaft ? "off" : "on");
+  if (((o->workloads >> FR_WL_WHITTED) & 1) && (rc = cli_whitted_setup(s, &o->whitted, &b->mats, &b->w))) return rc;
+  if (o->esel) {
+    ebr_options eo = {.threads = o->threads, .quality = 2}; /* high quality, not robust: Embree's fastest tracing */
+    if (ebr_create(s, eo, &b->e)) return cli_error(1, "embree: cannot build the scene");
+    const size_t tris = fr_scene_triangle_count(s);
     printf("build_seconds=%.3f tracer=embree scene=%s tris=%zu threads=%d quality=high bytes_per_tri=%.1f\n",
-           ebr_build_seconds(e), s->name, tris, threads, (double)ebr_bytes(e) / (double)tris);
+           ebr_build_seconds(b->e), s->name, tris, o->threads, (double)ebr_bytes(b->e) / (double)tris);
   }
-  bench_run runs[N_FRUSTA_MODES + EBR_MODE_COUNT];
-  const int width = st.single_width;
-  for (int k = all_wl ? 0 : (int)wk; k < (all_wl ? FR_WL_COUNT : (int)wk + 1); k++) {
-    w.kind = (fr_workload_kind)k;
-    int nruns = 0;
-    for (int m = 0; m < N_FRUSTA_MODES; m++) {
-      if (!((fsel >> m) & 1) || (m == MODE_MFT && fr_scene_sphere_count(s))) continue;
-      bench_run *r = &runs[nruns++];
-      memset(r, 0, sizeof *r);
-      r->tracer = "frusta";
-      r->mode = m;
-      if (m >= MODE_LARGE)
-        snprintf(r->name, sizeof r->name, "%s/%s/%s", frusta_modes[m], fr_lp_traversal_name(wo.lp.traversal),
-                 fr_cull_name(wo.lp.cull));
-      else
-        snprintf(r->name, sizeof r->name, "%s", frusta_modes[m]);
-      r->lpc = (fr_lp_tracer){s, cli_lp_scene(s), wo.lp, m >= MODE_LARGE ? 2 << (m - MODE_LARGE) : 0};
-      r->t = m == MODE_MFT ? fr_tracer_mft(&mctx) : m >= MODE_LARGE ? fr_tracer_lp(&r->lpc) : fr_tracer_frusta(s);
-    }
-    for (int m = 0; e && m < EBR_MODE_COUNT; m++) {
-      if (!((esel >> m) & 1)) continue;
-      bench_run *r = &runs[nruns++];
-      memset(r, 0, sizeof *r);
-      r->tracer = "embree";
-      r->mode = m;
-      snprintf(r->name, sizeof r->name, "%s", ebr_mode_name((ebr_mode)m));
-      choose_embree_variant(&w, e, r, embree_flag, embree_packing);
-    }
-    for (int rep = 0; rep < repeat; rep++)
-      for (int i = 0; i < nruns; i++) {
-        bench_run *r = &runs[i];
-        if (r->tracer[0] == 'f') set_frusta_mode(s, r->mode, &topt, width);
-        fr_counters_reset();
-        fr_workload_result res = fr_workload_run(&w, &r->t);
-        fr_counters c = fr_counters_read();
-        fr_counters_add(&r->c, &c);
-        r->secs[rep] = res.seconds;
-        memcpy(r->stage[rep], res.stage, sizeof res.stage);
-        r->rays = res.rays;
-      }
-    fr_scene_set_bvh_width(s, width);
-    fr_scene_set_trace_options(s, &topt);
-    for (int i = 0; i < nruns; i++) report(&w, &runs[i], s->name, tris, repeat);
-  }
-  ebr_release(e);
-  fr_bvh2_free(&shallow);
-  fr_whitted_mats_free(&mats);
-  fr_scene_release(s);
   return 0;
+}
+
+/* One workload: every selected run, their repetitions interleaved, then one
+ * line each. */
+static void bench_workload(const bench_opts *o, bench_setup *b, fr_workload_kind k) {
+  fr_scene *s = b->s;
+  fr_workload *w = &b->w;
+  w->kind = k;
+  bench_run runs[N_FRUSTA_MODES + EBR_MODE_COUNT];
+  int nruns = 0;
+  const fr_lp_opts *lp = &o->whitted.lp;
+  for (int m = 0; m < N_FRUSTA_MODES; m++) {
+    if (!((o->fsel >> m) & 1) || (m == MODE_MFT && fr_scene_sphere_count(s))) continue;
+    bench_run *r = &runs[nruns++];
+    memset(r, 0, sizeof *r);
+    r->tracer = "frusta";
+    r->mode = m;
+    if (m >= MODE_LARGE)
+      snprintf(r->name, sizeof r->name, "%s/%s/%s", frusta_modes[m], fr_lp_traversal_name(lp->traversal),
+               fr_cull_name(lp->cull));
+    else
+      snprintf(r->name, sizeof r->name, "%s", frusta_modes[m]);
+    r->lpc = (fr_lp_tracer){s, cli_lp_scene(s), *lp, m >= MODE_LARGE ? 2 << (m - MODE_LARGE) : 0};
+    r->t = m == MODE_MFT ? fr_tracer_mft(&b->mctx) : m >= MODE_LARGE ? fr_tracer_lp(&r->lpc) : fr_tracer_frusta(s);
+  }
+  for (int m = 0; b->e && m < EBR_MODE_COUNT; m++) {
+    if (!((o->esel >> m) & 1)) continue;
+    bench_run *r = &runs[nruns++];
+    memset(r, 0, sizeof *r);
+    r->tracer = "embree";
+    r->mode = m;
+    snprintf(r->name, sizeof r->name, "%s", ebr_mode_name((ebr_mode)m));
+    choose_embree_variant(w, b->e, r, o->embree_flag, o->embree_packing);
+  }
+  for (int rep = 0; rep < o->repeat; rep++)
+    for (int i = 0; i < nruns; i++) {
+      bench_run *r = &runs[i];
+      if (r->tracer[0] == 'f') set_frusta_mode(s, r->mode, &o->tuning, b->width);
+      fr_counters_reset();
+      fr_workload_result res = fr_workload_run(w, &r->t);
+      fr_counters c = fr_counters_read();
+      fr_counters_add(&r->c, &c);
+      r->secs[rep] = res.seconds;
+      memcpy(r->stage[rep], res.stage, sizeof res.stage);
+      r->rays = res.rays;
+    }
+  fr_scene_set_bvh_width(s, b->width);
+  fr_scene_set_tuning(s, &o->tuning);
+  for (int i = 0; i < nruns; i++) report(w, &runs[i], s->name, fr_scene_triangle_count(s), o->repeat);
+}
+
+int cmd_bench(int argc, char **argv) {
+  cli_args a;
+  int rc = cli_args_parse(CLI_BENCH, argc, argv, 1, &a);
+  if (rc) return rc == CLI_HELP_SHOWN ? 0 : rc;
+  bench_opts o;
+  if ((rc = bench_options(&a, &o))) return rc;
+  bench_setup b;
+  if (!(rc = bench_prepare(&o, &b)))
+    for (int k = 0; k < FR_WL_COUNT; k++)
+      if ((o.workloads >> k) & 1) bench_workload(&o, &b, (fr_workload_kind)k);
+  setup_free(&b);
+  return rc;
 }

@@ -12,13 +12,6 @@
 #include "render/whitted.h"
 #include "render/workload.h"
 
-static int onoff(const char *flag, const char *val, int *out) {
-  if (!strcmp(val, "on")) *out = 1;
-  else if (!strcmp(val, "off")) *out = 0;
-  else return cli_error(CLI_USAGE_ERROR, "%s is on or off, not '%s'", flag, val);
-  return 0;
-}
-
 /* Mean absolute difference of two images of ch channels per pixel, over
  * the n pixels that hit (not background in the RGB image img). */
 static double mae(const float *a, const float *b, int ch, const float *img, size_t n) {
@@ -67,67 +60,40 @@ done:
 }
 
 int cmd_render(int argc, char **argv) {
-  const char *scene = NULL, *out = NULL, *shade = "eyelight";
-  cli_view v;
-  memset(&v, 0, sizeof v);
-  v.width = 1024; v.height = 1024;
+  cli_args a;
+  int rc = cli_args_parse(CLI_RENDER, argc, argv, 1, &a);
+  if (rc) return rc == CLI_HELP_SHOWN ? 0 : rc;
+  const char *scene = a.pos[0], *out = a.val[F_OUT], *ref_out = a.val[F_REFERENCE_OUT];
   int threads = omp_get_num_procs(), mft = -1; /* -1: not given */
-  const char *ref_out = NULL;
   fr_softshadow_opts so = {16, 1, FR_LIGHT_SETS_CELLS};
+  static const char *const shades[] = {"eyelight", "normals", "shadows", "softshadow", "whitted"};
+  static const char *const sets[] = {"cells", "spread"}; /* FR_LIGHT_SETS_CELLS, _SPREAD */
+  int shade = 0, set = 0;
+  cli_view v;
   cli_whitted wo;
-  cli_whitted_default(&wo);
-  for (int i = 0; i < argc; i++) {
-    int r = cli_view_flag(argc, argv, &i, &v);
-    if (r == 0) r = cli_whitted_flag(argc, argv, &i, &wo);
-    if (r < 0) return CLI_USAGE_ERROR;
-    if (r > 0) continue;
-    const char *a = argv[i];
-    if (!strcmp(a, "--light-samples") || !strcmp(a, "--filter") || !strcmp(a, "--light-sets") || !strcmp(a, "--mft") ||
-        !strcmp(a, "--reference-out")) {
-      if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
-      const char *val = argv[++i];
-      if (!strcmp(a, "--light-samples")) {
-        if (!cli_parse_int(val, 16, 4096, &so.samples) || so.samples % 16)
-          return cli_error(CLI_USAGE_ERROR, "--light-samples wants a multiple of 16 (16..4096), got '%s'", val);
-      } else if (!strcmp(a, "--filter")) {
-        if (onoff(a, val, &so.filter)) return CLI_USAGE_ERROR;
-      } else if (!strcmp(a, "--mft")) {
-        if (onoff(a, val, &mft)) return CLI_USAGE_ERROR;
-      } else if (!strcmp(a, "--reference-out")) {
-        ref_out = val;
-      } else if (!strcmp(val, "cells")) so.sets = FR_LIGHT_SETS_CELLS;
-      else if (!strcmp(val, "spread")) so.sets = FR_LIGHT_SETS_SPREAD;
-      else return cli_error(CLI_USAGE_ERROR, "--light-sets is cells or spread, not '%s'", val);
-      continue;
-    }
-    if (strcmp(a, "--out") == 0 || strcmp(a, "--shade") == 0 || strcmp(a, "--threads") == 0) {
-      if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
-      const char *val = argv[++i];
-      if (a[2] == 'o') out = val;
-      else if (a[2] == 's') shade = val;
-      else if (!cli_parse_int(val, 1, 1024, &threads)) return cli_error(CLI_USAGE_ERROR, "--threads wants 1..1024, got '%s'", val);
-    } else if (cli_is_builtin(a) || a[0] != '-') {
-      if (scene) return cli_error(CLI_USAGE_ERROR, "render takes one scene");
-      scene = a;
-    } else return cli_error(CLI_USAGE_ERROR, "render: unknown option '%s'", a);
-  }
+  if ((rc = cli_view_from_args(&a, &v)) || (rc = cli_whitted_from_args(&a, &wo)) ||
+      (rc = cli_common_from_args(&a, &threads)) || (rc = cli_arg_choice(&a, F_SHADE, shades, 5, &shade)) ||
+      (rc = cli_arg_choice(&a, F_LIGHT_SETS, sets, 2, &set)) || (rc = cli_arg_onoff(&a, F_FILTER, &so.filter)) ||
+      (rc = cli_arg_onoff(&a, F_MFT, &mft)) || (rc = cli_arg_int(&a, F_LIGHT_SAMPLES, 16, 4096, &so.samples)))
+    return rc;
+  so.sets = set ? FR_LIGHT_SETS_SPREAD : FR_LIGHT_SETS_CELLS;
+  if (so.samples % 16)
+    return cli_error(CLI_USAGE_ERROR, "--light-samples wants a multiple of 16 (16..4096), got '%s'", a.val[F_LIGHT_SAMPLES]);
   if (!scene || !out)
-    return cli_error(CLI_USAGE_ERROR, "usage: frusta render SCENE|--builtin --out FILE.png|.exr|.pfm "
-                                      "[--shade eyelight|normals|shadows|softshadow|whitted]");
+    return cli_error(CLI_USAGE_ERROR, "usage: frusta render SCENE|--builtin --out FILE.png|.exr|.pfm [flags] "
+                                      "(see frusta render --help)");
   if (!fr_image_format_known(out)) return cli_error(CLI_USAGE_ERROR, "%s: unknown image format (use .png, .exr or .pfm)", out);
   if (ref_out && !fr_image_format_known(ref_out))
     return cli_error(CLI_USAGE_ERROR, "%s: unknown image format (use .png, .exr or .pfm)", ref_out);
+  static const fr_workload_kind kinds[] = {FR_WL_PRIMARY, FR_WL_PRIMARY, FR_WL_SHADOW, FR_WL_SOFT16, FR_WL_WHITTED};
+  static const fr_shade shading[] = {FR_SHADE_EYELIGHT, FR_SHADE_NORMALS, FR_SHADE_LIGHT, FR_SHADE_LIGHT, FR_SHADE_LIGHT};
   fr_workload w;
   memset(&w, 0, sizeof w);
-  if (strcmp(shade, "eyelight") == 0) { w.kind = FR_WL_PRIMARY; w.shade = FR_SHADE_EYELIGHT; }
-  else if (strcmp(shade, "normals") == 0) { w.kind = FR_WL_PRIMARY; w.shade = FR_SHADE_NORMALS; }
-  else if (strcmp(shade, "shadows") == 0) { w.kind = FR_WL_SHADOW; w.shade = FR_SHADE_LIGHT; }
-  else if (strcmp(shade, "softshadow") == 0) { w.kind = FR_WL_SOFT16; w.shade = FR_SHADE_LIGHT; }
-  else if (strcmp(shade, "whitted") == 0) { w.kind = FR_WL_WHITTED; w.shade = FR_SHADE_LIGHT; }
-  else return cli_error(CLI_USAGE_ERROR, "--shade is eyelight, normals, shadows, softshadow or whitted, not '%s'", shade);
+  w.kind = kinds[shade];
+  w.shade = shading[shade];
 
   fr_scene *s;
-  int rc = cli_workload_setup(scene, &v, threads, &s, &w);
+  rc = cli_workload_setup(scene, &v, threads, &s, &w);
   if (rc) return rc;
   w.seed = 1;
   w.progress = 1;
@@ -142,8 +108,8 @@ int cmd_render(int argc, char **argv) {
   w.image = calloc((size_t)v.width * (size_t)v.height * 3, sizeof(float));
   if (!w.image) { fr_whitted_mats_free(&mats); fr_scene_release(s); return cli_error(1, "out of memory for a %dx%d image", v.width, v.height); }
   /* Whitted: camera rays by multi-frusta tracing and the rest as streams
-   * (the fastest measured, see docs/performance-log.md), or with --mft off or any of
-   * --packet, --traversal, --cull: large packets of --packet x --packet */
+   * (the fastest), or with --mft off or any of --packet, --traversal,
+   * --cull: large packets of --packet x --packet */
   fr_lp_tracer lpc = {s, cli_lp_scene(s), wo.lp, wo.packet};
   fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
   if (w.kind == FR_WL_WHITTED && mft == 1 && wo.large_flags) {
@@ -151,9 +117,8 @@ int cmd_render(int argc, char **argv) {
     return cli_error(CLI_USAGE_ERROR, "--mft on and --packet/--traversal/--cull: large packets need --mft off");
   }
   /* multi-frusta tracing does not see spheres: such scenes go the packet
-   * way. Camera rays are traced as frusta by default for every shade (1.5-2.8x
-   * packets on the shared scenes, docs/performance-log.md "Multi-frusta triangle tests
-   * without branches"); the rest as streams (auto). */
+   * way. Camera rays are traced as frusta by default for every shade, the
+   * rest as streams (auto). */
   const int use_mft = mft != 0 && !fr_scene_sphere_count(s) && !(w.kind == FR_WL_WHITTED && wo.large_flags);
   fr_tracer t = use_mft ? fr_tracer_mft(&mctx) : w.kind != FR_WL_WHITTED ? fr_tracer_frusta(s) : fr_tracer_lp(&lpc);
   const int whitted_mft = w.kind == FR_WL_WHITTED && use_mft;
@@ -167,7 +132,7 @@ int cmd_render(int argc, char **argv) {
   else
     printf("rendered scene=%s tris=%zu size=%dx%d shade=%s tracer=%s isa=%s threads=%d build_seconds=%.3f rays=%llu "
            "seconds=%.3f mrays=%.2f -> %s\n",
-           s->name, fr_scene_triangle_count(s), v.width, v.height, shade,
+           s->name, fr_scene_triangle_count(s), v.width, v.height, shades[shade],
            use_mft ? "mft" : w.kind == FR_WL_WHITTED ? "packets" : "auto", fr_isa_name(fr_get_isa()), threads,
            s->build_seconds, (unsigned long long)r.rays, r.seconds, (double)r.rays / r.seconds * 1e-6, out);
   free(w.image);

@@ -38,14 +38,14 @@ static int table5(const char *path, const cli_view *v, int threads, const char *
     fr_scene_release(s);
     return rc;
   }
-  fr_trace_options o;
-  fr_trace_options_default(&o);
+  fr_tuning o;
+  fr_tuning_default(&o);
   o.mode = FR_TRACE_HYBRID16;
   o.hybrid_threshold = threshold;
   o.hybrid_tune = 0; /* the paper's table is for one threshold */
   if (coherent >= 0) o.coherent_threshold = coherent;
   o.packet_bvh_width = width;
-  fr_scene_set_trace_options(s, &o);
+  fr_scene_set_tuning(s, &o);
   fr_tracer t = fr_tracer_frusta(s);
   fr_counters_reset();
   fr_workload_result r = fr_workload_run(&w, &t);
@@ -70,33 +70,22 @@ static int table5(const char *path, const cli_view *v, int threads, const char *
 }
 
 int cmd_stats(int argc, char **argv) {
-  const char *path = NULL, *workload = NULL;
-  int embree = 0, threads = omp_get_num_procs(), threshold = 7, coherent = -1, width = 8;
+  cli_args a;
+  int rc = cli_args_parse(CLI_STATS, argc, argv, 1, &a);
+  if (rc) return rc == CLI_HELP_SHOWN ? 0 : rc;
+  const char *path = a.pos[0], *workload = a.val[F_WORKLOAD];
+  const int embree = a.val[F_EMBREE] != NULL;
+  int threads = omp_get_num_procs(), threshold = 7, coherent = -1, width = 8;
   cli_view v;
-  memset(&v, 0, sizeof v);
-  v.width = 1024; v.height = 1024;
-  for (int i = 0; i < argc; i++) {
-    int r = cli_view_flag(argc, argv, &i, &v);
-    if (r < 0) return CLI_USAGE_ERROR;
-    if (r > 0) continue;
-    if (strcmp(argv[i], "--embree") == 0) embree = 1;
-    else if (strcmp(argv[i], "--workload") == 0 && i + 1 < argc) workload = argv[++i];
-    else if (strcmp(argv[i], "--threshold") == 0 && i + 1 < argc) {
-      if (!cli_parse_int(argv[++i], 0, 16, &threshold)) return cli_error(CLI_USAGE_ERROR, "--threshold wants 0..16");
-    } else if (strcmp(argv[i], "--coherent-threshold") == 0 && i + 1 < argc) {
-      if (!cli_parse_int(argv[++i], 0, 16, &coherent)) return cli_error(CLI_USAGE_ERROR, "--coherent-threshold wants 0..16");
-    } else if (strcmp(argv[i], "--packet-width") == 0 && i + 1 < argc) {
-      if (!cli_parse_int(argv[++i], 4, 8, &width) || (width != 4 && width != 8)) return cli_error(CLI_USAGE_ERROR, "--packet-width is 4 or 8");
-    }
-    else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
-      if (!cli_parse_int(argv[++i], 1, 1024, &threads)) return cli_error(CLI_USAGE_ERROR, "--threads wants 1..1024");
-    } else if (cli_is_builtin(argv[i]) || argv[i][0] != '-') {
-      if (path) return cli_error(CLI_USAGE_ERROR, "stats takes one scene");
-      path = argv[i];
-    } else return cli_error(CLI_USAGE_ERROR, "stats: unknown option '%s'", argv[i]);
-  }
+  if ((rc = cli_view_from_args(&a, &v)) || (rc = cli_common_from_args(&a, &threads)) ||
+      (rc = cli_arg_int(&a, F_THRESHOLD, 0, 16, &threshold)) ||
+      (rc = cli_arg_int(&a, F_COHERENT_THRESHOLD, 0, 16, &coherent)) ||
+      (rc = cli_arg_int(&a, F_PACKET_WIDTH, 4, 8, &width)))
+    return rc;
+  if (width != 4 && width != 8) return cli_error(CLI_USAGE_ERROR, "--packet-width is 4 or 8, not '%s'", a.val[F_PACKET_WIDTH]);
   if (!path)
-    return cli_error(CLI_USAGE_ERROR, "usage: frusta stats SCENE|--builtin [--embree] [--threads N] [--workload W [--threshold N] [--coherent-threshold N] [--packet-width 4|8] [view flags]]");
+    return cli_error(CLI_USAGE_ERROR, "usage: frusta stats SCENE|--builtin [--embree] [--workload W] [flags] "
+                                      "(see frusta stats --help)");
   omp_set_num_threads(threads);
   if (workload) return table5(path, &v, threads, workload, threshold, coherent, width);
   fr_scene *s;

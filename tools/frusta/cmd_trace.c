@@ -1,5 +1,5 @@
 /* frusta trace SCENE RAYS --query closest|any --out FILE: answers a ray file
- * (../shared/spec/rayfile.md) with frusta, or with Embree for comparison.
+ * (docs/rayfile.md) with frusta, or with Embree for comparison.
  * --mode picks frusta's kernels: single rays (default), or the stream calls
  * in packet8, packet16, hybrid16, auto or raystream mode over consecutive
  * rays. */
@@ -13,36 +13,19 @@
 #include "io/rayfile.h"
 
 int cmd_trace(int argc, char **argv) {
-  const char *scene = NULL, *rays_path = NULL, *out = NULL, *query = NULL, *tracer = "frusta";
-  static const char *mode_names[] = {"auto", "single", "packet8", "packet16", "hybrid16", "raystream"}; /* fr_trace_mode order */
-  int mode = FR_TRACE_SINGLE;
-  for (int i = 0; i < argc; i++) {
-    const char *a = argv[i];
-    if ((strcmp(a, "--query") == 0 || strcmp(a, "--out") == 0 || strcmp(a, "--tracer") == 0 || strcmp(a, "--isa") == 0 ||
-         strcmp(a, "--mode") == 0)) {
-      if (i + 1 >= argc) return cli_error(CLI_USAGE_ERROR, "%s needs a value", a);
-      const char *v = argv[++i];
-      if (a[2] == 'q') query = v;
-      else if (a[2] == 'o') out = v;
-      else if (a[2] == 't') tracer = v;
-      else if (a[2] == 'm') {
-        mode = -1;
-        for (int m = 0; m < (int)(sizeof mode_names / sizeof mode_names[0]); m++)
-          if (strcmp(v, mode_names[m]) == 0) mode = m;
-        if (mode < 0) return cli_error(CLI_USAGE_ERROR, "--mode is single, packet8, packet16, hybrid16, auto or raystream, not '%s'", v);
-      } else if (cli_set_isa(v)) return 1;
-    } else if (a[0] == '-' && !cli_is_builtin(a)) {
-      return cli_error(CLI_USAGE_ERROR, "trace: unknown option '%s'", a);
-    } else if (!scene) scene = a;
-    else if (!rays_path) rays_path = a;
-    else return cli_error(CLI_USAGE_ERROR, "trace: unexpected argument '%s'", a);
-  }
-  if (!scene || !rays_path || !out || !query)
-    return cli_error(CLI_USAGE_ERROR, "usage: frusta trace SCENE RAYS --query closest|any --out FILE [--tracer frusta|embree] [--mode M]");
-  int closest = strcmp(query, "closest") == 0;
-  if (!closest && strcmp(query, "any") != 0) return cli_error(CLI_USAGE_ERROR, "--query is closest or any, not '%s'", query);
-  int use_embree = strcmp(tracer, "embree") == 0;
-  if (!use_embree && strcmp(tracer, "frusta") != 0) return cli_error(CLI_USAGE_ERROR, "--tracer is frusta or embree, not '%s'", tracer);
+  cli_args a;
+  int rc = cli_args_parse(CLI_TRACE, argc, argv, 2, &a);
+  if (rc) return rc == CLI_HELP_SHOWN ? 0 : rc;
+  const char *scene = a.pos[0], *rays_path = a.pos[1], *out = a.val[F_OUT];
+  static const char *const modes[] = {"auto", "single", "packet8", "packet16", "hybrid16", "raystream"}; /* fr_trace_mode order */
+  static const char *const queries[] = {"any", "closest"}, *const tracers[] = {"frusta", "embree"};
+  int mode = FR_TRACE_SINGLE, closest = 0, use_embree = 0;
+  if ((rc = cli_arg_choice(&a, F_MODE, modes, 6, &mode)) || (rc = cli_arg_choice(&a, F_QUERY, queries, 2, &closest)) ||
+      (rc = cli_arg_choice(&a, F_TRACER, tracers, 2, &use_embree)) || (a.val[F_ISA] && (rc = cli_set_isa(a.val[F_ISA]))))
+    return rc;
+  if (!scene || !rays_path || !out || !a.val[F_QUERY])
+    return cli_error(CLI_USAGE_ERROR, "usage: frusta trace SCENE RAYS --query closest|any --out FILE [flags] "
+                                      "(see frusta trace --help)");
 
   fr_ray *rays;
   size_t n;
@@ -50,10 +33,7 @@ int cmd_trace(int argc, char **argv) {
   fr_scene *s;
   int lrc = cli_load_scene(scene, &s);
   if (lrc) { free(rays); return lrc; }
-  fr_trace_options topt;
-  fr_trace_options_default(&topt);
-  topt.mode = (fr_trace_mode)mode;
-  fr_scene_set_trace_options(s, &topt);
+  fr_scene_set_trace_mode(s, (fr_trace_mode)mode);
   const int stream = !use_embree && mode != FR_TRACE_SINGLE;
   const size_t chunk = 4096; /* a multiple of 16: packets never straddle chunks */
   ebr_scene *e = NULL;
@@ -61,7 +41,6 @@ int cmd_trace(int argc, char **argv) {
     ebr_options o = {.threads = 0, .quality = 2, .robust = 1}; /* robust: Embree's watertight mode */
     if (ebr_create(s, o, &e)) { free(rays); fr_scene_release(s); return cli_error(1, "embree: cannot build the scene"); }
   }
-  int rc = 0;
   if (closest) {
     fr_hit *hits = malloc((n ? n : 1) * sizeof *hits);
     if (!hits) rc = cli_error(1, "out of memory for %zu hits", n);

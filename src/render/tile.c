@@ -1,0 +1,185 @@
+/*
+ * One tile of the primary, shadow, soft16, ao16, diffuse8 and specular8
+ * workloads: camera rays (as frusta where the tracer has them), the
+ * workload's secondary rays, and the shading of the render modes.
+ */
+#include "render/tile.h"
+#include "base/rng.h"
+#include "render/mft_rays.h"
+
+void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, fr_ray *rays, fr_hit *hits) {
+  fr_mft_batch b;
+  static _Thread_local fr_mft_hits h;
+  const fr_mft_sets *cam_set = w->camera_set;
+  fr_mft_batch_camera(&b, &w->cam, tx, ty);
+  t->intersect_frusta(t->ctx, &b, cam_set, &h);
+  fr_mft_active()->expand(&b, cam_set, &h, rays, hits);
+}
+
+/* shadow and ao16: each hit's point-light shadow ray or 16 hemisphere rays,
+ * traced as one call; lit[i] gets pixel i's unoccluded fraction. Returns
+ * the rays traced. */
+static uint64_t point_or_ao_rays(const fr_workload *w, const fr_tracer *t, fr_tile_buffers *B, int n, float *lit) {
+  const int W = w->cam.width;
+  int m = 0;
+  int per = w->kind == FR_WL_SHADOW ? 1 : 16;
+  for (int i = 0; i < n; i++) {
+    const fr_hit *h = &B->prim_hit[i];
+    if (h->prim == FR_INVALID_ID) continue;
+    vec3 p = hit_point(&B->prim_ray[i], h), nn = facing_normal(w->scene, h, &B->prim_ray[i]);
+    fr_rng rng = fr_rng_seed(w->seed, (uint64_t)B->py[i] * (uint64_t)W + (uint64_t)B->px[i]);
+    for (int k = 0; k < per; k++) {
+      vec3 dir;
+      float tfar;
+      if (w->kind == FR_WL_AO16) {
+        dir = cosine_dir(nn, fr_rng_float(&rng), fr_rng_float(&rng));
+        tfar = INFINITY;
+      } else {
+        vec3 L = w->view.light;
+        vec3 to = v3_sub(L, p);
+        float dist = v3_len(to);
+        dir = v3_scale(to, 1.0f / dist);
+        tfar = dist * (1.0f - 1e-4f);
+      }
+      B->rays[m] = make_ray(p, dir, w->eps, tfar);
+      B->owner[m++] = i;
+    }
+  }
+  t->occluded(t->ctx, B->rays, B->occ, (size_t)m, 0);
+  int cnt[TILE_PIX] = {0};
+  for (int k = 0; k < m; k++) cnt[B->owner[k]] += !B->occ[k];
+  for (int i = 0; i < n; i++) lit[i] = (float)cnt[i] / (float)per;
+  return (uint64_t)m;
+}
+
+/* diffuse8 and specular8: up to 8 bounces from each hit, the live paths
+ * traced together at each bounce; a path ends at its first miss. Returns
+ * the rays traced. */
+static uint64_t bounce_rays(const fr_workload *w, const fr_tracer *t, fr_tile_buffers *B, int n) {
+  const int W = w->cam.width;
+  uint64_t rays = 0;
+  fr_rng rng[TILE_PIX];
+  fr_ray cur[TILE_PIX];
+  fr_hit ch[TILE_PIX];
+  int alive[TILE_PIX], na = 0;
+  for (int i = 0; i < n; i++)
+    if (B->prim_hit[i].prim != FR_INVALID_ID) {
+      alive[na++] = i;
+      cur[i] = B->prim_ray[i];
+      ch[i] = B->prim_hit[i];
+      rng[i] = fr_rng_seed(w->seed, (uint64_t)B->py[i] * (uint64_t)W + (uint64_t)B->px[i]);
+    }
+  for (int bounce = 0; bounce < 8 && na > 0; bounce++) {
+    for (int a = 0; a < na; a++) {
+      int i = alive[a];
+      vec3 d = v3_load(cur[i].dir), p = hit_point(&cur[i], &ch[i]), nn = facing_normal(w->scene, &ch[i], &cur[i]);
+      vec3 nd = w->kind == FR_WL_DIFFUSE8 ? cosine_dir(nn, fr_rng_float(&rng[i]), fr_rng_float(&rng[i]))
+                                          : v3_sub(d, v3_scale(nn, 2.0f * v3_dot(d, nn)));
+      cur[i] = make_ray(p, nd, w->eps, INFINITY);
+      B->rays[a] = cur[i]; /* the tracer may overwrite its copy */
+    }
+    rays += (uint64_t)na;
+    t->intersect(t->ctx, B->rays, B->hits, (size_t)na, 0);
+    int nn2 = 0;
+    for (int a = 0; a < na; a++) {
+      int i = alive[a];
+      if (B->hits[a].prim == FR_INVALID_ID) continue;
+      ch[i] = B->hits[a];
+      alive[nn2++] = i;
+    }
+    na = nn2;
+  }
+  return rays;
+}
+
+/* The soft-shadow filter's inputs: per pixel light visibility, primary hit
+ * distance (+inf on a miss), unit normal facing the camera and albedo. */
+static void write_gbuffer(const fr_workload *w, const fr_tile_buffers *B, int n, const float *lit) {
+  const int W = w->cam.width;
+  for (int i = 0; i < n; i++) {
+    size_t px = (size_t)B->py[i] * (size_t)W + (size_t)B->px[i];
+    const fr_hit *h = &B->prim_hit[i];
+    vec3 nn = v3(0, 0, 0);
+    if (h->prim != FR_INVALID_ID) nn = facing_normal(w->scene, h, &B->prim_ray[i]);
+    w->gbuf_vis[px] = h->prim == FR_INVALID_ID ? 0.0f : lit[i];
+    w->gbuf_depth[px] = h->prim == FR_INVALID_ID ? INFINITY : h->t;
+    w->gbuf_normal[3 * px] = nn.x; w->gbuf_normal[3 * px + 1] = nn.y; w->gbuf_normal[3 * px + 2] = nn.z;
+    vec3 al = h->prim == FR_INVALID_ID ? v3(0, 0, 0) : albedo(w->scene, h->prim);
+    w->gbuf_albedo[3 * px] = al.x; w->gbuf_albedo[3 * px + 1] = al.y; w->gbuf_albedo[3 * px + 2] = al.z;
+  }
+}
+
+/* The shaded pixels of the render modes. */
+static void shade_pixels(const fr_workload *w, const fr_tile_buffers *B, int n, const float *lit) {
+  const int W = w->cam.width;
+  for (int i = 0; i < n; i++) {
+    float *px = w->image + 3 * ((size_t)B->py[i] * (size_t)W + (size_t)B->px[i]);
+    const fr_hit *h = &B->prim_hit[i];
+    if (h->prim == FR_INVALID_ID) { px[0] = px[1] = px[2] = 0.05f; continue; }
+    vec3 d = v3_load(B->prim_ray[i].dir), nn = facing_normal(w->scene, h, &B->prim_ray[i]), c;
+    float cosv = fabsf(v3_dot(nn, d));
+    if (w->shade == FR_SHADE_NORMALS) {
+      c = v3_scale(v3_add(nn, v3(1, 1, 1)), 0.5f);
+    } else if (w->shade == FR_SHADE_LIGHT && w->kind == FR_WL_SHADOW) {
+      vec3 p = hit_point(&B->prim_ray[i], h), L = v3_norm(v3_sub(w->view.light, p));
+      c = v3_scale(albedo(w->scene, h->prim), 0.15f * cosv + 0.85f * lit[i] * fmaxf(0.0f, v3_dot(nn, L)));
+    } else if (w->shade == FR_SHADE_LIGHT) {
+      c = v3_scale(albedo(w->scene, h->prim), lit[i] * (0.25f + 0.75f * cosv));
+    } else {
+      c = v3_scale(albedo(w->scene, h->prim), cosv);
+    }
+    px[0] = c.x; px[1] = c.y; px[2] = c.z;
+  }
+}
+
+/* One tile: returns rays traced; writes shaded pixels when w->image is set. */
+uint64_t fr_tile_run(const fr_workload *w, const fr_tracer *t, fr_tile_buffers *B, int tx, int ty) {
+  const int W = w->cam.width, H = w->cam.height;
+  int n = 0;
+  /* a full tile's camera rays come from the frusta tracer, made on demand */
+  const int frusta = t->intersect_frusta && tx + TILE <= W && ty + TILE <= H;
+  /* pixels in 4x4 blocks, so groups of 16 rays are coherent */
+  for (int by = 0; by < TILE; by += 4)
+    for (int bx = 0; bx < TILE; bx += 4)
+      for (int y = 0; y < 4; y++)
+        for (int x = 0; x < 4; x++) {
+          int X = tx + bx + x, Y = ty + by + y;
+          if (X >= W || Y >= H) continue;
+          B->px[n] = X; B->py[n] = Y;
+          if (!frusta) {
+            B->prim_ray[n] = fr_camera_ray(&w->cam, X, Y);
+            B->rays[n] = B->prim_ray[n];
+          }
+          n++;
+        }
+  uint64_t rays = (uint64_t)n;
+  if (frusta)
+    fr_camera_frusta(w, t, tx, ty, B->prim_ray, B->prim_hit);
+  else
+    t->intersect(t->ctx, B->rays, B->prim_hit, (size_t)n, 1);
+  float lit[TILE_PIX];
+  for (int i = 0; i < n; i++) lit[i] = 1.0f;
+
+  switch (w->kind) {
+  case FR_WL_PRIMARY:
+    break;
+  case FR_WL_SOFT16:
+    for (int i = 0; i < n; i++) lit[i] = 0.0f;
+    rays += fr_tile_soft_shadows(w, t, B, n, lit);
+    break;
+  case FR_WL_SHADOW:
+  case FR_WL_AO16:
+    rays += point_or_ao_rays(w, t, B, n, lit);
+    break;
+  case FR_WL_DIFFUSE8:
+  case FR_WL_SPECULAR8:
+    rays += bounce_rays(w, t, B, n);
+    break;
+  default:
+    break;
+  }
+
+  if (w->gbuf_vis) write_gbuffer(w, B, n, lit);
+  if (w->image) shade_pixels(w, B, n, lit);
+  return rays;
+}
