@@ -1,8 +1,8 @@
 #!/bin/sh
 # The command line as a user meets it: exit codes, one-line errors, whole
-# outputs or none. usage: cli_test.sh FRUSTA SHARED_DIR
+# outputs or none. usage: cli_test.sh FRUSTA SHARED_DIR SOURCE_DIR
 set -u
-F="$1"; SHARED="$2"
+F="$1"; SHARED="$2"; SRC="$3"
 T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
 fails=0; passes=0
 ok() { passes=$((passes+1)); }
@@ -174,6 +174,32 @@ expect 0 "$F" bench --builtin --size 32x32 --workload soft16 --mode mft --repeat
 expect 2 "$F" bench --builtin --workload soft16 --mode mft --mft-shaft maybe
 expect 2 "$F" bench --builtin --workload soft16 --mode mft --mft-leaf 16
 expect 2 "$F" bench --builtin --workload soft16 --mode mft --corner-rays sometimes
+
+# help, version and the manual page, all from the one flag table
+for c in render bench trace stats; do
+  expect 0 "$F" $c --help
+  grep -q "^usage: frusta $c " "$T/out" && grep -q '^  --' "$T/out" && ok || bad "$c --help"
+  expect 0 "$F" help $c
+done
+expect 0 "$F" bench --help
+grep -q -- '--embree-flag best|hint|coherent|incoherent' "$T/out" && ok || bad "bench --help lacks --embree-flag"
+expect 0 "$F" --help
+grep -q 'render' "$T/out" && grep -q 'stats' "$T/out" && ok || bad "frusta --help"
+expect 0 "$F" --version
+grep -q '^frusta [0-9]*\.[0-9]* (' "$T/out" && ok || bad "--version"
+expect 2 "$F" help frobnicate
+expect 2 "$F" render --builtin --out "$T/h.png" --threads
+expect 2 "$F" trace --builtin --mode single
+expect 0 "$F" help --man
+cmp -s "$T/out" "$SRC/docs/frusta.1" && ok || bad "docs/frusta.1 is not what 'frusta help --man' prints (regenerate it)"
+# bench names Embree's context flag and packing, and takes them fixed
+expect 0 "$F" bench --builtin --size 32x32 --workload ao16 --mode packet16 --tracer embree --repeat 1
+grep -q 'tracer=embree mode=packet16 .* flag=[a-z]* packing=[a-z]*$' "$T/out" && ok || bad "bench embree line lacks flag and packing"
+expect 0 "$F" bench --builtin --size 32x32 --workload ao16 --mode stream --tracer embree --repeat 1 --embree-flag coherent --embree-packing samples
+grep -q 'flag=coherent packing=samples$' "$T/out" && ok || bad "bench --embree-flag/--embree-packing"
+expect 2 "$F" bench --builtin --workload ao16 --mode stream --tracer embree --embree-flag sometimes
+expect 0 "$F" bench --builtin --size 32x32 --workload primary,shadow --mode single --repeat 1
+[ "$(grep -c '^scene=' "$T/out")" = 2 ] && ok || bad "bench --workload list"
 
 echo "cli: $passes passed, $fails failed"
 [ "$fails" -eq 0 ]

@@ -1,4 +1,4 @@
-/* The ray, hit and occlusion files of ../shared/spec/rayfile.md. */
+/* The ray, hit and occlusion files of docs/rayfile.md. */
 #ifndef FR_IO_RAYFILE_H
 #define FR_IO_RAYFILE_H
 #include <stddef.h>
