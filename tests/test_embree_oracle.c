@@ -13,7 +13,7 @@
 #include "render/views.h"
 #include "test_util.h"
 
-#define SIDE 80
+#define SIDE (FR_TEST_SANITIZED ? 40 : 80)
 
 /* Camera rays in 4x4 pixel blocks, then a shadow ray and a hemisphere ray
  * from each hit (in the same order), then random rays through the bounds: as

@@ -177,7 +177,7 @@ static void test_random_scenes(void **state) {
   lp = fr_alloc_aligned(sizeof *lp, 64);
   fr_rng g = fr_rng_seed(11, 0);
   tally tl = {0, 0, 0, 0};
-  for (int sc = 0; sc < 12; sc++) {
+  for (int sc = 0; sc < FR_TEST_ROUNDS(12); sc++) {
     vec3 center = sc % 3 == 2 ? v3(1000, -2000, 500) : v3(0, 0, 0);
     float size = sc % 4 == 3 ? 0.01f : 1.0f;
     scene_data sd = make_scene(&g, 200 + 400 * (size_t)sc, center, size);

@@ -348,7 +348,7 @@ static void random_scenes(void **state) {
   (void)state;
   fr_rng r = fr_rng_seed(11, 3);
   tally tl = {0};
-  for (int round = 0; round < 6; round++) {
+  for (int round = 0; round < FR_TEST_ROUNDS(6); round++) {
     vec3 center = round % 3 == 2 ? v3(1e4f, -3e3f, 2e3f) : v3(0, 0, 0);
     float size = round % 2 ? 1.0f : 30.0f;
     scene_data sd = make_scene(&r, 600 + 300 * (size_t)round, center, size);
@@ -427,7 +427,7 @@ static void rays_frusta(void **state) {
   fr_rng r = fr_rng_seed(29, 5);
   tally tl = {0};
   long made = 0, stopped = 0;
-  for (int round = 0; round < 4; round++) {
+  for (int round = 0; round < FR_TEST_ROUNDS(4); round++) {
     vec3 center = round == 3 ? v3(1e4f, -3e3f, 2e3f) : v3(0, 0, 0);
     float size = round % 2 ? 1.0f : 30.0f;
     scene_data sd = make_scene(&r, 800 + 400 * (size_t)round, center, size);
@@ -630,7 +630,7 @@ static void check_shared_scene(const char *path, tally *tl) {
   assert_int_equal(fr_scene_commit(s), FR_OK);
   fr_view v;
   if (!fr_view_lookup(s->name, &v)) fail_msg("%s: no view", s->name);
-  enum { SZ = 64 };
+  enum { SZ = FR_TEST_SANITIZED ? 32 : 64 };
   fr_camera cam;
   assert_int_equal(fr_camera_setup(&cam, v.eye, v.at, v.up, v.fov, SZ, SZ), FR_OK);
   for (int y = 0; y < SZ; y += 16)

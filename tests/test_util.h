@@ -17,6 +17,20 @@
 #include "frusta.h"
 #include "api/scene.h"
 
+/* Under the sanitizers (several times slower) the slowest tests check
+ * fewer random cases and smaller images: FR_TEST_ROUNDS(n) of them. */
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define FR_TEST_SANITIZED 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define FR_TEST_SANITIZED 1
+#endif
+#endif
+#ifndef FR_TEST_SANITIZED
+#define FR_TEST_SANITIZED 0
+#endif
+#define FR_TEST_ROUNDS(n) (FR_TEST_SANITIZED ? ((n) + 3) / 4 : (n))
+
 static inline float urand(fr_rng *r, float lo, float hi) { return lo + (hi - lo) * fr_rng_float(r); }
 
 /* Closest hit by testing every triangle in double precision (Möller–Trumbore).

@@ -268,7 +268,7 @@ fr_error fr_plane_occluders_find(const fr_mesh *m, fr_plane_occluders *out) {
   }
   free(pl);
   if (e) { free(list); return e; }
-  qsort(list, nl, sizeof *list, occluder_cmp);
+  if (nl) qsort(list, nl, sizeof *list, occluder_cmp); /* qsort takes no NULL, even for none */
   out->list = list;
   out->n = nl < FR_PLANE_OCCLUDERS_MAX ? nl : FR_PLANE_OCCLUDERS_MAX;
   return FR_OK;

@@ -17,11 +17,11 @@ int fr_file_exists(const char *path) {
   return stat(path, &st) == 0 && S_ISREG(st.st_mode);
 }
 
-static fr_error read_raw(const char *path, char **data, size_t *size) {
+static fr_error read_raw(const char *path, size_t max, char **data, size_t *size) {
   struct stat st;
   if (stat(path, &st) != 0) return fr_fail(FR_ERR_IO, "%s: %s", path, strerror(errno));
   if (!S_ISREG(st.st_mode)) return fr_fail(FR_ERR_IO, "%s: not a regular file", path);
-  if ((size_t)st.st_size > FR_MAX_FILE_BYTES) return fr_fail(FR_ERR_UNSUPPORTED, "%s: file too large", path);
+  if ((size_t)st.st_size > max) return fr_fail(FR_ERR_UNSUPPORTED, "%s: larger than %zu bytes", path, max);
   FILE *f = fopen(path, "rb");
   if (!f) return fr_fail(FR_ERR_IO, "%s: %s", path, strerror(errno));
   size_t n = (size_t)st.st_size;
@@ -37,22 +37,29 @@ static fr_error read_raw(const char *path, char **data, size_t *size) {
   return FR_OK;
 }
 
-static fr_error inflate_zst(const char *path, const char *in, size_t n, char **data, size_t *size) {
+static fr_error inflate_zst(const char *path, const char *in, size_t n, size_t max, char **data, size_t *size) {
+  /* what the compressed bytes may honestly hold */
+  const size_t bound = n > (max - FR_INFLATE_SLACK) / FR_INFLATE_RATIO ? max : n * FR_INFLATE_RATIO + FR_INFLATE_SLACK;
+  const size_t limit = bound < max ? bound : max;
   ZSTD_DCtx *dc = ZSTD_createDCtx();
   if (!dc) return fr_fail(FR_ERR_NOMEM, "%s: cannot create zstd context", path);
   /* the shared scenes use --long=27; allow windows up to 2^31 */
   ZSTD_DCtx_setParameter(dc, ZSTD_d_windowLogMax, 31);
   unsigned long long hint = ZSTD_getFrameContentSize(in, n);
-  size_t cap = (hint != ZSTD_CONTENTSIZE_UNKNOWN && hint != ZSTD_CONTENTSIZE_ERROR && hint < FR_MAX_FILE_BYTES)
-                   ? (size_t)hint + 1 : n * 4 + 1024;
+  size_t cap = (hint != ZSTD_CONTENTSIZE_UNKNOWN && hint != ZSTD_CONTENTSIZE_ERROR && hint < limit)
+                   ? (size_t)hint + 1 : (n < limit / 4 ? n * 4 + 1024 : limit + 1);
   char *out = malloc(cap);
   if (!out) { ZSTD_freeDCtx(dc); return fr_fail(FR_ERR_NOMEM, "%s: cannot allocate %zu bytes", path, cap); }
   ZSTD_inBuffer ib = {in, n, 0};
   size_t used = 0, ret = 1;
   while (ib.pos < ib.size || ret != 0) {
     if (used + 1 >= cap) {
-      if (cap >= FR_MAX_FILE_BYTES) { free(out); ZSTD_freeDCtx(dc); return fr_fail(FR_ERR_UNSUPPORTED, "%s: inflates past %zu bytes", path, FR_MAX_FILE_BYTES); }
-      size_t nc = cap * 2;
+      if (cap > limit) {
+        free(out); ZSTD_freeDCtx(dc);
+        return fr_fail(FR_ERR_UNSUPPORTED, "%s: inflates past %zu bytes (%zu compressed)", path, limit, n);
+      }
+      /* grow, but never past the limit (and one byte to see it passed) */
+      size_t nc = cap <= limit / 2 ? cap * 2 : limit + 1;
       char *q = realloc(out, nc);
       if (!q) { free(out); ZSTD_freeDCtx(dc); return fr_fail(FR_ERR_NOMEM, "%s: cannot allocate %zu bytes", path, nc); }
       out = q;
@@ -79,12 +86,15 @@ static fr_error inflate_zst(const char *path, const char *in, size_t n, char **d
   return FR_OK;
 }
 
-fr_error fr_read_file(const char *path, char **data, size_t *size) {
+fr_error fr_read_file_max(const char *path, size_t max, char **data, size_t *size) {
+  if (!max || max > FR_MAX_FILE_BYTES) max = FR_MAX_FILE_BYTES;
   char *raw = NULL;
   size_t n = 0;
-  fr_error e = read_raw(path, &raw, &n);
+  fr_error e = read_raw(path, max, &raw, &n);
   if (e || !fr_has_suffix(path, ".zst")) { if (!e) { *data = raw; *size = n; } return e; }
-  e = inflate_zst(path, raw, n, data, size);
+  e = inflate_zst(path, raw, n, max, data, size);
   free(raw);
   return e;
 }
+
+fr_error fr_read_file(const char *path, char **data, size_t *size) { return fr_read_file_max(path, 0, data, size); }

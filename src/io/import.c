@@ -30,6 +30,18 @@ fr_error fr_import(const char *path, fr_mesh *m) {
     if (e) return e;
     e = ext[0] == 'p' ? fr_import_ply(path, data, size, m) : fr_import_obj(path, data, size, m);
     free(data);
+    if (e == FR_ERR_FORMAT) {
+      /* frusta's readers are strict; what Assimp reads of such a file
+       * (a nonstandard header line, say) is still a scene */
+      char why[512];
+      snprintf(why, sizeof why, "%s", fr_last_error());
+      fr_mesh_free(m);
+      fr_mesh_init(m);
+      if (fr_import_assimp(path, ext, m) == FR_OK) return fr_mesh_validate(m, path);
+      fr_mesh_free(m);
+      fr_mesh_init(m);
+      return fr_fail(FR_ERR_FORMAT, "%s", why);
+    }
   } else {
     e = fr_import_assimp(path, ext, m);
   }

@@ -1,9 +1,20 @@
 /*
  * Everything that is not PLY or OBJ goes through Assimp's C API (glTF, FBX,
- * 3DS, ...). Meshes are flattened with their node transforms; triangle numbers
- * follow Assimp's mesh order. A .zst file is inflated and handed over from
- * memory (formats with external buffers then need the uncompressed file).
+ * 3DS, ...). Meshes are flattened with their node transforms; triangle
+ * numbers follow the node tree, depth first, each node's meshes in order.
+ *
+ * Assimp runs in a child process: an untrusted file must not take the
+ * process down, and some files crash Assimp, abort in its assertions, loop,
+ * or make it allocate what their headers claim. The child reads the scene
+ * through a file system confined to the scene's folder (io/assimp_files.h),
+ * under limits on memory and time, and sends the mesh back through a pipe;
+ * a child that dies is a one-line error. A .zst file is inflated and handed
+ * over from memory (formats with external buffers then need the
+ * uncompressed file).
  */
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
 #include <stdio.h>
 #include <assimp/cimport.h>
 #include <assimp/material.h>
@@ -11,9 +22,28 @@
 #include <assimp/scene.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include "base/error.h"
+#include "io/assimp_files.h"
 #include "io/file_read.h"
 #include "io/import.h"
+
+/* The child's allowance: this much time, and memory beyond what the process
+ * already maps of this many bytes plus a multiple of the file's size. */
+#define ASSIMP_SECONDS 120
+#define ASSIMP_MEMORY_BASE ((size_t)1 << 30)
+#define ASSIMP_MEMORY_PER_BYTE 64u
+
+#if defined(__SANITIZE_ADDRESS__)
+#define FR_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define FR_ASAN 1
+#endif
+#endif
 
 /* key, type, index: the triple Assimp's AI_MATKEY_* macros expand to */
 static void copy_color(const struct aiMaterial *am, const char *key, unsigned type, unsigned index, float out[3]) {
@@ -21,17 +51,64 @@ static void copy_color(const struct aiMaterial *am, const char *key, unsigned ty
   if (aiGetMaterialColor(am, key, type, index, &c) == aiReturn_SUCCESS) { out[0] = c.r; out[1] = c.g; out[2] = c.b; }
 }
 
+/* One mesh, its vertices moved by the node transform t (NULL: none). */
+static fr_error add_mesh(const struct aiMesh *am, const struct aiMatrix4x4 *t, uint32_t mat, fr_mesh *m) {
+  if (m->nverts + am->mNumVertices >= 0xFFFFFFF0u) return fr_fail(FR_ERR_UNSUPPORTED, "too many vertices");
+  if ((am->mNumVertices && !am->mVertices) || (am->mNumFaces && !am->mFaces)) return FR_OK; /* nothing to read */
+  const uint32_t base = (uint32_t)m->nverts;
+  fr_error e = FR_OK;
+  for (unsigned v = 0; v < am->mNumVertices && !e; v++) {
+    struct aiVector3D p = am->mVertices[v];
+    if (t) aiTransformVecByMatrix4(&p, t);
+    e = fr_mesh_add_vertex(m, p.x, p.y, p.z);
+  }
+  for (unsigned f = 0; f < am->mNumFaces && !e; f++) {
+    const struct aiFace *face = &am->mFaces[f];
+    for (unsigned j = 2; j < face->mNumIndices && face->mIndices && !e; j++)
+      e = fr_mesh_add_triangle(m, base + face->mIndices[0], base + face->mIndices[j - 1], base + face->mIndices[j], mat);
+  }
+  return e;
+}
+
+/* The meshes of node and its children, each moved by its nodes' transforms
+ * (parent times child), as Assimp's PreTransformVertices step would, which
+ * asserts on some files. */
+#define MAX_NODE_DEPTH 256
+static fr_error add_node(const struct aiScene *sc, const struct aiNode *node, const struct aiMatrix4x4 *parent,
+                         const uint32_t *matmap, fr_mesh *m, int depth) {
+  if (depth > MAX_NODE_DEPTH) return fr_fail(FR_ERR_FORMAT, "scene nodes nested deeper than %d", MAX_NODE_DEPTH);
+  struct aiMatrix4x4 t = node->mTransformation;
+  if (parent) {
+    struct aiMatrix4x4 p = *parent;
+    aiMultiplyMatrix4(&p, &node->mTransformation);
+    t = p;
+  }
+  fr_error e = FR_OK;
+  for (unsigned i = 0; i < node->mNumMeshes && node->mMeshes && !e; i++) {
+    if (node->mMeshes[i] >= sc->mNumMeshes || !sc->mMeshes[node->mMeshes[i]]) return fr_fail(FR_ERR_FORMAT, "a node names mesh %u of %u", node->mMeshes[i], sc->mNumMeshes);
+    const struct aiMesh *am = sc->mMeshes[node->mMeshes[i]];
+    const uint32_t mat = am->mMaterialIndex < sc->mNumMaterials ? matmap[am->mMaterialIndex] : FR_INVALID_ID;
+    e = add_mesh(am, &t, mat, m);
+  }
+  /* Assimp's importers are not all consistent: counts can exceed the
+   * pointers behind them (its RAW reader leaves children NULL) */
+  for (unsigned c = 0; c < node->mNumChildren && node->mChildren && !e; c++)
+    if (node->mChildren[c]) e = add_node(sc, node->mChildren[c], &t, matmap, m, depth + 1);
+  return e;
+}
+
 static fr_error convert(const struct aiScene *sc, fr_mesh *m) {
   uint32_t *matmap = calloc(sc->mNumMaterials + 1, sizeof(uint32_t));
   if (!matmap) return fr_fail(FR_ERR_NOMEM, "out of memory");
   for (unsigned i = 0; i < sc->mNumMaterials; i++) {
-    const struct aiMaterial *am = sc->mMaterials[i];
+    const struct aiMaterial *am = sc->mMaterials ? sc->mMaterials[i] : NULL;
     struct aiString name;
     char nm[64];
-    if (aiGetMaterialString(am, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS) snprintf(nm, sizeof nm, "%s", name.data);
+    if (am && aiGetMaterialString(am, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS) snprintf(nm, sizeof nm, "%s", name.data);
     else snprintf(nm, sizeof nm, "material_%u", i);
     fr_error e = fr_mesh_material(m, nm, &matmap[i]);
     if (e) { free(matmap); return e; }
+    if (!am) continue;
     fr_material *fm = &m->mats[matmap[i]];
     copy_color(am, AI_MATKEY_COLOR_DIFFUSE, fm->diffuse);
     copy_color(am, AI_MATKEY_COLOR_SPECULAR, fm->specular);
@@ -43,40 +120,171 @@ static fr_error convert(const struct aiScene *sc, fr_mesh *m) {
     one = 1;
     if (aiGetMaterialFloatArray(am, AI_MATKEY_REFRACTI, &f, &one) == aiReturn_SUCCESS) fm->ior = f;
   }
-  fr_error e = FR_OK;
-  for (unsigned i = 0; i < sc->mNumMeshes && !e; i++) {
-    const struct aiMesh *am = sc->mMeshes[i];
-    if (m->nverts + am->mNumVertices >= 0xFFFFFFF0u) { e = fr_fail(FR_ERR_UNSUPPORTED, "too many vertices"); break; }
-    uint32_t base = (uint32_t)m->nverts;
-    for (unsigned v = 0; v < am->mNumVertices && !e; v++)
-      e = fr_mesh_add_vertex(m, am->mVertices[v].x, am->mVertices[v].y, am->mVertices[v].z);
-    uint32_t mat = am->mMaterialIndex < sc->mNumMaterials ? matmap[am->mMaterialIndex] : FR_INVALID_ID;
-    for (unsigned f = 0; f < am->mNumFaces && !e; f++) {
-      const struct aiFace *face = &am->mFaces[f];
-      for (unsigned j = 2; j < face->mNumIndices && !e; j++)
-        e = fr_mesh_add_triangle(m, base + face->mIndices[0], base + face->mIndices[j - 1], base + face->mIndices[j], mat);
-    }
-  }
+  fr_error e = sc->mRootNode ? add_node(sc, sc->mRootNode, NULL, matmap, m, 0) : FR_OK;
   free(matmap);
   return e;
 }
 
-fr_error fr_import_assimp(const char *path, const char *ext, fr_mesh *m) {
-  unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType;
-  const struct aiScene *sc;
-  if (fr_has_suffix(path, ".zst")) {
-    char *data;
-    size_t size;
-    fr_error e = fr_read_file(path, &data, &size);
-    if (e) return e;
-    if (size > 0xFFFFFFFFu) { free(data); return fr_fail(FR_ERR_UNSUPPORTED, "%s: too large for Assimp", path); }
-    sc = aiImportFileFromMemory(data, (unsigned)size, flags, ext);
-    free(data);
-  } else {
-    sc = aiImportFile(path, flags);
+/* The import itself, in the child. */
+static const struct aiScene *import_scene(const char *path, const char *ext) {
+  unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType;
+  if (!fr_has_suffix(path, ".zst")) {
+    struct aiFileIO io;
+    fr_assimp_files(&io, path);
+    return aiImportFileEx(path, flags, &io);
   }
-  if (!sc) return fr_fail(FR_ERR_FORMAT, "%s: %s", path, aiGetErrorString());
-  fr_error e = convert(sc, m);
-  aiReleaseImport(sc);
+  char *data;
+  size_t size;
+  if (fr_read_file(path, &data, &size)) return NULL;
+  const struct aiScene *sc = size <= 0xFFFFFFFFu ? aiImportFileFromMemory(data, (unsigned)size, flags, ext) : NULL;
+  free(data);
+  return sc;
+}
+
+/* The pipe's records: a status, then the message or the mesh. */
+static int put(int fd, const void *p, size_t n) {
+  const char *c = p;
+  while (n) {
+    ssize_t w = write(fd, c, n);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) return 0;
+    c += w;
+    n -= (size_t)w;
+  }
+  return 1;
+}
+
+static int get(int fd, void *p, size_t n) {
+  char *c = p;
+  while (n) {
+    ssize_t r = read(fd, c, n);
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) return 0;
+    c += r;
+    n -= (size_t)r;
+  }
+  return 1;
+}
+
+static void send_mesh(int fd, fr_error e, const fr_mesh *m) {
+  const int32_t status = (int32_t)e;
+  if (!put(fd, &status, sizeof status)) return;
+  if (e) {
+    const char *msg = fr_last_error();
+    const uint32_t n = (uint32_t)strlen(msg);
+    if (put(fd, &n, sizeof n)) put(fd, msg, n);
+    return;
+  }
+  const uint64_t counts[3] = {m->nverts, m->ntris, m->nmats};
+  const uint8_t has_mat = m->mat != NULL;
+  if (put(fd, counts, sizeof counts) && put(fd, &has_mat, 1) && put(fd, m->pos, m->nverts * 3 * sizeof(float)) &&
+      put(fd, m->idx, m->ntris * 3 * sizeof(uint32_t)) && (!has_mat || put(fd, m->mat, m->ntris * sizeof(uint32_t))))
+    put(fd, m->mats, m->nmats * sizeof(fr_material));
+}
+
+static void limit_child(size_t file_bytes) {
+  alarm(ASSIMP_SECONDS); /* a child that blocks */
+  struct rlimit cpu = {ASSIMP_SECONDS, ASSIMP_SECONDS + 1};
+  setrlimit(RLIMIT_CPU, &cpu); /* a child that spins */
+#ifndef FR_ASAN /* AddressSanitizer's shadow memory would not fit */
+  long pages = 0;
+  FILE *f = fopen("/proc/self/statm", "r");
+  if (f) {
+    if (fscanf(f, "%ld", &pages) != 1) pages = 0;
+    fclose(f);
+  }
+  const size_t mapped = (size_t)pages * (size_t)sysconf(_SC_PAGESIZE);
+  const size_t allow = ASSIMP_MEMORY_BASE + (file_bytes < ((size_t)1 << 34) ? file_bytes * ASSIMP_MEMORY_PER_BYTE
+                                                                            : ((size_t)1 << 40));
+  struct rlimit as = {mapped + allow, mapped + allow};
+  setrlimit(RLIMIT_AS, &as);
+#endif
+}
+
+static _Noreturn void run_child(int fd, const char *path, const char *ext) {
+  const int devnull = open("/dev/null", O_WRONLY);
+  if (devnull >= 0) { dup2(devnull, 1); dup2(devnull, 2); } /* Assimp's chatter is not ours */
+  struct stat st;
+  limit_child(stat(path, &st) == 0 && st.st_size > 0 ? (size_t)st.st_size : 0);
+  fr_mesh m;
+  fr_mesh_init(&m);
+  const struct aiScene *sc = import_scene(path, ext);
+  fr_error e = sc ? convert(sc, &m) : fr_fail(FR_ERR_FORMAT, "%s: %s", path, aiGetErrorString());
+  send_mesh(fd, e, &m);
+  _exit(0);
+}
+
+/* The mesh from the pipe, read as it comes, so that memory follows what the
+ * child really sent. *broke: the pipe ended early (the child died). */
+static fr_error receive_mesh(int fd, const char *path, fr_mesh *m, int *broke) {
+#define BROKE (*broke = 1, FR_ERR_IO)
+  int32_t status;
+  if (!get(fd, &status, sizeof status)) return BROKE;
+  if (status) {
+    uint32_t n = 0;
+    char msg[512] = "";
+    if (get(fd, &n, sizeof n) && n < sizeof msg) get(fd, msg, n);
+    return fr_fail((fr_error)status, "%s", msg[0] ? msg : "Assimp could not read the file");
+  }
+  uint64_t counts[3];
+  uint8_t has_mat;
+  if (!get(fd, counts, sizeof counts) || !get(fd, &has_mat, 1)) return BROKE;
+  if (counts[0] > 0xFFFFFFF0u || counts[1] > 0xFFFFFFF0u || counts[2] > 0xFFFFFFu)
+    return fr_fail(FR_ERR_FORMAT, "%s: too large", path);
+  for (uint64_t i = 0; i < counts[0]; i++) {
+    float v[3];
+    if (!get(fd, v, sizeof v)) return BROKE;
+    fr_error e = fr_mesh_add_vertex(m, v[0], v[1], v[2]);
+    if (e) return e;
+  }
+  uint32_t *idx = malloc(counts[1] ? counts[1] * 3 * sizeof *idx : 1), *mat = NULL;
+  if (!idx) return fr_fail(FR_ERR_NOMEM, "%s: out of memory", path);
+  fr_error e = get(fd, idx, counts[1] * 3 * sizeof *idx) ? FR_OK : BROKE;
+  if (!e && has_mat && !(mat = malloc(counts[1] ? counts[1] * sizeof *mat : 1))) e = fr_fail(FR_ERR_NOMEM, "out of memory");
+  if (!e && has_mat && !get(fd, mat, counts[1] * sizeof *mat)) e = BROKE;
+  for (uint64_t i = 0; i < counts[2] && !e; i++) {
+    fr_material fm;
+    uint32_t k;
+    if (!get(fd, &fm, sizeof fm)) { e = BROKE; break; }
+    fm.name[sizeof fm.name - 1] = 0;
+    if (!(e = fr_mesh_material(m, fm.name, &k))) m->mats[k] = fm;
+  }
+  for (uint64_t t = 0; t < counts[1] && !e; t++)
+    e = fr_mesh_add_triangle(m, idx[3 * t], idx[3 * t + 1], idx[3 * t + 2], mat ? mat[t] : FR_INVALID_ID);
+  free(idx);
+  free(mat);
   return e;
+#undef BROKE
+}
+
+fr_error fr_import_assimp(const char *path, const char *ext, fr_mesh *m) {
+  int fd[2];
+  if (pipe(fd)) return fr_fail(FR_ERR_IO, "%s: pipe: %s", path, strerror(errno));
+  fflush(NULL);
+  pid_t pid = fork();
+  if (pid < 0) {
+    close(fd[0]);
+    close(fd[1]);
+    return fr_fail(FR_ERR_NOMEM, "%s: fork: %s", path, strerror(errno));
+  }
+  if (pid == 0) {
+    close(fd[0]);
+    run_child(fd[1], path, ext);
+  }
+  close(fd[1]);
+  int broke = 0;
+  fr_error e = receive_mesh(fd[0], path, m, &broke);
+  close(fd[0]);
+  int st = 0;
+  while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {}
+  if (!broke) return e;
+  fr_mesh_free(m);
+  fr_mesh_init(m);
+  if (WIFSIGNALED(st)) {
+    const int sig = WTERMSIG(st);
+    if (sig == SIGALRM || sig == SIGXCPU)
+      return fr_fail(FR_ERR_FORMAT, "%s: Assimp did not finish within %d s", path, ASSIMP_SECONDS);
+    return fr_fail(FR_ERR_FORMAT, "%s: Assimp failed on this file (%s)", path, strsignal(sig));
+  }
+  return fr_fail(FR_ERR_FORMAT, "%s: Assimp failed on this file", path);
 }

@@ -2,7 +2,8 @@
  * Wavefront OBJ + MTL reader. Faces are fan-triangulated in file order (so
  * triangle numbers match the PLY of the same scene); `usemtl` sets each
  * triangle's material, `mtllib` files are looked up beside the OBJ, also as
- * NAME.zst. Normals, texture coordinates, groups and smoothing are ignored.
+ * NAME.zst, and never outside its folder. Normals, texture coordinates,
+ * groups and smoothing are ignored.
  */
 #include <stdio.h>
 #include <errno.h>
@@ -11,6 +12,7 @@
 #include "base/error.h"
 #include "io/file_read.h"
 #include "io/import.h"
+#include "io/scene_path.h"
 
 #define MAX_POLY 4096
 #define MAX_LINE 65536
@@ -62,18 +64,20 @@ static int keyword(const char *s, size_t len, const char *kw) {
   return len > k && memcmp(s, kw, k) == 0 && (s[k] == ' ' || s[k] == '\t');
 }
 
+/* An MTL is a few kilobytes of text: one larger than this is not one. */
+#define MAX_MTL_BYTES ((size_t)64 << 20)
+
+/* The MTL the OBJ names, beside it (as NAME or NAME.zst), never outside the
+ * OBJ's folder (io/scene_path.h). */
 static void load_mtllib(const char *objpath, const char *name, fr_mesh *m) {
-  char dir[4096], path[8192];
-  snprintf(dir, sizeof dir, "%s", objpath);
-  char *slash = strrchr(dir, '/');
-  if (slash) slash[1] = 0; else dir[0] = 0;
+  char ref[4096], path[8192];
   const char *cands[2] = {"", ".zst"};
   for (int i = 0; i < 2; i++) {
-    snprintf(path, sizeof path, "%s%s%s", dir, name, cands[i]);
-    if (!fr_file_exists(path)) continue;
+    snprintf(ref, sizeof ref, "%s%s", name, cands[i]);
+    if (!fr_scene_ref_path(objpath, ref, path, sizeof path)) continue;
     char *data;
     size_t size;
-    if (fr_read_file(path, &data, &size) == FR_OK) {
+    if (fr_read_file_max(path, MAX_MTL_BYTES, &data, &size) == FR_OK) {
       fr_import_mtl(path, data, size, m); /* a broken MTL leaves default materials */
       free(data);
     }
@@ -131,7 +135,7 @@ fr_error fr_import_obj(const char *path, const char *data, size_t size, fr_mesh 
     } else if (keyword(s, len, "mtllib")) {
       char name[1024];
       parse_name(s + 6, e, name, sizeof name);
-      if (name[0] && !strstr(name, "..")) load_mtllib(path, name, m);
+      if (name[0]) load_mtllib(path, name, m);
     }
     /* vt, vn, g, o, s, l and comments: not needed */
   }

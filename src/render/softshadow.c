@@ -17,12 +17,16 @@ fr_error fr_render_softshadow(const fr_workload *w0, const fr_tracer *t, const f
   fr_workload w = *w0;
   w.kind = FR_WL_SOFT16;
   w.image = NULL;
-  w.light_sets_kind = o->sets;
+  /* Several passes converge to the light's true visibility only if each
+   * pass samples the whole light: with cells sets a pixel's samples stay
+   * in one cell of the light in every pass, and a grid of pixel-sized
+   * errors shows through the unfiltered average. */
+  const int passes = o->samples / 16;
+  w.light_sets_kind = passes > 1 ? FR_LIGHT_SETS_SPREAD : o->sets;
   w.gbuf_vis = vis; w.gbuf_depth = depth; w.gbuf_normal = normal; w.gbuf_albedo = albedo;
   memset(acc, 0, np * sizeof(float));
   double t0 = fr_seconds();
   uint64_t rays = 0;
-  int passes = o->samples / 16;
   for (int p = 0; p < passes; p++) {
     w.seed = w0->seed + (uint64_t)p * 0x9E3779B97F4A7C15ull; /* a new scramble per pass */
     w.progress = w0->progress && passes == 1;

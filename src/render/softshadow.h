@@ -9,9 +9,10 @@
 #include "render/workload.h"
 
 typedef struct fr_softshadow_opts {
-  int samples;          /* per pixel: 16, or a multiple of 16 (passes of 16 averaged, no filter: a reference) */
+  int samples;          /* per pixel: 16, or a multiple of 16 (passes of 16 spread samples averaged, no
+                           filter: converges to the reference) */
   int filter;           /* the discontinuity filter (16 samples only) */
-  fr_light_sets sets;   /* how a 4x4 block's 256 samples are dealt out */
+  fr_light_sets sets;   /* how a 4x4 block's 256 samples are dealt out (16 samples only) */
 } fr_softshadow_opts;
 
 /* image: w->cam.width * height * 3 RGB; vis: the same pixels' visibility
