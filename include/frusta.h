@@ -102,7 +102,12 @@ int fr_scene_geometric_normal(const fr_scene *s, uint32_t prim, const float p[3]
  * "floor"), seen with spd_balls' view. depth 0..5. */
 fr_error fr_scene_builtin_sphereflake(int depth, fr_scene **out);
 
-/* Builds the acceleration structures; must be called before tracing. */
+/* Builds the acceleration structures; must be called before tracing.
+ * Triangles that are degenerate or too small for float arithmetic (edge
+ * cross products that underflow) are left out (fr_scene_skipped_triangles);
+ * a scene reaching beyond FR_MAX_COORDINATE from the origin is refused with
+ * FR_ERR_UNSUPPORTED, rather than traced wrongly. */
+#define FR_MAX_COORDINATE 1e11f
 fr_error fr_scene_commit(fr_scene *s);
 
 size_t fr_scene_triangle_count(const fr_scene *s);

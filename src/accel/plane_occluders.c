@@ -252,7 +252,7 @@ fr_error fr_plane_occluders_find(const fr_mesh *m, fr_plane_occluders *out) {
     for (int a = 0; a < 3; a++)
       if (x[0][a] == x[1][a] && x[1][a] == x[2][a]) {
         /* only triangles the BVH holds: a skipped one would be a gap */
-        if (!fr_mesh_triangle_degenerate(m, t)) pl[n++] = (plane_tri){a, x[0][a] == 0.0f ? 0.0f : x[0][a], (uint32_t)t};
+        if (fr_mesh_triangle_traceable(m, t)) pl[n++] = (plane_tri){a, x[0][a] == 0.0f ? 0.0f : x[0][a], (uint32_t)t};
         break;
       }
   }

@@ -1,5 +1,6 @@
 /* The public scene API: creation, commit (BVH build), queries and tracing. */
 #include "scene.h"
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -167,8 +168,15 @@ static fr_error build_tree(fr_scene *s, fr_build_tree *tree, size_t *count) {
   if (!boxes || !ids) { fr_free_aligned(boxes); fr_free_aligned(ids); return fr_fail(FR_ERR_NOMEM, "out of memory for %zu triangles", m->ntris); }
   size_t n = 0;
   s->bounds = aabb_empty();
+  /* Beyond FR_MAX_COORDINATE the kernels' products of coordinate
+   * differences lose the hits: such a scene is refused rather than traced
+   * wrongly. */
+  float reach = 0.0f;
   for (size_t t = 0; t < m->ntris; t++) {
     if (fr_mesh_triangle_degenerate(m, t)) continue;
+    for (int k = 0; k < 3; k++)
+      for (int a = 0; a < 3; a++) reach = fmaxf(reach, fabsf(m->pos[3 * (size_t)m->idx[3 * t + k] + a]));
+    if (!fr_mesh_triangle_traceable(m, t)) continue;
     aabb b = aabb_empty();
     for (int k = 0; k < 3; k++) b = aabb_grow(b, v3_load(m->pos + 3 * (size_t)m->idx[3 * t + k]));
     boxes[n] = b;
@@ -176,10 +184,17 @@ static fr_error build_tree(fr_scene *s, fr_build_tree *tree, size_t *count) {
     s->bounds = aabb_merge(s->bounds, b);
   }
   *count = n;
+  if (!(reach <= FR_MAX_COORDINATE)) {
+    fr_free_aligned(boxes);
+    fr_free_aligned(ids);
+    return fr_fail(FR_ERR_UNSUPPORTED, "%s: coordinates up to %g; frusta traces scenes within %g of the origin", s->name,
+                   (double)reach, (double)FR_MAX_COORDINATE);
+  }
   if (n == 0 && s->spheres.n == 0) {
     fr_free_aligned(boxes);
     fr_free_aligned(ids);
-    return fr_fail(FR_ERR_FORMAT, "%s: %s", s->name, m->ntris ? "every triangle is degenerate" : "no triangles and no spheres");
+    return fr_fail(FR_ERR_FORMAT, "%s: %s", s->name,
+                   m->ntris ? "every triangle is degenerate or too small to trace" : "no triangles and no spheres");
   }
   /* FRUSTA_PRESPLIT=off|on overrides the choice (below), for measurements
    * and tests */

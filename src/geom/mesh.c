@@ -90,6 +90,17 @@ fr_error fr_mesh_validate(const fr_mesh *m, const char *what) {
   return FR_OK;
 }
 
+int fr_mesh_triangle_traceable(const fr_mesh *m, size_t tri) {
+  if (fr_mesh_triangle_degenerate(m, tri)) return 0;
+  const uint32_t *t = m->idx + 3 * tri;
+  const float *a = m->pos + 3 * (size_t)t[0], *b = m->pos + 3 * (size_t)t[1], *c = m->pos + 3 * (size_t)t[2];
+  float e1[3], e2[3];
+  for (int k = 0; k < 3; k++) { e1[k] = b[k] - a[k]; e2[k] = c[k] - a[k]; }
+  const float n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+  const int zero = n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f;
+  return !zero && isfinite(n[0]) && isfinite(n[1]) && isfinite(n[2]);
+}
+
 int fr_mesh_triangle_degenerate(const fr_mesh *m, size_t tri) {
   const uint32_t *t = m->idx + 3 * tri;
   const float *a = m->pos + 3 * (size_t)t[0], *b = m->pos + 3 * (size_t)t[1], *c = m->pos + 3 * (size_t)t[2];

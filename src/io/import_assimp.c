@@ -9,8 +9,7 @@
  * through a file system confined to the scene's folder (io/assimp_files.h),
  * under limits on memory and time, and sends the mesh back through a pipe;
  * a child that dies is a one-line error. A .zst file is inflated and handed
- * over from memory (formats with external buffers then need the
- * uncompressed file).
+ * to Assimp from memory under the name without .zst.
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -128,16 +127,23 @@ static fr_error convert(const struct aiScene *sc, fr_mesh *m) {
 /* The import itself, in the child. */
 static const struct aiScene *import_scene(const char *path, const char *ext) {
   unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType;
+  struct aiFileIO io;
+  fr_assimp_fs fs = {path, path, NULL, 0};
   if (!fr_has_suffix(path, ".zst")) {
-    struct aiFileIO io;
-    fr_assimp_files(&io, path);
+    fr_assimp_files(&io, &fs);
     return aiImportFileEx(path, flags, &io);
   }
-  char *data;
+  /* a .zst: Assimp opens the inflated bytes by the name without .zst (its
+   * extension picks the importer); what they name still resolves inside
+   * the scene's folder */
+  char *data, name[4096];
   size_t size;
   if (fr_read_file(path, &data, &size)) return NULL;
-  const struct aiScene *sc = size <= 0xFFFFFFFFu ? aiImportFileFromMemory(data, (unsigned)size, flags, ext) : NULL;
-  free(data);
+  snprintf(name, sizeof name, "%.*s", (int)(strlen(path) - 4), path);
+  fs = (fr_assimp_fs){path, name, data, size};
+  fr_assimp_files(&io, &fs);
+  const struct aiScene *sc = aiImportFileEx(name, flags, &io);
+  free(data); /* the child ends soon after; Assimp holds no pointer into it */
   return sc;
 }
 

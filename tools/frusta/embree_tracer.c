@@ -380,7 +380,7 @@ fr_error ebr_builder_sah(const fr_scene *s, int threads, int quality, double *sa
   const uint32_t *ix = fr_scene_indices(s);
   aabb root = aabb_empty();
   for (size_t t = 0; t < nt; t++) {
-    if (fr_mesh_triangle_degenerate(&s->mesh, t)) continue; /* the triangles frusta builds over, no more */
+    if (!fr_mesh_triangle_traceable(&s->mesh, t)) continue; /* the triangles frusta builds over, no more */
     aabb b = aabb_empty();
     for (int k = 0; k < 3; k++) b = aabb_grow(b, v3_load(v + 3 * (size_t)ix[3 * t + k]));
     prims[n] = (struct RTCBuildPrimitive){b.lo.x, b.lo.y, b.lo.z, 0, b.hi.x, b.hi.y, b.hi.z, (unsigned)t};
