@@ -17,7 +17,7 @@ fi
 FUZZ_SECONDS="${FRUSTA_FUZZ_SECONDS:-60}"
 if [ "$FUZZ_SECONDS" != 0 ]; then
   FUZZ="${FRUSTA_FUZZ_DIR:-build-fuzz}"
-  CC=clang cmake -S . -B "$FUZZ" -DCMAKE_BUILD_TYPE=Release -DFRUSTA_FUZZ=ON >/dev/null
+  CC=clang CXX=clang++ cmake -S . -B "$FUZZ" -DCMAKE_BUILD_TYPE=Release -DFRUSTA_FUZZ=ON >/dev/null
   cmake --build "$FUZZ" -j "$(nproc)" --target fuzz_readers >/dev/null
   found=$(mktemp -d)
   trap 'rm -rf "$found" "$found.log"' EXIT

@@ -657,6 +657,10 @@ static void check_shared_scene(const char *path, tally *tl) {
 
 static void shared_scene_one(const char *path, void *ctx) {
   tally *tl = ctx;
+  /* under the sanitizers: the three scenes with planar occluders, fine
+   * shadows and a small tree (kitchen, museum, sibenik), not all fifteen */
+  if (FR_TEST_SANITIZED && !strstr(path, "/kitchen.") && !strstr(path, "/museum.") && !strstr(path, "/sibenik."))
+    return;
   long before = tl->disagree;
   check_shared_scene(path, tl);
   print_message("%s: %ld disagreements so far (+%ld)\n", path, tl->disagree, tl->disagree - before);
@@ -673,7 +677,7 @@ static void shared_scenes(void **state) {
                 tl.planes_left_out);
   assert_true(tl.shafts > 0 && tl.planes_left_out > 0);
   assert_true(tl.planes_only > 0); /* kitchen's table top */
-  assert_true(checked >= 14);
+  assert_true(checked >= 14); /* found, if not all checked */
   assert_true(tl.disagree * 1000 < tl.rays);
 }
 
