@@ -30,9 +30,10 @@ fr_error fr_import(const char *path, fr_mesh *m) {
     if (e) return e;
     e = ext[0] == 'p' ? fr_import_ply(path, data, size, m) : fr_import_obj(path, data, size, m);
     free(data);
-    if (e == FR_ERR_FORMAT) {
-      /* frusta's readers are strict; what Assimp reads of such a file
-       * (a nonstandard header line, say) is still a scene */
+    if (e == FR_ERR_UNSUPPORTED) {
+      /* a construct frusta's strict readers do not read (a nonstandard PLY
+       * header line, say): what Assimp reads of the file is still a scene.
+       * Broken files (lying counts, truncation) are refused at once. */
       char why[512];
       snprintf(why, sizeof why, "%s", fr_last_error());
       fr_mesh_free(m);

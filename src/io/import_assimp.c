@@ -124,8 +124,11 @@ static fr_error convert(const struct aiScene *sc, fr_mesh *m) {
   return e;
 }
 
-/* The import itself, in the child. */
-static const struct aiScene *import_scene(const char *path, const char *ext) {
+/* The import itself, in the child; NULL with *e set where frusta's own
+ * reading failed (a .zst that does not inflate), with *e FR_OK where
+ * Assimp's did. */
+static const struct aiScene *import_scene(const char *path, fr_error *e) {
+  *e = FR_OK;
   unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType;
   struct aiFileIO io;
   fr_assimp_fs fs = {path, path, NULL, 0};
@@ -138,7 +141,7 @@ static const struct aiScene *import_scene(const char *path, const char *ext) {
    * the scene's folder */
   char *data, name[4096];
   size_t size;
-  if (fr_read_file(path, &data, &size)) return NULL;
+  if ((*e = fr_read_file(path, &data, &size))) return NULL;
   snprintf(name, sizeof name, "%.*s", (int)(strlen(path) - 4), path);
   fs = (fr_assimp_fs){path, name, data, size};
   fr_assimp_files(&io, &fs);
@@ -207,15 +210,17 @@ static void limit_child(size_t file_bytes) {
 #endif
 }
 
-static _Noreturn void run_child(int fd, const char *path, const char *ext) {
+static _Noreturn void run_child(int fd, const char *path) {
   const int devnull = open("/dev/null", O_WRONLY);
   if (devnull >= 0) { dup2(devnull, 1); dup2(devnull, 2); } /* Assimp's chatter is not ours */
   struct stat st;
   limit_child(stat(path, &st) == 0 && st.st_size > 0 ? (size_t)st.st_size : 0);
   fr_mesh m;
   fr_mesh_init(&m);
-  const struct aiScene *sc = import_scene(path, ext);
-  fr_error e = sc ? convert(sc, &m) : fr_fail(FR_ERR_FORMAT, "%s: %s", path, aiGetErrorString());
+  fr_error e;
+  const struct aiScene *sc = import_scene(path, &e);
+  if (sc) e = convert(sc, &m);
+  else if (!e) e = fr_fail(FR_ERR_FORMAT, "%s: %s", path, aiGetErrorString());
   send_mesh(fd, e, &m);
   _exit(0);
 }
@@ -275,7 +280,7 @@ fr_error fr_import_assimp(const char *path, const char *ext, fr_mesh *m) {
   }
   if (pid == 0) {
     close(fd[0]);
-    run_child(fd[1], path, ext);
+    run_child(fd[1], path);
   }
   close(fd[1]);
   int broke = 0;

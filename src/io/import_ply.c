@@ -100,7 +100,7 @@ static fr_error parse_header(const char *path, const char *data, size_t size, el
     if (strcmp(w[0], "format") == 0 && nw >= 2) {
       *format = strcmp(w[1], "ascii") == 0 ? F_ASCII : strcmp(w[1], "binary_little_endian") == 0 ? F_LE
               : strcmp(w[1], "binary_big_endian") == 0 ? F_BE : -2;
-      if (*format == -2) return fr_fail(FR_ERR_FORMAT, "%s: unknown PLY format '%s'", path, w[1]);
+      if (*format == -2) return fr_fail(FR_ERR_UNSUPPORTED, "%s: unknown PLY format '%s'", path, w[1]);
     } else if (strcmp(w[0], "element") == 0 && nw >= 3) {
       if (*nelems == MAX_ELEMS) return fr_fail(FR_ERR_UNSUPPORTED, "%s: more than %d PLY elements", path, MAX_ELEMS);
       elem *e = &elems[(*nelems)++];
@@ -125,15 +125,15 @@ static fr_error parse_header(const char *path, const char *data, size_t size, el
         pr->count_type = parse_type(w[2]);
         pr->type = parse_type(w[3]);
         if (pr->count_type == T_BAD || pr->type == T_BAD || pr->count_type == T_F32 || pr->count_type == T_F64)
-          return fr_fail(FR_ERR_FORMAT, "%s: bad PLY list types '%s %s'", path, w[2], w[3]);
+          return fr_fail(FR_ERR_UNSUPPORTED, "%s: PLY list types '%s %s'", path, w[2], w[3]);
         snprintf(pr->name, sizeof pr->name, "%s", name);
       } else {
         pr->type = parse_type(w[1]);
-        if (pr->type == T_BAD) return fr_fail(FR_ERR_FORMAT, "%s: unknown PLY type '%s'", path, w[1]);
+        if (pr->type == T_BAD) return fr_fail(FR_ERR_UNSUPPORTED, "%s: unknown PLY type '%s'", path, w[1]);
         snprintf(pr->name, sizeof pr->name, "%s", w[2]);
       }
     } else {
-      return fr_fail(FR_ERR_FORMAT, "%s: unexpected PLY header line '%.40s'", path, line);
+      return fr_fail(FR_ERR_UNSUPPORTED, "%s: unexpected PLY header line '%.40s'", path, line);
     }
   }
   if (*format < 0) return fr_fail(FR_ERR_FORMAT, "%s: PLY header has no format line", path);
