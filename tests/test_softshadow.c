@@ -40,17 +40,8 @@ static quality compare(const float *vis, const float *ref, const float *img) {
 static void converge(const char *rel) {
   char path[1024];
   shared_scene_path(path, sizeof path, rel);
-  fr_scene *s;
-  if (fr_scene_load(path, &s) != FR_OK) fail_msg("%s: %s", path, fr_last_error());
-  assert_int_equal(fr_scene_commit(s), FR_OK);
   fr_workload w;
-  memset(&w, 0, sizeof w);
-  w.scene = s;
-  assert_true(fr_view_lookup(s->name, &w.view));
-  assert_int_equal(fr_camera_setup(&w.cam, w.view.eye, w.view.at, w.view.up, w.view.fov, SZ, SZ), FR_OK);
-  float lo[3], hi[3];
-  fr_scene_bounds(s, lo, hi);
-  w.eps = 1e-4f * v3_len(v3_sub(v3_load(hi), v3_load(lo)));
+  fr_scene *s = shared_workload(path, SZ, &w);
   w.threads = 2;
   fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
   fr_tracer t = fr_tracer_mft(&mctx);

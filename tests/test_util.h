@@ -16,6 +16,8 @@
 #include "base/vec3.h"
 #include "frusta.h"
 #include "api/scene.h"
+#include "render/views.h"
+#include "render/workload.h"
 
 /* Under the sanitizers (several times slower) the slowest tests check
  * fewer random cases and smaller images: FR_TEST_ROUNDS(n) of them. */
@@ -77,6 +79,23 @@ typedef struct mesh_ref { const float *pos; const uint32_t *idx; size_t nt; } me
 static inline mesh_ref scene_mesh(const fr_scene *s) {
   mesh_ref m = {fr_scene_vertices(s), fr_scene_indices(s), fr_scene_triangle_count(s)};
   return m;
+}
+
+/* The committed scene at path and a workload on it from the scene's own
+ * view at size x size (eps as workloads.md sets it); the caller releases
+ * the scene. */
+static inline fr_scene *shared_workload(const char *path, int size, fr_workload *w) {
+  fr_scene *s;
+  if (fr_scene_load(path, &s) != FR_OK) fail_msg("%s: %s", path, fr_last_error());
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  memset(w, 0, sizeof *w);
+  w->scene = s;
+  assert_true(fr_view_lookup(s->name, &w->view));
+  assert_int_equal(fr_camera_setup(&w->cam, w->view.eye, w->view.at, w->view.up, w->view.fov, size, size), FR_OK);
+  float lo[3], hi[3];
+  fr_scene_bounds(s, lo, hi);
+  w->eps = 1e-4f * v3_len(v3_sub(v3_load(hi), v3_load(lo)));
+  return s;
 }
 
 /* A random point of a random triangle of m. */

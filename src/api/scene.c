@@ -176,7 +176,7 @@ static fr_error build_tree(fr_scene *s, fr_build_tree *tree, size_t *count) {
     if (fr_mesh_triangle_degenerate(m, t)) continue;
     for (int k = 0; k < 3; k++)
       for (int a = 0; a < 3; a++) reach = fmaxf(reach, fabsf(m->pos[3 * (size_t)m->idx[3 * t + k] + a]));
-    if (!fr_mesh_triangle_traceable(m, t)) continue;
+    if (!fr_mesh_triangle_resolvable(m, t)) continue;
     aabb b = aabb_empty();
     for (int k = 0; k < 3; k++) b = aabb_grow(b, v3_load(m->pos + 3 * (size_t)m->idx[3 * t + k]));
     boxes[n] = b;

@@ -91,7 +91,10 @@ fr_error fr_mesh_validate(const fr_mesh *m, const char *what) {
 }
 
 int fr_mesh_triangle_traceable(const fr_mesh *m, size_t tri) {
-  if (fr_mesh_triangle_degenerate(m, tri)) return 0;
+  return !fr_mesh_triangle_degenerate(m, tri) && fr_mesh_triangle_resolvable(m, tri);
+}
+
+int fr_mesh_triangle_resolvable(const fr_mesh *m, size_t tri) {
   const uint32_t *t = m->idx + 3 * tri;
   const float *a = m->pos + 3 * (size_t)t[0], *b = m->pos + 3 * (size_t)t[1], *c = m->pos + 3 * (size_t)t[2];
   float e1[3], e2[3];

@@ -27,8 +27,10 @@ void fr_material_default(fr_material *mat, const char *name);
 fr_error fr_mesh_validate(const fr_mesh *m, const char *what);
 /* Twice-area test in double: zero-area triangles never enter the BVH. */
 int fr_mesh_triangle_degenerate(const fr_mesh *m, size_t tri);
-/* Whether the kernels can trace the triangle: not degenerate, and its edge
- * cross product, in float as the kernels form it, neither zero (a triangle
- * of denormal size) nor infinite. Triangles that fail never enter the BVH. */
+/* Whether float arithmetic resolves a triangle that is not degenerate: its
+ * edge cross product, in float as the kernels form it, is neither zero (a
+ * triangle of denormal size) nor infinite. */
+int fr_mesh_triangle_resolvable(const fr_mesh *m, size_t tri);
+/* Not degenerate and resolvable: triangles that fail never enter the BVH. */
 int fr_mesh_triangle_traceable(const fr_mesh *m, size_t tri);
 #endif

@@ -6,6 +6,16 @@
 #include "base/timer.h"
 #include "render/shadow_filter.h"
 
+fr_softshadow_opts fr_softshadow_used(const fr_softshadow_opts *o) {
+  fr_softshadow_opts u = *o;
+  /* Several passes converge to the light's true visibility only if each
+   * pass samples the whole light: with cells sets a pixel's samples stay
+   * in one cell of the light in every pass, and a grid of pixel-sized
+   * errors shows through the unfiltered average. */
+  if (u.samples > 16) { u.sets = FR_LIGHT_SETS_SPREAD; u.filter = 0; }
+  return u;
+}
+
 fr_error fr_render_softshadow(const fr_workload *w0, const fr_tracer *t, const fr_softshadow_opts *o, float *image,
                               float *vis_out, fr_workload_result *res) {
   if (o->samples < 16 || o->samples % 16) return fr_fail(FR_ERR_ARG, "light samples must be a multiple of 16, not %d", o->samples);
@@ -17,12 +27,9 @@ fr_error fr_render_softshadow(const fr_workload *w0, const fr_tracer *t, const f
   fr_workload w = *w0;
   w.kind = FR_WL_SOFT16;
   w.image = NULL;
-  /* Several passes converge to the light's true visibility only if each
-   * pass samples the whole light: with cells sets a pixel's samples stay
-   * in one cell of the light in every pass, and a grid of pixel-sized
-   * errors shows through the unfiltered average. */
-  const int passes = o->samples / 16;
-  w.light_sets_kind = passes > 1 ? FR_LIGHT_SETS_SPREAD : o->sets;
+  const fr_softshadow_opts used = fr_softshadow_used(o);
+  const int passes = used.samples / 16;
+  w.light_sets_kind = used.sets;
   w.gbuf_vis = vis; w.gbuf_depth = depth; w.gbuf_normal = normal; w.gbuf_albedo = albedo;
   memset(acc, 0, np * sizeof(float));
   double t0 = fr_seconds();
@@ -34,7 +41,7 @@ fr_error fr_render_softshadow(const fr_workload *w0, const fr_tracer *t, const f
     for (size_t i = 0; i < np; i++) acc[i] += vis[i];
   }
   for (size_t i = 0; i < np; i++) acc[i] /= (float)passes;
-  if (o->filter && passes == 1) fr_filter_visibility(acc, depth, normal, W, H, vis);
+  if (used.filter) fr_filter_visibility(acc, depth, normal, W, H, vis);
   else memcpy(vis, acc, np * sizeof(float));
   vec3 centre = v3_add(w.view.area_c, v3_scale(v3_add(w.view.area_e1, w.view.area_e2), 0.5f));
   for (int y = 0; y < H; y++)

@@ -15,6 +15,10 @@ typedef struct fr_softshadow_opts {
   fr_light_sets sets;   /* how a 4x4 block's 256 samples are dealt out (16 samples only) */
 } fr_softshadow_opts;
 
+/* The options a render with o really uses: more than 16 samples take
+ * unfiltered passes of spread samples. */
+fr_softshadow_opts fr_softshadow_used(const fr_softshadow_opts *o);
+
 /* image: w->cam.width * height * 3 RGB; vis: the same pixels' visibility
  * (may be NULL). w->kind, image and gbuf fields are ignored. Returns the rays
  * and seconds of all passes (the filter and shading included). */

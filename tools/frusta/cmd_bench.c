@@ -6,6 +6,7 @@
  * a workload, so that every run samples the same stretches of a host whose
  * speed drifts.
  */
+#include <math.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -162,29 +163,19 @@ static int parse_modes(const char *list, int use_frusta, int use_embree, unsigne
 static void choose_embree_variant(const fr_workload *w, ebr_scene *e, bench_run *r, int flag, int packing) {
   const int runs16 = w->kind == FR_WL_SOFT16 || w->kind == FR_WL_AO16;
   const int grouped = r->mode != EBR_SINGLE;
-  double best[EBR_FLAG_COUNT][EBR_PACK_COUNT];
-  int use[EBR_FLAG_COUNT][EBR_PACK_COUNT], n = 0;
-  for (int f = 0; f < EBR_FLAG_COUNT; f++)
-    for (int p = 0; p < EBR_PACK_COUNT; p++) {
-      use[f][p] = (flag < 0 || flag == f) && (packing < 0 ? p == EBR_PACK_RAYS || (runs16 && grouped) : packing == p);
-      best[f][p] = 1e30;
-      n += use[f][p];
-    }
   r->flag = flag < 0 ? EBR_FLAG_HINT : (ebr_flag)flag;
   r->packing = packing < 0 ? EBR_PACK_RAYS : (ebr_packing)packing;
-  if (n > 1)
-    for (int rep = 0; rep < 2; rep++)
-      for (int f = 0; f < EBR_FLAG_COUNT; f++)
-        for (int p = 0; p < EBR_PACK_COUNT; p++) {
-          if (!use[f][p]) continue;
-          fr_tracer t = ebr_tracer(e, (ebr_mode)r->mode, (ebr_flag)f, (ebr_packing)p);
-          fr_workload_result res = fr_workload_run(w, &t);
-          if (res.seconds < best[f][p]) best[f][p] = res.seconds;
-          if (best[f][p] < best[r->flag][r->packing] || !use[r->flag][r->packing]) {
-            r->flag = (ebr_flag)f;
-            r->packing = (ebr_packing)p;
-          }
-        }
+  double best = INFINITY;
+  const int choices = (flag < 0 ? EBR_FLAG_COUNT : 1) * (packing < 0 && runs16 && grouped ? EBR_PACK_COUNT : 1);
+  for (int rep = 0; choices > 1 && rep < 2; rep++)
+    for (int f = 0; f < EBR_FLAG_COUNT; f++)
+      for (int p = 0; p < EBR_PACK_COUNT; p++) {
+        const int use = (flag < 0 || flag == f) && (packing < 0 ? p == EBR_PACK_RAYS || (runs16 && grouped) : packing == p);
+        if (!use) continue;
+        fr_tracer t = ebr_tracer(e, (ebr_mode)r->mode, (ebr_flag)f, (ebr_packing)p);
+        const double secs = fr_workload_run(w, &t).seconds;
+        if (secs < best) { best = secs; r->flag = (ebr_flag)f; r->packing = (ebr_packing)p; }
+      }
   r->t = ebr_tracer(e, (ebr_mode)r->mode, r->flag, r->packing);
 }
 

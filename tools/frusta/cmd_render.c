@@ -39,10 +39,11 @@ static int render_soft(fr_scene *s, fr_workload *w, const fr_softshadow_opts *so
   fr_workload_result r;
   if (fr_render_softshadow(w, &t, so, img, vis, &r)) { rc = cli_error(1, "%s", fr_last_error()); goto done; }
   if (fr_image_write(out, w->cam.width, w->cam.height, img)) { rc = cli_error(1, "%s", fr_last_error()); goto done; }
+  const fr_softshadow_opts used = fr_softshadow_used(so);
   printf("rendered scene=%s tris=%zu size=%dx%d shade=softshadow light_samples=%d filter=%s light_sets=%s tracer=%s "
          "isa=%s threads=%d rays=%llu seconds=%.3f mrays=%.2f -> %s\n",
-         s->name, fr_scene_triangle_count(s), w->cam.width, w->cam.height, so->samples,
-         so->filter && so->samples == 16 ? "on" : "off", so->sets == FR_LIGHT_SETS_CELLS && so->samples == 16 ? "cells" : "spread", mft ? "mft" : "auto", fr_isa_name(fr_get_isa()), threads,
+         s->name, fr_scene_triangle_count(s), w->cam.width, w->cam.height, used.samples, used.filter ? "on" : "off",
+         used.sets == FR_LIGHT_SETS_CELLS ? "cells" : "spread", mft ? "mft" : "auto", fr_isa_name(fr_get_isa()), threads,
          (unsigned long long)r.rays, r.seconds, (double)r.rays / r.seconds * 1e-6, out);
   if (ref_out) {
     fr_softshadow_opts ro = {256, 0, FR_LIGHT_SETS_SPREAD};
