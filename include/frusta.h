@@ -206,8 +206,9 @@ void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occluded
 /* How fr_intersect_stream, fr_occluded_stream and fr_intersect16 trace: the
  * choice of Table VIII of the MIC paper. Every mode gives the same answers
  * (t, and the triangle up to which of two a ray exactly through their shared
- * edge reports); only speed differs. Set it while no thread traces the
- * scene. */
+ * edge reports; u and v to rounding); only speed differs. Within a mode the
+ * same ray gets the same bits every time, on every thread. Set it while no
+ * thread traces the scene. */
 typedef enum fr_trace_mode {
   FR_TRACE_AUTO,      /* default: coherent groups of 16 as hybrid packets, the rest sorted by
                          octant into hybrid packets or ray streams */

@@ -43,7 +43,7 @@ static void test_agreement(void **st) {
     float t1 = 0, u1 = 0, v1 = 0, t2 = 0, u2 = 0, v2 = 0, t3 = 0, u3 = 0, v3 = 0;
     int h1 = fr_tri_moller(o, d, 0.0f, INFINITY, a, b, c, &t1, &u1, &v1);
     int h2 = fr_tri_shevtsov_test(&rec, o, d, 0.0f, INFINITY, &t2, &u2, &v2);
-    int h3 = fr_tri_watertight(&w, o, 0.0f, INFINITY, a, b, c, &t3, &u3, &v3);
+    int h3 = fr_tri_watertight(&w, o, d, 0.0f, INFINITY, a, b, c, &t3, &u3, &v3);
     if (fabs(m) < 1e-4) continue; /* within rounding of an edge */
     compared++;
     int want = m > 0 && isfinite(tref);
@@ -94,12 +94,12 @@ static void test_degenerate_and_nan(void **st) {
     float t = NAN, u = NAN, v = NAN;
     fr_wt_ray w = fr_wt_setup(d);
     assert_false(fr_tri_moller(o, d, 0.0f, INFINITY, a, b, c, &t, &u, &v));
-    assert_false(fr_tri_watertight(&w, o, 0.0f, INFINITY, a, b, c, &t, &u, &v));
+    assert_false(fr_tri_watertight(&w, o, d, 0.0f, INFINITY, a, b, c, &t, &u, &v));
     /* NaN anywhere: no hit */
     vec3 bad = v3(NAN, 0, 0);
     assert_false(fr_tri_moller(bad, d, 0.0f, INFINITY, v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0), &t, &u, &v));
     fr_wt_ray wn = fr_wt_setup(v3(NAN, 1, 0));
-    assert_false(fr_tri_watertight(&wn, o, 0.0f, INFINITY, v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0), &t, &u, &v));
+    assert_false(fr_tri_watertight(&wn, o, v3(NAN, 1, 0), 0.0f, INFINITY, v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0), &t, &u, &v));
   }
 }
 

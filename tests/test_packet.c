@@ -10,6 +10,7 @@
  */
 #include <string.h>
 #include "geom/tri_shevtsov.h"
+#include "geom/tri_watertight.h"
 #include "io/rayfile.h"
 #include "random_scene.h"
 #include "test_util.h"
@@ -241,8 +242,9 @@ static void test_packets_far(void **st) { (void)st; check_scene(v3(1e4f, -2e4f, 
 static void test_packets_tiny(void **st) { (void)st; check_scene(v3(0.1f, 0.2f, 0.3f), 1e-3f, 23); }
 
 /* The packet leaf test lane by lane against the scalar Shevtsov test
- * (geom/tri_shevtsov.h) on one-triangle scenes: the same hits and the same
- * barycentric bits, at every ISA, with and without the axis-aligned path. */
+ * (geom/tri_shevtsov.h) on one-triangle scenes: the same hits, t as
+ * fr_tri_refine_t makes it from its t, and u and v to rounding, at every
+ * ISA, with and without the axis-aligned path. */
 static void test_leaf_against_scalar(void **st) {
   (void)st;
   fr_rng r = fr_rng_seed(31, 1);
@@ -286,8 +288,11 @@ static void test_leaf_against_scalar(void **st) {
           assert_int_equal(hit, h.prim[i] == 0);
           if (!hit) continue;
           hits++;
-          assert_memory_equal(&u, &h.u[i], sizeof u);
-          assert_memory_equal(&w, &h.v[i], sizeof w);
+          /* t made again from the plane (fr_tri_refine_t), u and v those of its point */
+          float et = fr_tri_refine_t(v3_load(rays[i].org), v3_load(rays[i].dir), 0.0f, INFINITY, v3(v[0], v[1], v[2]),
+                                     v3(v[3], v[4], v[5]), v3(v[6], v[7], v[8]), t);
+          assert_memory_equal(&et, &h.t[i], sizeof et);
+          assert_true(fabsf(u - h.u[i]) <= 1e-4f && fabsf(w - h.v[i]) <= 1e-4f);
         }
       }
     }

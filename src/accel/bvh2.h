@@ -39,18 +39,35 @@ typedef struct fr_bvh2_tri {
   float v0[3], v1[3], v2[3];
   uint32_t prim;
   uint32_t edge_flip;
-  uint32_t pad;
+  uint32_t thin; /* 1: the normal is made in double (fr_bvh2_tri_normal) */
 } __attribute__((aligned(16))) fr_bvh2_tri;
 
 _Static_assert(sizeof(fr_bvh2_tri) == 48, "BVH2 triangle is 48 bytes");
 
-/* The unnormalized normal (v1 - v0) x (v2 - v0), in float: the same bits
- * at every ISA level (no contraction) and in every kernel. */
+/* The unnormalized normal (v1 - v0) x (v2 - v0): in float, the same bits
+ * at every ISA level (no contraction) and in every kernel, except for a
+ * thin triangle, where the float cross product loses the normal's
+ * direction by 2^-24 over the sine of the angle at v0 and with it the
+ * plane's distance (a ray leaving a sliver met it again 1e-3 on): there in
+ * double, rounded once. Thin: that sine under 1 / FR_BVH2_THIN
+ * (fr_bvh2_tri_thin). */
+#define FR_BVH2_THIN 16.0
+static inline void fr_bvh2_tri_normal_exact(const fr_bvh2_tri *r, float n[3]) {
+  double e1[3], e2[3];
+  for (int a = 0; a < 3; a++) { e1[a] = (double)r->v1[a] - r->v0[a]; e2[a] = (double)r->v2[a] - r->v0[a]; }
+  n[0] = (float)(e1[1] * e2[2] - e1[2] * e2[1]);
+  n[1] = (float)(e1[2] * e2[0] - e1[0] * e2[2]);
+  n[2] = (float)(e1[0] * e2[1] - e1[1] * e2[0]);
+}
+uint32_t fr_bvh2_tri_thin(const fr_bvh2_tri *r);
 static inline void fr_bvh2_tri_normal(const fr_bvh2_tri *r, float n[3]) {
+  if (r->thin) {
+    fr_bvh2_tri_normal_exact(r, n);
+    return;
+  }
   vec3 a = v3_load(r->v0), c = v3_cross(v3_sub(v3_load(r->v1), a), v3_sub(v3_load(r->v2), a));
   n[0] = c.x; n[1] = c.y; n[2] = c.z;
 }
-
 /* leaves hold at most this many triangles (the count field has 4 bits) */
 #define FR_BVH2_MAX_LEAF 15
 

@@ -6,6 +6,7 @@
 #include "base/alloc.h"
 #include "base/error.h"
 #include "base/tuning.h"
+#include "geom/tri_watertight.h"
 
 typedef struct conv {
   const fr_build_tree *t;
@@ -36,7 +37,9 @@ static void fill_block(conv *c, fr_tri4 *blk, uint32_t first, uint32_t count) {
         blk->v1[a][l] = c->m->pos[3 * (size_t)ix[1] + a];
         blk->v2[a][l] = c->m->pos[3 * (size_t)ix[2] + a];
       }
-      blk->prim[l] = prim;
+      const int thin = fr_tri_thin(blk->v0[0][l], blk->v0[1][l], blk->v0[2][l], blk->v1[0][l], blk->v1[1][l],
+                                   blk->v1[2][l], blk->v2[0][l], blk->v2[1][l], blk->v2[2][l]);
+      blk->prim[l] = prim | (thin ? FR_TRI4_THIN : 0u);
       fr_tri_shevtsov *rec = &c->b->shev[4 * (size_t)(blk - c->b->tris) + (size_t)l];
       vec3 p0 = v3(blk->v0[0][l], blk->v0[1][l], blk->v0[2][l]);
       vec3 p1 = v3(blk->v1[0][l], blk->v1[1][l], blk->v1[2][l]);

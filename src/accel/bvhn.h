@@ -52,8 +52,14 @@ _Static_assert(sizeof(fr_bvh8_node) == 256, "BVH8 node is four cache lines");
 /* Four triangles; unused lanes hold NaN vertices, which fail every test. */
 typedef struct fr_tri4 {
   float v0[3][4], v1[3][4], v2[3][4];
-  uint32_t prim[4];
+  uint32_t prim[4]; /* the id, | FR_TRI4_THIN for a thin triangle; FR_INVALID_ID in an empty lane */
 } __attribute__((aligned(16))) fr_tri4;
+
+/* A thin triangle's hits take the plane's t in double (fr_tri_thin): the
+ * flag rides in the id's top bit, where the kernels read it with the ids'
+ * sign bits (scenes hold fewer than 2^31 triangles). */
+#define FR_TRI4_THIN 0x80000000u
+#define FR_TRI4_PRIM(id) ((id) == FR_INVALID_ID ? FR_INVALID_ID : (id) & ~FR_TRI4_THIN)
 _Static_assert(offsetof(fr_tri4, v1) == 48 && offsetof(fr_tri4, v2) == 96, "kernels address v1, v2 from v0");
 
 typedef struct fr_bvhn {

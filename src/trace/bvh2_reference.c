@@ -41,7 +41,7 @@ static int traverse(const fr_bvh2 *b, const fr_mesh *m, const fr_ray *ray, fr_hi
         uint32_t prim = b->prims[i];
         vec3 p0 = vertex(m, prim, 0), p1 = vertex(m, prim, 1), p2 = vertex(m, prim, 2);
         float t, u, v;
-        if (!fr_tri_watertight(&w, o, ray->tnear, tfar, p0, p1, p2, &t, &u, &v)) continue;
+        if (!fr_tri_watertight(&w, o, d, ray->tnear, tfar, p0, p1, p2, &t, &u, &v)) continue;
         if (any_hit) return 1;
         found = 1;
         tfar = t;

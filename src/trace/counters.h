@@ -27,7 +27,7 @@
  * 16-ray sphere tests. Single-ray streams' occluder cache: rays that tried
  * their stream's last occluder, and those it occluded (cache_*). */
 #define FR_COUNTER_FIELDS(X)                                                   \
-  X(rays) X(nodes) X(box_tests) X(leaves) X(tri_tests)                         \
+  X(rays) X(nodes) X(box_tests) X(leaves) X(tri_tests) X(tri_hit_tests) X(tri_plane_t) \
   X(packets) X(pk_nodes) X(pk_box_tests) X(pk_box_lanes) X(pk_tri_tests)       \
   X(pk_tri_lanes) X(pk_quad_tests) X(ia_culled) X(mailbox_hits) X(switches) X(switch_rays)    \
   X(mft_batches) X(mft_nodes) X(mft_box_tests) X(mft_box_lanes) X(mft_tris)   \

@@ -109,10 +109,10 @@ static inline void fr_hit_finish(const fr_bvhn *b, const fr_subtree_hit *best, v
   vec3 p1 = v3(blk->v1[0][l], blk->v1[1][l], blk->v1[2][l]);
   vec3 p2 = v3(blk->v2[0][l], blk->v2[1][l], blk->v2[2][l]);
   vec3 ng = v3_cross(v3_sub(p1, p0), v3_sub(p2, p0));
+  hit->prim = FR_TRI4_PRIM(blk->prim[l]);
+  hit->ng[0] = ng.x; hit->ng[1] = ng.y; hit->ng[2] = ng.z;
   hit->u = best->u;
   hit->v = best->v;
-  hit->prim = blk->prim[l];
-  hit->ng[0] = ng.x; hit->ng[1] = ng.y; hit->ng[2] = ng.z;
   hit->t = fr_tri_refine_t(org, dir, tnear, tfar, p0, p1, p2, best->t);
 }
 

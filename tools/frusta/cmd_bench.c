@@ -87,10 +87,10 @@ static void report(const fr_workload *w0, const bench_run *r, const char *scene,
   fr_counters c = r->c;
   if (fr_counters_enabled() && c.rays)
     printf("counters tracer=%s mode=%s workload=%s per_ray nodes=%.2f box_tests=%.2f leaves=%.2f tri_tests=%.2f "
-           "cache_tries=%llu cache_hits=%llu\n",
+           "tri_hit_tests=%.3f tri_plane_t=%.4f cache_tries=%llu cache_hits=%llu\n",
            tracer, mode, fr_workload_name(w0->kind), (double)c.nodes / c.rays, (double)c.box_tests / c.rays,
-           (double)c.leaves / c.rays, (double)c.tri_tests / c.rays, (unsigned long long)c.cache_tries,
-           (unsigned long long)c.cache_hits);
+           (double)c.leaves / c.rays, (double)c.tri_tests / c.rays, (double)c.tri_hit_tests / c.rays,
+           (double)c.tri_plane_t / c.rays, (unsigned long long)c.cache_tries, (unsigned long long)c.cache_hits);
   if (fr_counters_enabled() && c.mft_batches)
     printf("counters tracer=%s mode=%s workload=%s batches=%llu per_batch nodes=%.2f box_tests=%.2f "
            "avg_active_frusta=%.2f tris=%.2f tri_frusta=%.2f tri_frusta_left=%.2f ray_batches=%llu stream_batches=%llu cached_leaves=%llu "

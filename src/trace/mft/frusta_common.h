@@ -316,9 +316,11 @@ FR_INLINE void leaf_edges_shared(const frusta *F, const fr_bvh2_tri *r, uint32_t
   vpf lo[8], hi[8];
   vp_load_records8_rows((const float *)r, 12, (int)count, lo);
   vp_load_records8_rows((const float *)r + 4, 12, (int)count, hi);
-  unsigned flip[3] = {0, 0, 0};
-  for (uint32_t k = 0; k < count; k++)
+  unsigned flip[3] = {0, 0, 0}, thin = 0;
+  for (uint32_t k = 0; k < count; k++) {
     for (int i = 0; i < 3; i++) flip[i] |= ((r[k].edge_flip >> i) & 1u) << k;
+    thin |= r[k].thin << k;
+  }
   vpf V0[3] = {lo[0], lo[1], lo[2]}, V1[3] = {lo[3], lo[4], lo[5]}, V2[3] = {lo[6], lo[7], hi[4]};
   vpf A[3], B[3], C[3], n[3];
   for (int a = 0; a < 3; a++) {
@@ -331,6 +333,15 @@ FR_INLINE void leaf_edges_shared(const frusta *F, const fr_bvh2_tri *r, uint32_t
     fr_cross3v(e1, e2, n);
   }
   for (int a = 0; a < 3; a++) vp_store(L->nrm[a], n[a]);
+  if (__builtin_expect(thin != 0, 0)) { /* fr_bvh2_tri_normal's double path */
+    for (unsigned m = thin; m; m &= m - 1) {
+      const int k = __builtin_ctz(m);
+      float e[3];
+      fr_bvh2_tri_normal_exact(&r[k], e);
+      for (int a = 0; a < 3; a++) L->nrm[a][k] = e[a];
+    }
+    for (int a = 0; a < 3; a++) n[a] = vp_load(L->nrm[a]);
+  }
   vp_store(L->t.det, fr_dot3v(A[0], A[1], A[2], n[0], n[1], n[2]));
   const vpf *ends[3][2] = {{V1, V2}, {V2, V0}, {V0, V1}};
   const vpf *from[3][2] = {{B, C}, {C, A}, {A, B}};

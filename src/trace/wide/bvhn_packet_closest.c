@@ -37,7 +37,16 @@ static _Thread_local fr_hybrid_tune tune_closest;
  * fr_tri_refine_lane in one loop the compiler vectorizes, the normal as
  * v3_cross(p1 - p0, p2 - p0) with the same operations. Misses get
  * fr_hit_miss's values. */
-static void finish(const fr_bvhn *b, const packet *pk, const uint32_t *best, vpf tfar, vpf U, vpf V, hit_regs *h) {
+static inline void fr_cross3(const vpf a[3], const vpf b[3], vpf c[3]) {
+  c[0] = vp_sub(vp_mul(a[1], b[2]), vp_mul(a[2], b[1]));
+  c[1] = vp_sub(vp_mul(a[2], b[0]), vp_mul(a[0], b[2]));
+  c[2] = vp_sub(vp_mul(a[0], b[1]), vp_mul(a[1], b[0]));
+}
+static inline vpf fr_dot3(const vpf a[3], const vpf b[3]) {
+  return vp_add(vp_add(vp_mul(a[0], b[0]), vp_mul(a[1], b[1])), vp_mul(a[2], b[2]));
+}
+
+static void finish(const fr_bvhn *b, const packet *pk, const uint32_t *best, vpf tfar, hit_regs *h) {
   enum { REC = sizeof(fr_tri4) / sizeof(float) };
   _Static_assert(offsetof(fr_tri4, prim) == 36 * sizeof(float), "prim follows the vertices");
   int32_t ix[P] __attribute__((aligned(64)));
@@ -98,29 +107,41 @@ static void finish(const fr_bvhn *b, const packet *pk, const uint32_t *best, vpf
     T[i] = fr_tri_refine_lane(pk->o[0][i], pk->o[1][i], pk->o[2][i], pk->d[0][i], pk->d[1][i], pk->d[2][i], pk->tnear[i],
                               pk->tfar[i], A[0][i], A[1][i], A[2][i], A[3][i], A[4][i], A[5][i], A[6][i], A[7][i],
                               A[8][i], TF[i]);
-  vpf e1[3], e2[3];
+  vpf e1[3], e2[3], w[3];
+  const vpf t = vp_load(T);
   for (int k = 0; k < 3; k++) {
     vpf p0 = vp_load(A[k]);
     e1[k] = vp_sub(vp_load(A[3 + k]), p0);
     e2[k] = vp_sub(vp_load(A[6 + k]), p0);
+    w[k] = vp_add(vp_sub(vp_load(pk->o[k]), p0), vp_mul(t, vp_load(pk->d[k]))); /* the hit point, less p0 */
   }
+  vpf n[3], c[3];
+  fr_cross3(e1, e2, n);
+  /* u and v of the hit point itself, w = u e1 + v e2 (w x e2 = u n, e1 x w
+   * = v n), clamped into the triangle: they depend on the ray and the
+   * triangle only, not on whether the packet or the single-ray phase found
+   * it, so the hybrid's tuning never shows in an answer */
+  const vpf inn = vp_div(vp(1.0f), fr_dot3(n, n));
+  fr_cross3(w, e2, c);
+  vpf u = vp_max(vp_mul(fr_dot3(n, c), inn), zero);
+  fr_cross3(e1, w, c);
+  vpf v = vp_max(vp_mul(fr_dot3(n, c), inn), zero);
+  const vpf sum = vp_max(vp_add(u, v), vp(1.0f));
   vpm m = vpm_bits_to(hit);
-  h->t = vp_select(m, vp_load(T), h->t);
-  h->u = vp_select(m, U, zero);
-  h->v = vp_select(m, V, zero);
-  h->prim = vp_select(m, prim, h->prim);
-  h->ng[0] = vp_select(m, vp_sub(vp_mul(e1[1], e2[2]), vp_mul(e1[2], e2[1])), zero);
-  h->ng[1] = vp_select(m, vp_sub(vp_mul(e1[2], e2[0]), vp_mul(e1[0], e2[2])), zero);
-  h->ng[2] = vp_select(m, vp_sub(vp_mul(e1[0], e2[1]), vp_mul(e1[1], e2[0])), zero);
+  h->t = vp_select(m, t, h->t);
+  h->u = vp_select(m, vp_div(u, sum), zero);
+  h->v = vp_select(m, vp_div(v, sum), zero);
+  h->prim = vp_select(m, vp_and(prim, vp_id(~FR_TRI4_THIN)), h->prim); /* the ids without the thin flag */
+  for (int k = 0; k < 3; k++) h->ng[k] = vp_select(m, n[k], zero);
 }
 
-/* The rays of `active` against leaf ref for their closest hits: TF, UU, VV
- * and B (by lane; ids as float bit patterns, written by memcpy so that no
+/* The rays of `active` against leaf ref for their closest hits: TF and B
+ * (by lane; ids as float bit patterns, written by memcpy so that no
  * access breaks type aliasing) get the new hits, block by block as the
  * single-ray kernel takes them (tri4_nearest: the nearest lane, the first
  * on ties). */
 static void quad_closest(const fr_bvhn *b, uint32_t ref, const quad_rays *q, const packet *pk, unsigned active,
-                         float *TF, float *UU, float *VV, float *B) {
+                         float *TF, float *B) {
   const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
   while (active) {
     quad_group g;
@@ -131,9 +152,8 @@ static void quad_closest(const fr_bvhn *b, uint32_t ref, const quad_rays *q, con
       quad_hit h;
       const unsigned hit = quad_test(&b->tris[first + k], q, &g, live, &h);
       if (!hit) continue;
-      float T[P] __attribute__((aligned(64))), E1[P] __attribute__((aligned(64)));
-      float E2[P] __attribute__((aligned(64))), INV[P] __attribute__((aligned(64)));
-      vp_store(T, h.t); vp_store(E1, h.e1); vp_store(E2, h.e2); vp_store(INV, h.inv);
+      float T[P] __attribute__((aligned(64)));
+      vp_store(T, h.t);
       for (int j = 0; j < g.n; j++) {
         unsigned m = (hit >> (4 * j)) & 0xFu;
         if (!m) continue;
@@ -144,8 +164,6 @@ static void quad_closest(const fr_bvhn *b, uint32_t ref, const quad_rays *q, con
         }
         const int lane = g.lane[j];
         TF[lane] = T[bl];
-        UU[lane] = E1[bl] * INV[bl];
-        VV[lane] = E2[bl] * INV[bl];
         const uint32_t id = 4 * (first + k) + (uint32_t)(bl & 3);
         memcpy(&B[lane], &id, sizeof id);
         g.tfar = vp_select(vpm_bits_to(0xFu << (4 * j)), vp(T[bl]), g.tfar);
@@ -168,7 +186,6 @@ static void intersect_walk(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
   for (int a = 0; a < 3; a++) { R.o[a] = vp_load(pk.o[a]); R.rd[a] = vp_load(pk.rd[a]); }
   R.tnear = vp_load(pk.tnear);
   vpf tfar = vp_select(vpm_bits_to(valid), vp_load(pk.tfar), vp(-INFINITY));
-  vpf U = vp(0.0f), V = vp(0.0f);
   float tmax = INFINITY;
   int tmax_stale = 1;
   mailbox mb;
@@ -202,25 +219,25 @@ static void intersect_walk(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
     if (nactive <= threshold && !(ref & FR_BVHN_LEAF)) {
       FR_COUNT(switches, 1);
       FR_COUNT(switch_rays, nactive);
-      float TF[P] __attribute__((aligned(64))), UU[P] __attribute__((aligned(64))), VV[P] __attribute__((aligned(64)));
+      float TF[P] __attribute__((aligned(64)));
       lane_ids B;
-      vp_store(TF, tfar); vp_store(UU, U); vp_store(VV, V); vp_store(B.f, best);
+      vp_store(TF, tfar); vp_store(B.f, best);
       for (unsigned m = active; m; m &= m - 1) {
         int i = __builtin_ctz(m);
         fr_ray r = lane_ray(&pk, i, TF[i]);
         fr_subtree_hit h;
-        if (o->single->intersect_subtree(b, ref, &r, &h)) { TF[i] = h.t; UU[i] = h.u; VV[i] = h.v; B.u[i] = h.id; }
+        if (o->single->intersect_subtree(b, ref, &r, &h)) { TF[i] = h.t; B.u[i] = h.id; }
       }
-      tfar = vp_load(TF); U = vp_load(UU); V = vp_load(VV); best = vp_load(B.f);
+      tfar = vp_load(TF); best = vp_load(B.f);
       tmax_stale = 1;
       continue;
     }
     if ((ref & FR_BVHN_LEAF) && quad_wanted(o, QUAD_CLOSEST_MOST, &quad, &pk, valid, nactive)) {
-      float TF[P] __attribute__((aligned(64))), UU[P] __attribute__((aligned(64))), VV[P] __attribute__((aligned(64)));
+      float TF[P] __attribute__((aligned(64)));
       lane_ids B;
-      vp_store(TF, tfar); vp_store(UU, U); vp_store(VV, V); vp_store(B.f, best);
-      quad_closest(b, ref, &quad, &pk, active, TF, UU, VV, B.f);
-      tfar = vp_load(TF); U = vp_load(UU); V = vp_load(VV); best = vp_load(B.f);
+      vp_store(TF, tfar); vp_store(B.f, best);
+      quad_closest(b, ref, &quad, &pk, active, TF, B.f);
+      tfar = vp_load(TF); best = vp_load(B.f);
       tmax_stale = 1;
       continue;
     }
@@ -238,8 +255,6 @@ static void intersect_walk(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
         vpm hm = vpm_bits_to(hit);
         tmax_stale = 1;
         tfar = vp_select(hm, t, tfar);
-        U = vp_select(hm, u, U);
-        V = vp_select(hm, v, V);
         best = vp_select(hm, vp_id(4 * li + (uint32_t)j), best);
         /* finish() reads the hit triangles' vertices: start loading them now */
         const char *blk = (const char *)&b->tris[li + (uint32_t)j / 4];
@@ -300,7 +315,7 @@ static void intersect_walk(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
 
   lane_ids B;
   vp_store(B.f, best);
-  finish(b, &pk, B.u, tfar, U, V, out);
+  finish(b, &pk, B.u, tfar, out);
 }
 
 static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in, hit_regs *out) {

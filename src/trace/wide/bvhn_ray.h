@@ -24,6 +24,7 @@ typedef struct ray_pre {
   int kx4, ky4, kz4;          /* 4 * kx...: float offsets of an axis in a block */
   int near_x, near_y, near_z; /* float offsets of the near planes in a node */
   float tnear;
+  const fr_ray *src;         /* the ray as given: a thin triangle's plane t (tri4_plane_t) */
   vnode nrx_w, nry_w, nrz_w; /* the same times ROUND_UP: far distances (planes_test) */
 } ray_pre;
 
@@ -47,6 +48,7 @@ static inline void ray_setup(ray_pre *r, const fr_ray *ray) {
   r->near_y = ry >= 0.0f ? 2 * W : 3 * W;
   r->near_z = rz >= 0.0f ? 4 * W : 5 * W;
   r->tnear = ray->tnear;
+  r->src = ray;
 }
 
 /* A node's near and far planes as ray r meets them (its direction signs). */
@@ -122,6 +124,33 @@ static __attribute__((noinline, cold)) tri4_edges exact_edges(tri4_edges e, vflo
   return out;
 }
 
+/* The hit lanes `ill` of res again with the plane's t in double, dropped
+ * where it falls outside (tnear, tfar) (fr_tri_thin). */
+static __attribute__((noinline, cold)) void tri4_plane_t(const fr_tri4 *tr, const fr_ray *ray, float tnear, float tfar,
+                                                         tri4_result *res, int ill) {
+  float T[4] __attribute__((aligned(16)));
+  vf4_store(T, res->t);
+  for (; ill; ill &= ill - 1) {
+    const int i = __builtin_ctz((unsigned)ill);
+    const float t = fr_tri_plane_t(ray->org[0], ray->org[1], ray->org[2], ray->dir[0], ray->dir[1], ray->dir[2],
+                                   tr->v0[0][i], tr->v0[1][i], tr->v0[2][i], tr->v1[0][i], tr->v1[1][i], tr->v1[2][i],
+                                   tr->v2[0][i], tr->v2[1][i], tr->v2[2][i]);
+    if (t > tnear && t < tfar) T[i] = t;
+    else res->mask &= ~(1 << i);
+  }
+  res->t = vf4_load(T);
+}
+
+/* The hit lanes of res on thin triangles (FR_TRI4_THIN, the ids' sign
+ * bits) take the plane's t: fr_tri_watertight's rule, lane by lane. */
+FR_INLINE void tri4_check_thin(const fr_tri4 *tr, const ray_pre *r, float tfar, tri4_result *res) {
+  const int thin = res->mask & vm4_bits(vf4_lt(vf4_load((const float *)tr->prim), vf4(0.0f)));
+  FR_COUNT(tri_hit_tests, 1);
+  FR_COUNT(tri_plane_t, __builtin_popcount((unsigned)thin));
+  if (__builtin_expect(thin != 0, 0))
+    tri4_plane_t(tr, r->src, r->tnear, tfar, res, thin);
+}
+
 /* Four triangles against one ray; mask of lanes hit in (tnear, tfar). The
  * same operations as fr_tri_watertight, lane by lane, on negated vertex
  * coordinates (o - v, so the loads fold): the edge values come out identical
@@ -164,6 +193,7 @@ FR_INLINE void tri4_test(const fr_tri4 *tr, const ray_pre *r, float tfar, tri4_r
                       vm4_and(vf4_gt(t, vf4(r->tnear)), vf4_lt(t, vf4(tfar))));
   res->t = t; res->e1 = e1; res->e2 = e2; res->inv = inv;
   res->mask = vm4_bits(ok);
+  if (res->mask) tri4_check_thin(tr, r, tfar, res);
 }
 
 /* Two rays against one block: *ra and *rb as tri4_test gives them for ray
@@ -211,6 +241,8 @@ FR_INLINE void tri4_test2(const fr_tri4 *tr, const ray_pre *a, float tfa, const 
   }
   ra->t = vf8_lo(t); ra->e1 = vf8_lo(e1); ra->e2 = vf8_lo(e2); ra->inv = vf8_lo(inv); ra->mask = ok & 0x0F;
   rb->t = vf8_hi(t); rb->e1 = vf8_hi(e1); rb->e2 = vf8_hi(e2); rb->inv = vf8_hi(inv); rb->mask = ok >> 4;
+  if (ra->mask) tri4_check_thin(tr, a, tfa, ra);
+  if (rb->mask) tri4_check_thin(tr, b, tfb, rb);
   if (__builtin_expect(exact != 0, 0)) {
     if (exact & 0x0F) tri4_test(tr, a, tfa, ra);
     if (exact & 0xF0) tri4_test(tr, b, tfb, rb);

@@ -13,11 +13,11 @@
  * packet in FR_HYBRID_TUNE_TIMED; it traces most packets with the cheaper
  * arm and one in FR_HYBRID_TUNE_EXPLORE (or _FAR) with the other, and
  * halves its sums every FR_HYBRID_TUNE_WINDOW packets so that the choice
- * follows a workload's phases. Only speed depends on it: t and the
- * triangle are the single-ray kernel's either way (up to which of two
- * triangles a ray exactly through their shared edge reports, as for any
- * packet); u and v may differ in their last bits, the packet test
- * computing them otherwise than the single-ray phase's watertight test.
+ * follows a workload's phases. Only speed depends on it: the packet
+ * kernel makes t, u and v from the ray and the triangle it reports when it
+ * finishes, whichever phase found it, so they are the same bits either way;
+ * the triangle is too, up to which of two triangles that tie at one t (a
+ * ray exactly through their shared edge) is reported.
  */
 #ifndef FR_TRACE_HYBRID_TUNE_H
 #define FR_TRACE_HYBRID_TUNE_H

@@ -26,6 +26,8 @@ typedef struct stream_rays {
   float tnear[FR_STREAM_MAX], tfar[FR_STREAM_MAX]; /* closest hits lower tfar as they go */
   int32_t kx4[FR_STREAM_MAX], ky4[FR_STREAM_MAX], kz4[FR_STREAM_MAX];
   int32_t near_x[FR_STREAM_MAX], near_y[FR_STREAM_MAX], near_z[FR_STREAM_MAX];
+  const fr_ray *rays;   /* ray i is rays[idx[i]] */
+  const uint32_t *idx;
 } __attribute__((aligned(64))) stream_rays;
 
 /* Ray i as ray_setup would have made it. Inlined into the tests, the
@@ -40,6 +42,7 @@ FR_INLINE ray_pre stream_ray(const stream_rays *s, int i) {
   r.kx4 = s->kx4[i]; r.ky4 = s->ky4[i]; r.kz4 = s->kz4[i];
   r.near_x = s->near_x[i]; r.near_y = s->near_y[i]; r.near_z = s->near_z[i];
   r.tnear = s->tnear[i];
+  r.src = s->rays + s->idx[i];
   return r;
 }
 
@@ -52,6 +55,8 @@ FR_INLINE float stream_rcp(float d) { return 1.0f / (fabsf(d) < 1e-18f ? copysig
 FR_INLINE uint64_t stream_setup(const fr_ray *rays, const uint32_t *idx, int n, stream_rays *s, int *uniform) {
   uint64_t active = 0;
   FR_COUNT(rays, (uint64_t)n);
+  s->rays = rays;
+  s->idx = idx;
   /* 16 records at a time, loaded by index and transposed in registers,
    * fr_ray_invalid's checks made lane by lane (test_stream_setup holds
    * the two to the same verdict): gathered one by one with the scalar

@@ -26,6 +26,7 @@ enum { QUAD_RAYS = P / 4 }; /* rays per test */
  * share the permuted axes, 0 when not, -1 before quad_setup. */
 typedef struct quad_rays {
   vpf okx, oky, okz, sx, sy, nsz;
+  const float (*o)[P], (*d)[P]; /* the packet's rays as given: fr_wt_ill's plane t */
   int kx4, ky4, kz4; /* float offsets of an axis in a block, as ray_pre's */
   int ok;
 } quad_rays;
@@ -39,6 +40,8 @@ FR_INLINE void quad_setup(quad_rays *q, const float (*o)[P], const float (*d)[P]
   const unsigned k0 = a & b, k1 = ~a & c;
   int kz;
   q->ok = 0;
+  q->o = o;
+  q->d = d;
   if ((k0 & valid) == valid) kz = 0;
   else if ((k1 & valid) == valid) kz = 1;
   else if (((k0 | k1) & valid) == 0) kz = 2;
@@ -98,6 +101,27 @@ static __attribute__((noinline, cold)) void quad_exact_edges(vpf *e, const vpf *
   for (int k = 0; k < 3; k++) e[k] = vp_load(E[k]);
 }
 
+/* The hit lanes `ill` again with the plane's t in double, dropped where it
+ * falls outside (tnear, tfar): tri4_plane_t lane by lane. Returns the hit
+ * lanes left. */
+static __attribute__((noinline, cold)) unsigned quad_plane_t(const fr_tri4 *tr, const quad_rays *q,
+                                                             const quad_group *r, unsigned hit, unsigned ill, vpf *t) {
+  float T[P] __attribute__((aligned(64))), tn[P] __attribute__((aligned(64))), tf[P] __attribute__((aligned(64)));
+  vp_store(T, *t);
+  vp_store(tn, r->tnear);
+  vp_store(tf, r->tfar);
+  for (; ill; ill &= ill - 1) {
+    const int l = __builtin_ctz(ill), i = l % 4, k = r->lane[l / 4];
+    const float tt = fr_tri_plane_t(q->o[0][k], q->o[1][k], q->o[2][k], q->d[0][k], q->d[1][k], q->d[2][k],
+                                    tr->v0[0][i], tr->v0[1][i], tr->v0[2][i], tr->v1[0][i], tr->v1[1][i],
+                                    tr->v1[2][i], tr->v2[0][i], tr->v2[1][i], tr->v2[2][i]);
+    if (tt > tn[l] && tt < tf[l]) T[l] = tt;
+    else hit &= ~(1u << l);
+  }
+  *t = vp_load(T);
+  return hit;
+}
+
 /* What a closest-hit caller needs of the hit lanes. */
 typedef struct quad_hit { vpf t, e1, e2, inv; } quad_hit;
 
@@ -131,10 +155,15 @@ FR_INLINE unsigned quad_test(const fr_tri4 *tr, const quad_rays *q, const quad_g
   const vpf inv = vp_div(vp(1.0f), det);
   const vpf tz = vp_add(vp_add(vp_mul(e[0], vp_mul(r->nsz, az)), vp_mul(e[1], vp_mul(r->nsz, bz))),
                         vp_mul(e[2], vp_mul(r->nsz, cz)));
-  const vpf t = vp_mul(tz, inv);
-  if (h) { h->t = t; h->e1 = e[1]; h->e2 = e[2]; h->inv = inv; }
+  vpf t = vp_mul(tz, inv);
   /* det != 0 as tri4_test's unordered compare: a NaN det gives a NaN t,
    * which the ordered compares on t reject either way */
-  return inside & ~vpm_bits(vp_eq(det, zero)) & vpm_bits(vp_gt(t, r->tnear)) & vpm_bits(vp_lt(t, r->tfar));
+  unsigned hit = inside & ~vpm_bits(vp_eq(det, zero)) & vpm_bits(vp_gt(t, r->tnear)) & vpm_bits(vp_lt(t, r->tfar));
+  /* thin triangles' hits take the plane's t, as tri4_check_thin: the ids'
+   * sign bits, broadcast to the lanes of their triangle */
+  const unsigned thin = hit & vpm_bits(vp_lt(vp_bcast4((const float *)tr->prim), zero));
+  if (__builtin_expect(thin != 0, 0)) hit = quad_plane_t(tr, q, r, hit, thin, &t);
+  if (h) { h->t = t; h->e1 = e[1]; h->e2 = e[2]; h->inv = inv; }
+  return hit;
 }
 #endif
