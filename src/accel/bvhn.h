@@ -60,6 +60,10 @@ typedef struct fr_tri4 {
  * sign bits (scenes hold fewer than 2^31 triangles). */
 #define FR_TRI4_THIN 0x80000000u
 #define FR_TRI4_PRIM(id) ((id) == FR_INVALID_ID ? FR_INVALID_ID : (id) & ~FR_TRI4_THIN)
+/* bit l set where lane l of block t holds a thin triangle (or none) */
+static inline unsigned fr_tri4_thin_lanes(const fr_tri4 *t) {
+  return (t->prim[0] >> 31) | (t->prim[1] >> 31) << 1 | (t->prim[2] >> 31) << 2 | (t->prim[3] >> 31) << 3;
+}
 _Static_assert(offsetof(fr_tri4, v1) == 48 && offsetof(fr_tri4, v2) == 96, "kernels address v1, v2 from v0");
 
 typedef struct fr_bvhn {

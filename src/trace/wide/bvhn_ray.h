@@ -141,10 +141,10 @@ static __attribute__((noinline, cold)) void tri4_plane_t(const fr_tri4 *tr, cons
   res->t = vf4_load(T);
 }
 
-/* The hit lanes of res on thin triangles (FR_TRI4_THIN, the ids' sign
- * bits) take the plane's t: fr_tri_watertight's rule, lane by lane. */
+/* The hit lanes of res on thin triangles (FR_TRI4_THIN) take the plane's
+ * t: fr_tri_watertight's rule, lane by lane. */
 FR_INLINE void tri4_check_thin(const fr_tri4 *tr, const ray_pre *r, float tfar, tri4_result *res) {
-  const int thin = res->mask & vm4_bits(vf4_lt(vf4_load((const float *)tr->prim), vf4(0.0f)));
+  const int thin = res->mask & (int)fr_tri4_thin_lanes(tr);
   FR_COUNT(tri_hit_tests, 1);
   FR_COUNT(tri_plane_t, __builtin_popcount((unsigned)thin));
   if (__builtin_expect(thin != 0, 0))

@@ -159,9 +159,9 @@ FR_INLINE unsigned quad_test(const fr_tri4 *tr, const quad_rays *q, const quad_g
   /* det != 0 as tri4_test's unordered compare: a NaN det gives a NaN t,
    * which the ordered compares on t reject either way */
   unsigned hit = inside & ~vpm_bits(vp_eq(det, zero)) & vpm_bits(vp_gt(t, r->tnear)) & vpm_bits(vp_lt(t, r->tfar));
-  /* thin triangles' hits take the plane's t, as tri4_check_thin: the ids'
-   * sign bits, broadcast to the lanes of their triangle */
-  const unsigned thin = hit & vpm_bits(vp_lt(vp_bcast4((const float *)tr->prim), zero));
+  /* thin triangles' hits take the plane's t, as tri4_check_thin: lane
+   * 4j + i is triangle i */
+  const unsigned thin = hit & fr_tri4_thin_lanes(tr) * (P == 16 ? 0x1111u : 0x11u);
   if (__builtin_expect(thin != 0, 0)) hit = quad_plane_t(tr, q, r, hit, thin, &t);
   if (h) { h->t = t; h->e1 = e[1]; h->e2 = e[2]; h->inv = inv; }
   return hit;
