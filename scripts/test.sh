@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # One command for the whole test suite: install, build, run ctest; then the
 # same suite built with AddressSanitizer and UBSan (every report an error),
-# its slowest tests on smaller inputs; then a minute of fuzzing the readers
-# from the kept corpus. FRUSTA_SANITIZE_TESTS=0 and FRUSTA_FUZZ_SECONDS=0
-# skip the last two.
+# its slowest tests on smaller inputs; then the threaded paths under
+# ThreadSanitizer; then a minute of fuzzing the readers from the kept
+# corpus. FRUSTA_SANITIZE_TESTS=0, FRUSTA_TSAN_TESTS=0 and
+# FRUSTA_FUZZ_SECONDS=0 skip the last three.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -13,6 +14,30 @@ if [ "${FRUSTA_SANITIZE_TESTS:-1}" != 0 ]; then
   cmake -S . -B "$SAN" -DCMAKE_BUILD_TYPE=Release -DFRUSTA_SANITIZE=ON >/dev/null
   cmake --build "$SAN" -j "$(nproc)" >/dev/null
   (cd "$SAN" && ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 ctest --output-on-failure -j "$(nproc)" --timeout 1200)
+fi
+if [ "${FRUSTA_TSAN_TESTS:-1}" != 0 ]; then
+  # ThreadSanitizer over the threaded paths: many threads calling one
+  # scene, the hybrid's per-thread tuning, and the command's render and
+  # bench on worker threads; any report fails the run. Built with clang,
+  # whose OpenMP runtime tells the sanitizer of its barriers through the
+  # Archer tool (GCC's libgomp does not, and its joins read as races).
+  TSAN="${FRUSTA_TSAN_DIR:-build-tsan}"
+  CC=clang CXX=clang++ cmake -S . -B "$TSAN" -DCMAKE_BUILD_TYPE=Release -DFRUSTA_TSAN=ON >/dev/null
+  cmake --build "$TSAN" -j "$(nproc)" --target test_threads test_hybrid_tune frusta >/dev/null
+  export TSAN_OPTIONS=halt_on_error=1:exitcode=66:ignore_noninstrumented_modules=1
+  export OMP_TOOL_LIBRARIES=/usr/lib/llvm-14/lib/libarcher.so
+  "$TSAN/tests/test_threads" >/dev/null
+  "$TSAN/tests/test_hybrid_tune" >/dev/null
+  out=$(mktemp -d)
+  for shade in eyelight softshadow whitted; do
+    "$TSAN/frusta" render --builtin --shade "$shade" --size 96x96 --threads 4 --out "$out/$shade.png" >/dev/null
+  done
+  "$TSAN/frusta" render "${FRUSTA_SHARED:-../shared}/scenes/kitchen/kitchen.ply.zst" --shade softshadow --size 64x64 \
+    --threads 4 --out "$out/kitchen.png" >/dev/null
+  "$TSAN/frusta" bench --builtin --workload all --mode all --threads 4 --size 64x64 --repeat 1 >/dev/null
+  rm -rf "$out"
+  unset TSAN_OPTIONS OMP_TOOL_LIBRARIES
+  echo "ThreadSanitizer: threads, hybrid tuning, render and bench on 4 threads: no report"
 fi
 FUZZ_SECONDS="${FRUSTA_FUZZ_SECONDS:-60}"
 if [ "$FUZZ_SECONDS" != 0 ]; then
