@@ -124,14 +124,14 @@ static __attribute__((noinline, cold)) tri4_edges exact_edges(tri4_edges e, vflo
   return out;
 }
 
-/* The hit lanes `ill` of res again with the plane's t in double, dropped
+/* The hit lanes `thin` of res again with the plane's t in double, dropped
  * where it falls outside (tnear, tfar) (fr_tri_thin). */
 static __attribute__((noinline, cold)) void tri4_plane_t(const fr_tri4 *tr, const fr_ray *ray, float tnear, float tfar,
-                                                         tri4_result *res, int ill) {
+                                                         tri4_result *res, int thin) {
   float T[4] __attribute__((aligned(16)));
   vf4_store(T, res->t);
-  for (; ill; ill &= ill - 1) {
-    const int i = __builtin_ctz((unsigned)ill);
+  for (; thin; thin &= thin - 1) {
+    const int i = __builtin_ctz((unsigned)thin);
     const float t = fr_tri_plane_t(ray->org[0], ray->org[1], ray->org[2], ray->dir[0], ray->dir[1], ray->dir[2],
                                    tr->v0[0][i], tr->v0[1][i], tr->v0[2][i], tr->v1[0][i], tr->v1[1][i], tr->v1[2][i],
                                    tr->v2[0][i], tr->v2[1][i], tr->v2[2][i]);

@@ -26,7 +26,7 @@ enum { QUAD_RAYS = P / 4 }; /* rays per test */
  * share the permuted axes, 0 when not, -1 before quad_setup. */
 typedef struct quad_rays {
   vpf okx, oky, okz, sx, sy, nsz;
-  const float (*o)[P], (*d)[P]; /* the packet's rays as given: fr_wt_ill's plane t */
+  const float (*o)[P], (*d)[P]; /* the packet's rays as given: a thin triangle's plane t (quad_plane_t) */
   int kx4, ky4, kz4; /* float offsets of an axis in a block, as ray_pre's */
   int ok;
 } quad_rays;
@@ -101,17 +101,17 @@ static __attribute__((noinline, cold)) void quad_exact_edges(vpf *e, const vpf *
   for (int k = 0; k < 3; k++) e[k] = vp_load(E[k]);
 }
 
-/* The hit lanes `ill` again with the plane's t in double, dropped where it
+/* The hit lanes `thin` again with the plane's t in double, dropped where it
  * falls outside (tnear, tfar): tri4_plane_t lane by lane. Returns the hit
  * lanes left. */
 static __attribute__((noinline, cold)) unsigned quad_plane_t(const fr_tri4 *tr, const quad_rays *q,
-                                                             const quad_group *r, unsigned hit, unsigned ill, vpf *t) {
+                                                             const quad_group *r, unsigned hit, unsigned thin, vpf *t) {
   float T[P] __attribute__((aligned(64))), tn[P] __attribute__((aligned(64))), tf[P] __attribute__((aligned(64)));
   vp_store(T, *t);
   vp_store(tn, r->tnear);
   vp_store(tf, r->tfar);
-  for (; ill; ill &= ill - 1) {
-    const int l = __builtin_ctz(ill), i = l % 4, k = r->lane[l / 4];
+  for (; thin; thin &= thin - 1) {
+    const int l = __builtin_ctz(thin), i = l % 4, k = r->lane[l / 4];
     const float tt = fr_tri_plane_t(q->o[0][k], q->o[1][k], q->o[2][k], q->d[0][k], q->d[1][k], q->d[2][k],
                                     tr->v0[0][i], tr->v0[1][i], tr->v0[2][i], tr->v1[0][i], tr->v1[1][i],
                                     tr->v1[2][i], tr->v2[0][i], tr->v2[1][i], tr->v2[2][i]);
