@@ -26,15 +26,6 @@ typedef struct conv { const fr_build_tree *t; fr_bvh2 *b; const uint8_t *leaf; }
  * subtree's cost. A tri_cost of 0 makes every subtree of at most max_leaf
  * a leaf (its nodes cost at least its own visit): the sphere tree's rule,
  * whose kernels were tuned on it. */
-uint32_t fr_bvh2_tri_thin(const fr_bvh2_tri *r) {
-  double e1[3], e2[3];
-  for (int a = 0; a < 3; a++) { e1[a] = (double)r->v1[a] - r->v0[a]; e2[a] = (double)r->v2[a] - r->v0[a]; }
-  const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
-  const double nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-  const double ee = (e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]) * (e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]);
-  return nn * FR_BVH2_THIN * FR_BVH2_THIN < ee;
-}
-
 static float plan_leaves(const fr_build_tree *t, int32_t bi, uint32_t max_leaf, float tri_cost, uint8_t *leaf) {
   const fr_build_node *n = &t->nodes[bi];
   const float a = aabb_half_area(n->box);
@@ -122,7 +113,7 @@ fr_error fr_bvh2_from_build(const fr_build_tree *t, const fr_mesh *m, int max_le
       int gt = p[0] != q[0] ? p[0] > q[0] : p[1] != q[1] ? p[1] > q[1] : p[2] > q[2];
       r->edge_flip |= (uint32_t)gt << e;
     }
-    r->thin = fr_bvh2_tri_thin(r);
+    r->pad = 0;
   }
   fr_error e = make_nodes(t, max_leaf, m ? TRI_COST : 0.0f, out);
   if (e) fr_bvh2_free(out);

@@ -39,35 +39,30 @@ typedef struct fr_bvh2_tri {
   float v0[3], v1[3], v2[3];
   uint32_t prim;
   uint32_t edge_flip;
-  uint32_t thin; /* 1: the normal is made in double (fr_bvh2_tri_normal) */
+  uint32_t pad;
 } __attribute__((aligned(16))) fr_bvh2_tri;
 
 _Static_assert(sizeof(fr_bvh2_tri) == 48, "BVH2 triangle is 48 bytes");
 
-/* The unnormalized normal (v1 - v0) x (v2 - v0): in float, the same bits
- * at every ISA level (no contraction) and in every kernel, except for a
- * thin triangle, where the float cross product loses the normal's
- * direction by 2^-24 over the sine of the angle at v0 and with it the
- * plane's distance (a ray leaving a sliver met it again 1e-3 on): there in
- * double, rounded once. Thin: that sine under 1 / FR_BVH2_THIN
- * (fr_bvh2_tri_thin). */
-#define FR_BVH2_THIN 16.0
-static inline void fr_bvh2_tri_normal_exact(const fr_bvh2_tri *r, float n[3]) {
-  double e1[3], e2[3];
-  for (int a = 0; a < 3; a++) { e1[a] = (double)r->v1[a] - r->v0[a]; e2[a] = (double)r->v2[a] - r->v0[a]; }
-  n[0] = (float)(e1[1] * e2[2] - e1[2] * e2[1]);
-  n[1] = (float)(e1[2] * e2[0] - e1[0] * e2[2]);
-  n[2] = (float)(e1[0] * e2[1] - e1[1] * e2[0]);
+/* The unnormalized normal (v1 - v0) x (v2 - v0), made in double and
+ * rounded once: a float cross product turns it by 2^-24 over the sine of
+ * the angle at v0, and with it the plane's distance (a ray leaving a sliver
+ * met it again 1e-3 on). On plain floats and without branches, so that a
+ * loop over a leaf's triangles vectorizes; IEEE double operations give the
+ * same bits in every kernel and at every ISA level. */
+static inline void fr_tri_normal_lane(float ax, float ay, float az, float bx, float by, float bz, float cx, float cy,
+                                      float cz, float *nx, float *ny, float *nz) {
+  double e1x = (double)bx - ax, e1y = (double)by - ay, e1z = (double)bz - az;
+  double e2x = (double)cx - ax, e2y = (double)cy - ay, e2z = (double)cz - az;
+  *nx = (float)(e1y * e2z - e1z * e2y);
+  *ny = (float)(e1z * e2x - e1x * e2z);
+  *nz = (float)(e1x * e2y - e1y * e2x);
 }
-uint32_t fr_bvh2_tri_thin(const fr_bvh2_tri *r);
 static inline void fr_bvh2_tri_normal(const fr_bvh2_tri *r, float n[3]) {
-  if (r->thin) {
-    fr_bvh2_tri_normal_exact(r, n);
-    return;
-  }
-  vec3 a = v3_load(r->v0), c = v3_cross(v3_sub(v3_load(r->v1), a), v3_sub(v3_load(r->v2), a));
-  n[0] = c.x; n[1] = c.y; n[2] = c.z;
+  fr_tri_normal_lane(r->v0[0], r->v0[1], r->v0[2], r->v1[0], r->v1[1], r->v1[2], r->v2[0], r->v2[1], r->v2[2], &n[0],
+                     &n[1], &n[2]);
 }
+
 /* leaves hold at most this many triangles (the count field has 4 bits) */
 #define FR_BVH2_MAX_LEAF 15
 

@@ -316,30 +316,21 @@ FR_INLINE void leaf_edges_shared(const frusta *F, const fr_bvh2_tri *r, uint32_t
   vpf lo[8], hi[8];
   vp_load_records8_rows((const float *)r, 12, (int)count, lo);
   vp_load_records8_rows((const float *)r + 4, 12, (int)count, hi);
-  unsigned flip[3] = {0, 0, 0}, thin = 0;
-  for (uint32_t k = 0; k < count; k++) {
+  unsigned flip[3] = {0, 0, 0};
+  for (uint32_t k = 0; k < count; k++)
     for (int i = 0; i < 3; i++) flip[i] |= ((r[k].edge_flip >> i) & 1u) << k;
-    thin |= r[k].thin << k;
-  }
   vpf V0[3] = {lo[0], lo[1], lo[2]}, V1[3] = {lo[3], lo[4], lo[5]}, V2[3] = {lo[6], lo[7], hi[4]};
   vpf A[3], B[3], C[3], n[3];
   for (int a = 0; a < 3; a++) {
     const vpf o = vp(F->origin[a]);
     A[a] = vp_sub(V0[a], o); B[a] = vp_sub(V1[a], o); C[a] = vp_sub(V2[a], o);
   }
-  { /* fr_bvh2_tri_normal: (v1 - v0) x (v2 - v0) */
-    vpf e1[3], e2[3];
-    for (int a = 0; a < 3; a++) { e1[a] = vp_sub(V1[a], V0[a]); e2[a] = vp_sub(V2[a], V0[a]); }
-    fr_cross3v(e1, e2, n);
-  }
-  for (int a = 0; a < 3; a++) vp_store(L->nrm[a], n[a]);
-  if (__builtin_expect(thin != 0, 0)) { /* fr_bvh2_tri_normal's double path */
-    for (unsigned m = thin; m; m &= m - 1) {
-      const int k = __builtin_ctz(m);
-      float e[3];
-      fr_bvh2_tri_normal_exact(&r[k], e);
-      for (int a = 0; a < 3; a++) L->nrm[a][k] = e[a];
-    }
+  { /* fr_bvh2_tri_normal, lane by lane in a loop the compiler vectorizes */
+    float V[9][FR_PACKET] __attribute__((aligned(64)));
+    for (int a = 0; a < 3; a++) { vp_store(V[a], V0[a]); vp_store(V[3 + a], V1[a]); vp_store(V[6 + a], V2[a]); }
+    for (int k = 0; k < FR_PACKET; k++)
+      fr_tri_normal_lane(V[0][k], V[1][k], V[2][k], V[3][k], V[4][k], V[5][k], V[6][k], V[7][k], V[8][k], &L->nrm[0][k],
+                         &L->nrm[1][k], &L->nrm[2][k]);
     for (int a = 0; a < 3; a++) n[a] = vp_load(L->nrm[a]);
   }
   vp_store(L->t.det, fr_dot3v(A[0], A[1], A[2], n[0], n[1], n[2]));
