@@ -56,8 +56,8 @@ typedef struct fr_tri4 {
 } __attribute__((aligned(16))) fr_tri4;
 
 /* A thin triangle's hits take the plane's t in double (fr_tri_thin): the
- * flag rides in the id's top bit, where the kernels read it with the ids'
- * sign bits (scenes hold fewer than 2^31 triangles). */
+ * flag rides in the id's top bit, read with the id's cache line (commit
+ * refuses scenes of 2^31 triangles or more). */
 #define FR_TRI4_THIN 0x80000000u
 #define FR_TRI4_PRIM(id) ((id) == FR_INVALID_ID ? FR_INVALID_ID : (id) & ~FR_TRI4_THIN)
 /* bit l set where lane l of block t holds a thin triangle (or none) */

@@ -163,6 +163,8 @@ void fr_scene_release(fr_scene *s) {
 /* The SAH tree over the non-degenerate triangles (n of them); sets s->bounds. */
 static fr_error build_tree(fr_scene *s, fr_build_tree *tree, size_t *count) {
   const fr_mesh *m = &s->mesh;
+  if (m->ntris >= FR_TRI4_THIN) /* ids share a word with the thin flag (accel/bvhn.h) */
+    return fr_fail(FR_ERR_UNSUPPORTED, "%s: %zu triangles; frusta traces fewer than 2^31", s->name, m->ntris);
   aabb *boxes = fr_alloc_aligned(fr_mul_size(m->ntris, sizeof(aabb)), 64); /* owned by fr_presplit too */
   uint32_t *ids = fr_alloc_aligned(fr_mul_size(m->ntris, sizeof(uint32_t)), 64);
   if (!boxes || !ids) { fr_free_aligned(boxes); fr_free_aligned(ids); return fr_fail(FR_ERR_NOMEM, "out of memory for %zu triangles", m->ntris); }

@@ -130,7 +130,7 @@ static inline float fr_tri_refine_lane(float ox, float oy, float oz, float dx, f
                                        float tfar, float ax, float ay, float az, float bx, float by, float bz, float cx,
                                        float cy, float cz, float t) {
   float r = fr_tri_plane_t(ox, oy, oz, dx, dy, dz, ax, ay, az, bx, by, bz, cx, cy, cz);
-  return (r > tnear) & (r < tfar) ? r : t;
+  return ((r > tnear) & (r < tfar)) ? r : t;
 }
 static inline float fr_tri_refine_t(vec3 o, vec3 d, float tnear, float tfar, vec3 p0, vec3 p1, vec3 p2, float t) {
   return fr_tri_refine_lane(o.x, o.y, o.z, d.x, d.y, d.z, tnear, tfar, p0.x, p0.y, p0.z, p1.x, p1.y, p1.z, p2.x, p2.y,

@@ -23,8 +23,8 @@ FR_INLINE vpf fr_dot3v(vpf ax, vpf ay, vpf az, vpf bx, vpf by, vpf bz) {
   return vp_add(vp_add(vp_mul(ax, bx), vp_mul(ay, by)), vp_mul(az, bz));
 }
 
-/* c = a x b with v3_cross's operations, so lane by lane the same bits
- * (fr_bvh2_tri_normal's normal, and the edge products below) */
+/* c = a x b with v3_cross's operations, so lane by lane the same bits (the
+ * edge products below) */
 FR_INLINE void fr_cross3v(const vpf a[3], const vpf b[3], vpf c[3]) {
   c[0] = vp_sub(vp_mul(a[1], b[2]), vp_mul(a[2], b[1]));
   c[1] = vp_sub(vp_mul(a[2], b[0]), vp_mul(a[0], b[2]));
