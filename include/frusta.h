@@ -101,6 +101,9 @@ int fr_scene_geometric_normal(const fr_scene *s, uint32_t prim, const float p[3]
  * spheres (mirror material "flake") above a floor of two triangles (material
  * "floor"), seen with spd_balls' view. depth 0..5. */
 fr_error fr_scene_builtin_sphereflake(int depth, fr_scene **out);
+/* The material showcase: six unit spheres (materials lambert, plastic,
+ * chrome, gold, glass, carpaint) on a floor (material "floor") at y = 0. */
+fr_error fr_scene_builtin_materials(fr_scene **out);
 
 /* Builds the acceleration structures; must be called before tracing.
  * Triangles that are degenerate or too small for float arithmetic (edge

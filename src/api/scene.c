@@ -147,6 +147,18 @@ fr_error fr_scene_builtin_sphereflake(int depth, fr_scene **out) {
   return FR_OK;
 }
 
+fr_error fr_scene_builtin_materials(fr_scene **out) {
+  if (!out) return fr_fail(FR_ERR_ARG, "fr_scene_builtin_materials: out is NULL");
+  *out = NULL;
+  fr_scene *s = scene_new();
+  if (!s) return fr_fail(FR_ERR_NOMEM, "out of memory");
+  fr_error e = fr_builtin_materials(&s->mesh, &s->spheres);
+  if (e) { fr_scene_release(s); return e; }
+  snprintf(s->name, sizeof s->name, "materials");
+  *out = s;
+  return FR_OK;
+}
+
 void fr_scene_release(fr_scene *s) {
   if (!s) return;
   fr_mesh_free(&s->mesh);

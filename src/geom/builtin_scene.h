@@ -9,4 +9,7 @@ fr_error fr_builtin_scene(fr_mesh *m);
  * radius 0.5 at the origin, nine children a third its size on each sphere
  * down to depth levels, above a floor quad at z = -0.5. */
 fr_error fr_builtin_sphereflake(int depth, fr_mesh *m, fr_spheres *spheres);
+/* The material showcase (builtin_materials.c): six unit spheres on a floor
+ * at y = 0, one per path-tracing material. */
+fr_error fr_builtin_materials(fr_mesh *m, fr_spheres *spheres);
 #endif

@@ -8,6 +8,7 @@
 #include "base/alloc.h"
 #include "base/timer.h"
 #include "render/tile.h"
+#include "render/path.h"
 #include "render/whitted.h"
 #include "trace/counters.h"
 
@@ -32,13 +33,16 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
   uint32_t *order = fr_tile_order(tiles_x, tiles_y);
 #pragma omp parallel num_threads(w->threads) reduction(+ : total)
   {
-    fr_tile_buffers *B = whitted ? NULL : malloc(sizeof(fr_tile_buffers));
+    const int path = w->kind == FR_WL_PATH;
+    fr_tile_buffers *B = whitted || path ? NULL : malloc(sizeof(fr_tile_buffers));
     fr_whitted_scratch *WS = whitted ? fr_whitted_scratch_new() : NULL;
+    fr_path_scratch *PS = path ? fr_path_scratch_new() : NULL;
 #pragma omp for schedule(dynamic, 1)
     for (int i = 0; i < ntiles; i++) {
       const int k = order ? (int)order[i] : i;
       const int tx = (k % tiles_x) * tile, ty = (k / tiles_x) * tile;
       if (WS) total += fr_whitted_tile(w, t, WS, tx, ty);
+      else if (PS) total += fr_path_tile(w, t, PS, tx, ty);
       else if (B) total += fr_tile_run(w, t, B, tx, ty);
       if (w->progress) {
         int d, pct;
@@ -55,7 +59,11 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
     }
     free(B);
 #pragma omp critical
-    fr_whitted_scratch_stages(WS, stage);
+    {
+      fr_whitted_scratch_stages(WS, stage);
+      fr_path_scratch_stages(PS, stage);
+    }
+    fr_path_scratch_free(PS);
     fr_whitted_scratch_free(WS);
 #ifdef FRUSTA_COUNTERS
     fr_counters_flush();

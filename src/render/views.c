@@ -22,6 +22,8 @@ static const named_view table[] = {
     {"spd_tree", {4.5f, 0.4f, 2.0f, 0, 0, 1.5f, 0, 0, 1, 45, -5, 5, 50, -1, -1, 6, 0, 2, 0, 2, 0, 0}},
     {"hairball", {0, 0.3f, 2.4f, 0, 0, 0, 0, 1, 0, 45, 2, 3, 2, -0.5f, 1.5f, -0.5f, 1, 0, 0, 0, 0, 1}},
     /* built-in scene: looking over the grid; quad light above its centre facing down */
+    /* the material showcase: the row of spheres from the front, a little above */
+    {"materials", {0, 2.2f, 9.0f, 0, 0.9f, 0, 0, 1, 0, 50, 4, 10, 6, -2, 8, -2, 4, 0, 0, 0, 0, 4}},
     {"builtin", {11, 7, 13, 0, 0, 0, 0, 1, 0, 40, 6, 12, 4, -2, 10, -2, 4, 0, 0, 0, 0, 4}},
 };
 
@@ -52,4 +54,9 @@ fr_view fr_view_from_bounds(aabb b) {
   v.area_e1 = v3(0.4f * r, 0, 0);  /* e1 x e2 points down (-y) */
   v.area_e2 = v3(0, 0, 0.4f * r);
   return v;
+}
+
+void fr_view_surfaces(const char *name, const char **mirror, const char **glass) {
+  if (!strcmp(name, "kitchen")) { *mirror = "shiny_metal,metal"; *glass = "glass,glass_dragon"; }
+  else if (!strcmp(name, "museum")) { *mirror = "museum5_0"; *glass = "museum5_1"; }
 }

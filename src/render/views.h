@@ -13,6 +13,9 @@ typedef struct fr_view {
 
 /* 1 if name has a known view. */
 int fr_view_lookup(const char *name, fr_view *v);
+/* The scenes README's mirror and glass materials of a shared scene, as
+ * comma-separated names (left alone for a scene without suggestions). */
+void fr_view_surfaces(const char *name, const char **mirror, const char **glass);
 /* A 3/4 view of the box with lights above it. */
 fr_view fr_view_from_bounds(aabb b);
 #endif

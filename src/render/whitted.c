@@ -6,6 +6,7 @@
 #include "api/scene.h"
 #include "base/alloc.h"
 #include "base/error.h"
+#include "render/views.h"
 #include "base/timer.h"
 #include "base/vec3.h"
 #include "render/whitted_shade.h"
@@ -44,12 +45,6 @@ static fr_error check_list(const fr_scene *s, const char *list, const char *what
   return FR_OK;
 }
 
-/* the scenes README's suggestions */
-static void scene_defaults(const char *scene, const char **mirror, const char **glass) {
-  if (!strcmp(scene, "kitchen")) { *mirror = "shiny_metal,metal"; *glass = "glass,glass_dragon"; }
-  else if (!strcmp(scene, "museum")) { *mirror = "museum5_0"; *glass = "museum5_1"; }
-}
-
 static uint32_t mat_index(const fr_scene *s, const fr_whitted_mats *m, uint32_t prim) {
   uint32_t i = fr_scene_prim_material(s, prim);
   return i == FR_INVALID_ID || i + 1 >= m->count ? (uint32_t)m->count - 1 : i;
@@ -60,7 +55,7 @@ fr_error fr_whitted_mats_build(const fr_scene *s, const char *mirror, const char
   fr_error err;
   if ((err = check_list(s, mirror, "mirror")) || (err = check_list(s, glass, "glass"))) return err;
   const int defaults = !mirror && !glass;
-  if (defaults) scene_defaults(s->name, &mirror, &glass);
+  if (defaults) fr_view_surfaces(s->name, &mirror, &glass);
   const int by_mtl = defaults && !mirror && !glass;
   const int all = in_list(mirror, "all");
   size_t nm = fr_scene_material_count(s);

@@ -1,7 +1,7 @@
 #include "workload.h"
 #include <string.h>
 
-static const char *names[FR_WL_COUNT] = {"primary", "shadow", "soft16", "ao16", "diffuse8", "specular8", "whitted"};
+static const char *names[FR_WL_COUNT] = {"primary", "shadow", "soft16", "ao16", "diffuse8", "specular8", "whitted", "path"};
 
 const char *fr_workload_name(fr_workload_kind k) { return k < FR_WL_COUNT ? names[k] : "?"; }
 

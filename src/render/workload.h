@@ -14,7 +14,7 @@
 #include "render/tracer.h"
 
 typedef enum fr_workload_kind {
-  FR_WL_PRIMARY, FR_WL_SHADOW, FR_WL_SOFT16, FR_WL_AO16, FR_WL_DIFFUSE8, FR_WL_SPECULAR8, FR_WL_WHITTED, FR_WL_COUNT
+  FR_WL_PRIMARY, FR_WL_SHADOW, FR_WL_SOFT16, FR_WL_AO16, FR_WL_DIFFUSE8, FR_WL_SPECULAR8, FR_WL_WHITTED, FR_WL_PATH, FR_WL_COUNT
 } fr_workload_kind;
 
 const char *fr_workload_name(fr_workload_kind k);
@@ -49,6 +49,8 @@ typedef struct fr_workload {
    * walks the tree from the root and no shaft decides a fall-back, to
    * measure */
   int mft_no_shaft;
+  /* path: materials, lights, samples (render/path.h) */
+  const struct fr_path_setup *path;
   /* set by fr_workload_run for its tiles */
   const fr_mft_sets *light_sets;  /* this frame's interleaved samples on the quad light */
   const fr_mft_sets *camera_set;  /* the 4x4 pixels of a block */

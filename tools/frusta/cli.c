@@ -122,7 +122,9 @@ int cli_load_scene(const char *arg, fr_scene **s) {
   fr_error e;
   if (strcmp(arg, "--builtin") == 0 || strcmp(arg, "--builtin=default") == 0) e = fr_scene_builtin(s);
   else if (strcmp(arg, "--builtin=sphereflake") == 0) e = fr_scene_builtin_sphereflake(3, s);
-  else if (cli_is_builtin(arg)) return cli_error(CLI_USAGE_ERROR, "unknown built-in scene '%s' (default or sphereflake)", arg + 10);
+  else if (strcmp(arg, "--builtin=materials") == 0) e = fr_scene_builtin_materials(s);
+  else if (cli_is_builtin(arg))
+    return cli_error(CLI_USAGE_ERROR, "unknown built-in scene '%s' (default, sphereflake or materials)", arg + 10);
   else e = fr_scene_load(arg, s);
   if (e) return cli_error(1, "%s", fr_last_error());
   e = fr_scene_commit(*s);

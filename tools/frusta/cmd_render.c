@@ -7,6 +7,8 @@
 #include "api/scene.h"
 #include "cli.h"
 #include "commands.h"
+#include "base/timer.h"
+#include "cli_path.h"
 #include "io/image_write.h"
 #include "render/softshadow.h"
 #include "render/whitted.h"
@@ -60,6 +62,82 @@ done:
   return rc;
 }
 
+/* A filmic tone curve (Narkowicz's fit of ACES) after the exposure. */
+static float filmic(float x) {
+  x = x > 0.0f ? x : 0.0f;
+  return x * (2.51f * x + 0.03f) / (x * (2.43f * x + 0.59f) + 0.14f);
+}
+
+/* out with ".albedo.exr" for its extension */
+static void aov_name(const char *out, const char *kind, char *buf, size_t n) {
+  const char *dot = strrchr(out, '.');
+  const int stem = dot ? (int)(dot - out) : (int)strlen(out);
+  snprintf(buf, n, "%.*s.%s.exr", stem, out, kind);
+}
+
+/* --shade path: passes of FR_PATH_CHUNK samples (so the sums, and the
+ * image, are the same however the work is split), a progress line, the
+ * mean written linear (EXR, PFM) or tone-mapped (PNG). */
+static int render_path(fr_scene *s, fr_workload *w, const cli_path *po, const char *out, int threads) {
+  const size_t np = (size_t)w->cam.width * (size_t)w->cam.height;
+  cli_path_run run;
+  int rc = cli_path_setup(po, w, &run);
+  if (rc) return rc;
+  char albedo_out[4096], normal_out[4096];
+  aov_name(out, "albedo", albedo_out, sizeof albedo_out);
+  aov_name(out, "normal", normal_out, sizeof normal_out);
+  w->image = calloc(np * 3, sizeof(float));
+  if (po->aov) { w->gbuf_albedo = calloc(np * 3, sizeof(float)); w->gbuf_normal = calloc(np * 3, sizeof(float)); }
+  if (!w->image || (po->aov && (!w->gbuf_albedo || !w->gbuf_normal))) {
+    rc = cli_error(1, "out of memory for a %dx%d image", w->cam.width, w->cam.height);
+    goto done;
+  }
+  fr_tracer t = fr_tracer_frusta(s);
+  fr_path_setup *P = &run.setup;
+  const int spp = P->spp;
+  w->progress = 0;
+  uint64_t rays = 0;
+  const double t0 = fr_seconds();
+  double last = t0;
+  for (int s0 = 0; s0 < spp; s0 += FR_PATH_CHUNK) {
+    P->spp_begin = s0;
+    P->spp_end = s0 + FR_PATH_CHUNK < spp ? s0 + FR_PATH_CHUNK : spp;
+    rays += fr_workload_run(w, &t).rays;
+    const double now = fr_seconds();
+    if (now - last > 0.5 || P->spp_end == spp) {
+      last = now;
+      const double el = now - t0, left = el / P->spp_end * (spp - P->spp_end);
+      fprintf(stderr, "\rpath: %d/%d spp  %.1f Mrays/s  %.1f s, %.1f s left  ", P->spp_end, spp, rays / el * 1e-6, el, left);
+      fflush(stderr);
+    }
+  }
+  fprintf(stderr, "\n");
+  const double seconds = fr_seconds() - t0;
+  const float inv = 1.0f / (float)spp, gain = exp2f(po->exposure);
+  const int png = !strcmp(out + (strlen(out) >= 4 ? strlen(out) - 4 : 0), ".png");
+  for (size_t i = 0; i < 3 * np; i++) {
+    w->image[i] *= inv;
+    if (png) w->image[i] = filmic(w->image[i] * gain);
+    if (po->aov) { w->gbuf_albedo[i] *= inv; w->gbuf_normal[i] *= inv; }
+  }
+  if (fr_image_write(out, w->cam.width, w->cam.height, w->image) ||
+      (po->aov && (fr_image_write(albedo_out, w->cam.width, w->cam.height, w->gbuf_albedo) ||
+                   fr_image_write(normal_out, w->cam.width, w->cam.height, w->gbuf_normal)))) {
+    rc = cli_error(1, "%s", fr_last_error());
+    goto done;
+  }
+  printf("rendered scene=%s tris=%zu size=%dx%d shade=path spp=%d tracer=frusta isa=%s threads=%d "
+         "build_seconds=%.3f rays=%llu seconds=%.3f mrays=%.2f -> %s%s%s%s%s\n",
+         s->name, fr_scene_triangle_count(s), w->cam.width, w->cam.height, spp,
+         fr_isa_name(fr_get_isa()), threads, s->build_seconds, (unsigned long long)rays, seconds, rays / seconds * 1e-6, out,
+         po->aov ? " " : "", po->aov ? albedo_out : "", po->aov ? " " : "", po->aov ? normal_out : "");
+done:
+  free(w->image); free(w->gbuf_albedo); free(w->gbuf_normal);
+  w->image = w->gbuf_albedo = w->gbuf_normal = NULL;
+  cli_path_free(&run);
+  return rc;
+}
+
 int cmd_render(int argc, char **argv) {
   cli_args a;
   int rc = cli_args_parse(CLI_RENDER, argc, argv, 1, &a);
@@ -67,13 +145,14 @@ int cmd_render(int argc, char **argv) {
   const char *scene = a.pos[0], *out = a.val[F_OUT], *ref_out = a.val[F_REFERENCE_OUT];
   int threads = omp_get_num_procs(), mft = -1; /* -1: not given */
   fr_softshadow_opts so = {16, 1, FR_LIGHT_SETS_CELLS};
-  static const char *const shades[] = {"eyelight", "normals", "shadows", "softshadow", "whitted"};
+  static const char *const shades[] = {"eyelight", "normals", "shadows", "softshadow", "whitted", "path"};
   static const char *const sets[] = {"cells", "spread"}; /* FR_LIGHT_SETS_CELLS, _SPREAD */
   int shade = 0, set = 0;
   cli_view v;
   cli_whitted wo;
-  if ((rc = cli_view_from_args(&a, &v)) || (rc = cli_whitted_from_args(&a, &wo)) ||
-      (rc = cli_common_from_args(&a, &threads)) || (rc = cli_arg_choice(&a, F_SHADE, shades, 5, &shade)) ||
+  cli_path po;
+  if ((rc = cli_view_from_args(&a, &v)) || (rc = cli_whitted_from_args(&a, &wo)) || (rc = cli_path_from_args(&a, &po)) ||
+      (rc = cli_common_from_args(&a, &threads)) || (rc = cli_arg_choice(&a, F_SHADE, shades, 6, &shade)) ||
       (rc = cli_arg_choice(&a, F_LIGHT_SETS, sets, 2, &set)) || (rc = cli_arg_onoff(&a, F_FILTER, &so.filter)) ||
       (rc = cli_arg_onoff(&a, F_MFT, &mft)) || (rc = cli_arg_int(&a, F_LIGHT_SAMPLES, 16, 4096, &so.samples)))
     return rc;
@@ -86,8 +165,8 @@ int cmd_render(int argc, char **argv) {
   if (!fr_image_format_known(out)) return cli_error(CLI_USAGE_ERROR, "%s: unknown image format (use .png, .exr or .pfm)", out);
   if (ref_out && !fr_image_format_known(ref_out))
     return cli_error(CLI_USAGE_ERROR, "%s: unknown image format (use .png, .exr or .pfm)", ref_out);
-  static const fr_workload_kind kinds[] = {FR_WL_PRIMARY, FR_WL_PRIMARY, FR_WL_SHADOW, FR_WL_SOFT16, FR_WL_WHITTED};
-  static const fr_shade shading[] = {FR_SHADE_EYELIGHT, FR_SHADE_NORMALS, FR_SHADE_LIGHT, FR_SHADE_LIGHT, FR_SHADE_LIGHT};
+  static const fr_workload_kind kinds[] = {FR_WL_PRIMARY, FR_WL_PRIMARY, FR_WL_SHADOW, FR_WL_SOFT16, FR_WL_WHITTED, FR_WL_PATH};
+  static const fr_shade shading[] = {FR_SHADE_EYELIGHT, FR_SHADE_NORMALS, FR_SHADE_LIGHT, FR_SHADE_LIGHT, FR_SHADE_LIGHT, FR_SHADE_LIGHT};
   fr_workload w;
   memset(&w, 0, sizeof w);
   w.kind = kinds[shade];
@@ -101,6 +180,11 @@ int cmd_render(int argc, char **argv) {
   if (w.kind == FR_WL_SOFT16) {
     /* multi-frusta tracing does not see spheres: such scenes go the packet way */
     rc = render_soft(s, &w, &so, mft != 0 && !fr_scene_sphere_count(s), out, ref_out, threads);
+    fr_scene_release(s);
+    return rc;
+  }
+  if (w.kind == FR_WL_PATH) {
+    rc = render_path(s, &w, &po, out, threads);
     fr_scene_release(s);
     return rc;
   }

@@ -23,7 +23,7 @@ const cli_flag cli_flags[F_COUNT] = {
     [F_ISA] = {"--isa", "avx512|avx2|scalar", R | B | T | S,
                "instruction set of the kernels (default: the best the CPU has; also FRUSTA_ISA)"},
     [F_OUT] = {"--out", "FILE", R | T, "render: the image, .png, .exr or .pfm; trace: the hit or occlusion file"},
-    [F_SHADE] = {"--shade", "eyelight|normals|shadows|softshadow|whitted", R, "what to render (default eyelight)"},
+    [F_SHADE] = {"--shade", "eyelight|normals|shadows|softshadow|whitted|path", R, "what to render (default eyelight)"},
     [F_LIGHT_SAMPLES] = {"--light-samples", "N", R,
                          "softshadow: shadow rays per pixel, a multiple of 16 (default 16, filtered; more: "
                          "unfiltered passes of 16 spread samples)"},
@@ -34,15 +34,31 @@ const cli_flag cli_flags[F_COUNT] = {
     [F_MFT] = {"--mft", "on|off", R, "camera and soft-shadow rays as multi-frusta (default on; off: streams)"},
     [F_REFERENCE_OUT] = {"--reference-out", "FILE", R,
                          "softshadow: also render the 256-sample reference there and print the error"},
+    [F_SPP] = {"--spp", "N", R | B, "path: samples per pixel, 1..65536 (default 16)"},
+    [F_MAX_DEPTH] = {"--max-depth", "N", R | B, "path: segments per path, 1..64 (default 13)"},
+    [F_ENV] = {"--env", "FILE", R | B, "path: an HDR environment map, EXR or Radiance .hdr, latitude-longitude"},
+    [F_ENV_COLOR] = {"--env-color", "r,g,b", R | B, "path: a constant environment (default 1,1,1 without --env)"},
+    [F_ENV_INTENSITY] = {"--env-intensity", "X", R | B, "path: scales the environment (default 1)"},
+    [F_ENV_ROTATE] = {"--env-rotate", "DEG", R | B, "path: turns the environment about the up vector (default 0)"},
+    [F_LIGHTS] = {"--lights", "env,area,point|none", R | B,
+                  "path: the lights (default env,area; the area and point lights of --area and --light, each "
+                  "bright enough to light what the camera looks at)"},
+    [F_APERTURE] = {"--aperture", "R", R | B, "path: lens radius, depth of field (default 0: a pinhole)"},
+    [F_FOCUS] = {"--focus", "D", R | B, "path: focus distance (default: from the eye to --at)"},
+    [F_SAMPLER] = {"--sampler", "hammersley|sobol", R | B,
+                   "path: padded scrambled Hammersley (default) or Owen-scrambled Sobol"},
+    [F_SEED] = {"--seed", "N", R | B, "path: the sampler's seed (default 1)"},
+    [F_AOV] = {"--aov", NULL, R, "path: also write the first hits' albedo and normal, NAME.albedo.exr and NAME.normal.exr"},
+    [F_EXPOSURE] = {"--exposure", "EV", R, "path: PNG exposure in stops before the filmic tone curve (default 0)"},
     [F_MIRROR] = {"--mirror", "NAME,..|all", R | B,
-                  "whitted: materials that mirror (default: the scene's; all: every surface reflects half)"},
-    [F_GLASS] = {"--glass", "NAME,..", R | B, "whitted: materials that refract (default: the scene's)"},
+                  "whitted and path: materials that mirror (default: the scene's; whitted's all: every surface reflects half)"},
+    [F_GLASS] = {"--glass", "NAME,..", R | B, "whitted and path: materials that refract (default: the scene's)"},
     [F_DEPTH] = {"--depth", "N", R | B, "whitted: recursion depth, 1..8 (default 4)"},
     [F_PACKET] = {"--packet", "2|4|8|16|32", R, "whitted with large packets: packet side (default 16)"},
     [F_TRAVERSAL] = {"--traversal", "masked|ranged|partition", R | B, "large packets: traversal (default ranged)"},
     [F_CULL] = {"--cull", "off|ia|planes|corners", R | B, "large packets: whole-packet cull (default off)"},
     [F_WORKLOAD] = {"--workload", "W[,W..]|all", B | S,
-                    "primary, shadow, soft16, ao16, diffuse8, specular8, whitted (docs/workloads.md)"},
+                    "primary, shadow, soft16, ao16, diffuse8, specular8, whitted, path (docs/workloads.md; all: but path)"},
     [F_MODE] = {"--mode", "M[,M..]|all", B | T,
                 "bench: frusta's single single4 packet8 packet16 hybrid16 auto raystream mft packet2x2..packet32x32, "
                 "Embree's single packet4 packet8 packet16 stream; trace: single (default) packet8 packet16 hybrid16 "
@@ -87,7 +103,7 @@ static const struct {
   cli_cmd cmd;
   const char *name, *synopsis, *what;
 } commands[] = {
-    {CLI_RENDER, "render", "SCENE|--builtin[=sphereflake] --out FILE [flags]", "renders an image"},
+    {CLI_RENDER, "render", "SCENE|--builtin[=sphereflake|materials] --out FILE [flags]", "renders an image"},
     {CLI_BENCH, "bench", "SCENE --workload W --mode M [flags]",
      "measures Mrays/s of frusta's and Embree's modes on a workload, side by side"},
     {CLI_TRACE, "trace", "SCENE RAYS --query closest|any --out FILE [flags]",

@@ -15,6 +15,9 @@ typedef enum cli_flag_id {
   F_SIZE, F_EYE, F_AT, F_UP, F_FOV, F_LIGHT, F_AREA, F_THREADS, F_ISA,
   /* render */
   F_OUT, F_SHADE, F_LIGHT_SAMPLES, F_FILTER, F_LIGHT_SETS, F_MFT, F_REFERENCE_OUT,
+  /* path tracing */
+  F_SPP, F_MAX_DEPTH, F_ENV, F_ENV_COLOR, F_ENV_INTENSITY, F_ENV_ROTATE, F_LIGHTS, F_APERTURE, F_FOCUS, F_SAMPLER,
+  F_SEED, F_AOV, F_EXPOSURE,
   /* Whitted and large packets */
   F_MIRROR, F_GLASS, F_DEPTH, F_PACKET, F_TRAVERSAL, F_CULL,
   /* bench, trace and stats */

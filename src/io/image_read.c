@@ -1,0 +1,157 @@
+#include "image_read.h"
+#include <OpenEXR/ImfCRgbaFile.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "base/alloc.h"
+#include "base/error.h"
+#include "io/file_read.h"
+
+#define EXR_MAX_RATIO 1024u /* a claimed image may hold at most this many times the file's bytes (ZIP of flat regions) */
+
+static fr_error check_size(const char *what, long w, long h, size_t file_bytes) {
+  if (w <= 0 || h <= 0 || w > FR_IMAGE_MAX_SIDE || h > FR_IMAGE_MAX_SIDE)
+    return fr_fail(FR_ERR_FORMAT, "%s: image size %ldx%ld out of range (1..%d per side)", what, w, h, FR_IMAGE_MAX_SIDE);
+  const size_t n = (size_t)w * (size_t)h;
+  if (n > FR_IMAGE_MAX_PIXELS) return fr_fail(FR_ERR_UNSUPPORTED, "%s: %ldx%ld pixels is too large", what, w, h);
+  if (n / EXR_MAX_RATIO > file_bytes + 4096)
+    return fr_fail(FR_ERR_FORMAT, "%s: claims %ldx%ld pixels, more than its %zu bytes can hold", what, w, h, file_bytes);
+  return FR_OK;
+}
+
+/* Refuses non-finite values; clamps negative ones (the ringing of
+ * resampled HDR images, a few thousandths at most) to 0. */
+static fr_error check_values(const char *what, float *rgb, size_t n) {
+  for (size_t i = 0; i < n; i++) {
+    if (!isfinite(rgb[i])) return fr_fail(FR_ERR_FORMAT, "%s: pixel %zu has a non-finite value", what, i / 3);
+    if (rgb[i] < 0.0f) rgb[i] = 0.0f;
+  }
+  return FR_OK;
+}
+
+static fr_error read_exr(const char *path, size_t bytes, int *width, int *height, float **out) {
+  ImfInputFile *in = ImfOpenInputFile(path);
+  if (!in) return fr_fail(FR_ERR_FORMAT, "%s: not a readable OpenEXR file (%s)", path, ImfErrorMessage());
+  int x0, y0, x1, y1;
+  ImfHeaderDataWindow(ImfInputHeader(in), &x0, &y0, &x1, &y1);
+  const long w = (long)x1 - x0 + 1, h = (long)y1 - y0 + 1;
+  fr_error err = check_size(path, w, h, bytes);
+  if (err) { ImfCloseInputFile(in); return err; }
+  const size_t n = (size_t)w * (size_t)h;
+  ImfRgba *px = calloc(n, sizeof *px);
+  float *rgb = malloc(fr_mul_size(n, 3 * sizeof(float)));
+  if (!px || !rgb) { free(px); free(rgb); ImfCloseInputFile(in); return fr_fail(FR_ERR_NOMEM, "%s: out of memory", path); }
+  /* the frame buffer's origin is pixel (0, 0) of the data window's coordinates */
+  const int ok = ImfInputSetFrameBuffer(in, px - x0 - (ptrdiff_t)y0 * w, 1, (size_t)w) && ImfInputReadPixels(in, y0, y1);
+  if (!ok) err = fr_fail(FR_ERR_FORMAT, "%s: %s", path, ImfErrorMessage());
+  ImfCloseInputFile(in);
+  for (size_t i = 0; !err && i < n; i++) {
+    rgb[3 * i] = ImfHalfToFloat(px[i].r);
+    rgb[3 * i + 1] = ImfHalfToFloat(px[i].g);
+    rgb[3 * i + 2] = ImfHalfToFloat(px[i].b);
+  }
+  free(px);
+  if (!err) err = check_values(path, rgb, 3 * n);
+  if (err) { free(rgb); return err; }
+  *width = (int)w, *height = (int)h, *out = rgb;
+  return FR_OK;
+}
+
+/* RGBE: mantissas scaled by 2^(e - 136); e = 0 is black. */
+static void rgbe_to_float(const unsigned char *e, float *rgb) {
+  if (!e[3]) { rgb[0] = rgb[1] = rgb[2] = 0.0f; return; }
+  const float f = ldexpf(1.0f, (int)e[3] - 136);
+  for (int c = 0; c < 3; c++) rgb[c] = ((float)e[c] + 0.5f) * f;
+}
+
+/* One scanline of w pixels into line (4 bytes each); *p advances. */
+static int read_scanline(const unsigned char **p, const unsigned char *end, int w, unsigned char *line) {
+  const unsigned char *q = *p;
+  if (w >= 8 && w < 32768 && end - q >= 4 && q[0] == 2 && q[1] == 2 && !(q[2] & 0x80)) {
+    if (((int)q[2] << 8 | q[3]) != w) return 0;
+    q += 4;
+    for (int c = 0; c < 4; c++) /* new RLE: each component's run by itself */
+      for (int x = 0; x < w;) {
+        if (q >= end) return 0;
+        int n = *q++;
+        if (n > 128) {
+          n -= 128;
+          if (n > w - x || q >= end) return 0;
+          for (const unsigned char v = *q++; n--; x++) line[4 * x + c] = v;
+        } else {
+          if (n == 0 || n > w - x || end - q < n) return 0;
+          while (n--) line[4 * x++ + c] = *q++;
+        }
+      }
+  } else { /* flat pixels (old-style run markers are not written by any tool in use) */
+    if ((size_t)(end - q) < 4 * (size_t)w) return 0;
+    memcpy(line, q, 4 * (size_t)w);
+    q += 4 * (size_t)w;
+  }
+  *p = q;
+  return 1;
+}
+
+fr_error fr_hdr_decode(const char *what, const unsigned char *data, size_t size, int *width, int *height, float **out) {
+  const unsigned char *p = data, *end = data + size;
+  if (size < 2 || p[0] != '#' || p[1] != '?') return fr_fail(FR_ERR_FORMAT, "%s: not a Radiance HDR file", what);
+  /* header lines up to an empty one; then "-Y h +X w" */
+  int format_ok = 0;
+  for (;;) {
+    const unsigned char *nl = memchr(p, '\n', (size_t)(end - p));
+    if (!nl) return fr_fail(FR_ERR_FORMAT, "%s: header without an end", what);
+    if (nl == p) { p = nl + 1; break; }
+    if (nl - p >= 22 && !memcmp(p, "FORMAT=32-bit_rle_rgbe", 22)) format_ok = 1;
+    if (nl - p >= 7 && !memcmp(p, "FORMAT=", 7) && !format_ok)
+      return fr_fail(FR_ERR_UNSUPPORTED, "%s: only the RGBE format is read (not XYZE)", what);
+    p = nl + 1;
+  }
+  const unsigned char *nl = memchr(p, '\n', (size_t)(end - p));
+  char res[64];
+  if (!nl || nl - p >= (ptrdiff_t)sizeof res) return fr_fail(FR_ERR_FORMAT, "%s: missing resolution line", what);
+  memcpy(res, p, (size_t)(nl - p));
+  res[nl - p] = 0;
+  p = nl + 1;
+  long h, w;
+  char tail;
+  if (sscanf(res, "-Y %ld +X %ld%c", &h, &w, &tail) != 2)
+    return fr_fail(FR_ERR_UNSUPPORTED, "%s: resolution line '%s' (only -Y h +X w, top to bottom)", what, res);
+  /* a pixel takes at least 4 bytes flat, and RLE at least 2 bytes per 128 values */
+  fr_error err = check_size(what, w, h, size);
+  if (err) return err;
+  if ((size_t)w * (size_t)h / 64 > size) return fr_fail(FR_ERR_FORMAT, "%s: claims %ldx%ld pixels, more than its %zu bytes hold", what, w, h, size);
+  const size_t n = (size_t)w * (size_t)h;
+  float *rgb = malloc(fr_mul_size(n, 3 * sizeof(float)));
+  unsigned char *line = malloc(4 * (size_t)w);
+  if (!rgb || !line) { free(rgb); free(line); return fr_fail(FR_ERR_NOMEM, "%s: out of memory", what); }
+  for (long y = 0; y < h; y++) {
+    if (!read_scanline(&p, end, (int)w, line)) {
+      free(rgb); free(line);
+      return fr_fail(FR_ERR_FORMAT, "%s: scanline %ld is truncated or malformed", what, y);
+    }
+    for (long x = 0; x < w; x++) rgbe_to_float(line + 4 * x, rgb + 3 * ((size_t)y * (size_t)w + (size_t)x));
+  }
+  free(line);
+  *width = (int)w, *height = (int)h, *out = rgb;
+  return FR_OK;
+}
+
+fr_error fr_image_read(const char *path, int *width, int *height, float **rgb) {
+  if (fr_has_suffix(path, ".hdr") || fr_has_suffix(path, ".pic")) {
+    char *data;
+    size_t size;
+    fr_error err = fr_read_file_max(path, (size_t)1 << 30, &data, &size);
+    if (err) return err;
+    err = fr_hdr_decode(path, (const unsigned char *)data, size, width, height, rgb);
+    free(data);
+    return err;
+  }
+  if (!fr_has_suffix(path, ".exr")) return fr_fail(FR_ERR_ARG, "%s: unknown image format (use .exr or .hdr)", path);
+  FILE *f = fopen(path, "rb");
+  if (!f) return fr_fail(FR_ERR_IO, "%s: cannot open", path);
+  long bytes = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+  fclose(f);
+  if (bytes < 0) return fr_fail(FR_ERR_IO, "%s: cannot read", path);
+  return read_exr(path, (size_t)bytes, width, height, rgb);
+}

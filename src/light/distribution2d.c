@@ -1,0 +1,71 @@
+#include "light/distribution2d.h"
+#include <stdlib.h>
+#include <string.h>
+#include "base/alloc.h"
+#include "base/error.h"
+
+fr_error fr_dist2d_build(fr_dist2d *d, const float *weight, int w, int h) {
+  memset(d, 0, sizeof *d);
+  const size_t n = (size_t)w * (size_t)h;
+  d->w = w, d->h = h;
+  d->weight = malloc(fr_mul_size(n, sizeof(float)));
+  d->cdf_row = malloc(fr_mul_size((size_t)h, ((size_t)w + 1) * sizeof(float)));
+  d->cdf_marg = malloc(((size_t)h + 1) * sizeof(float));
+  if (!d->weight || !d->cdf_row || !d->cdf_marg) { fr_dist2d_free(d); return fr_fail(FR_ERR_NOMEM, "out of memory for a %dx%d distribution", w, h); }
+  memcpy(d->weight, weight, n * sizeof(float));
+  double *rows = calloc((size_t)h, sizeof(double));
+  if (!rows) { fr_dist2d_free(d); return fr_fail(FR_ERR_NOMEM, "out of memory"); }
+  double total = 0.0;
+  for (int y = 0; y < h; y++) {
+    float *c = d->cdf_row + (size_t)y * ((size_t)w + 1);
+    double s = 0.0;
+    c[0] = 0.0f;
+    for (int x = 0; x < w; x++) { s += weight[(size_t)y * w + x]; c[x + 1] = (float)s; }
+    for (int x = 1; x <= w; x++) c[x] = s > 0.0 ? (float)(c[x] / s) : (float)x / (float)w;
+    c[w] = 1.0f;
+    rows[y] = s;
+    total += s;
+  }
+  if (!(total > 0.0)) { free(rows); fr_dist2d_free(d); return fr_fail(FR_ERR_ARG, "nothing to sample: every weight is 0"); }
+  double s = 0.0;
+  d->cdf_marg[0] = 0.0f;
+  for (int y = 0; y < h; y++) { s += rows[y]; d->cdf_marg[y + 1] = (float)(s / total); }
+  d->cdf_marg[h] = 1.0f;
+  free(rows);
+  d->total = total;
+  return FR_OK;
+}
+
+void fr_dist2d_free(fr_dist2d *d) {
+  free(d->weight); free(d->cdf_row); free(d->cdf_marg);
+  memset(d, 0, sizeof *d);
+}
+
+/* The i with cdf[i] <= u < cdf[i + 1] among n intervals, skipping empty ones. */
+static int find(const float *cdf, int n, float u) {
+  int lo = 0, hi = n; /* cdf[lo] <= u < cdf[hi] */
+  while (hi - lo > 1) {
+    int mid = (lo + hi) / 2;
+    if (cdf[mid] <= u) lo = mid; else hi = mid;
+  }
+  while (lo < n - 1 && cdf[lo + 1] <= cdf[lo]) lo++; /* never an empty interval */
+  return lo;
+}
+
+float fr_dist2d_sample(const fr_dist2d *d, float u1, float u2, float *u, float *v, int *x, int *y) {
+  const int yy = find(d->cdf_marg, d->h, u2);
+  const float *c = d->cdf_row + (size_t)yy * ((size_t)d->w + 1);
+  const int xx = find(c, d->w, u1);
+  const float dv = d->cdf_marg[yy + 1] - d->cdf_marg[yy], du = c[xx + 1] - c[xx];
+  const float fv = dv > 0.0f ? (u2 - d->cdf_marg[yy]) / dv : 0.5f, fu = du > 0.0f ? (u1 - c[xx]) / du : 0.5f;
+  *u = ((float)xx + (fu < 0.0f ? 0.0f : fu)) / (float)d->w;
+  *v = ((float)yy + (fv < 0.0f ? 0.0f : fv)) / (float)d->h;
+  if (*u >= 1.0f) *u = 0.99999994f;
+  if (*v >= 1.0f) *v = 0.99999994f;
+  *x = xx, *y = yy;
+  return fr_dist2d_pdf(d, xx, yy);
+}
+
+float fr_dist2d_pdf(const fr_dist2d *d, int x, int y) {
+  return (float)((double)d->weight[(size_t)y * d->w + x] * d->w * d->h / d->total);
+}

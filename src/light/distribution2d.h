@@ -1,0 +1,25 @@
+/*
+ * A piecewise-constant 2D distribution over a w x h grid of non-negative
+ * weights: a marginal over rows, a conditional over each row's columns,
+ * sampled by inverting their cumulative sums (pbrt's Distribution2D).
+ */
+#ifndef FR_LIGHT_DISTRIBUTION2D_H
+#define FR_LIGHT_DISTRIBUTION2D_H
+#include "frusta.h"
+
+typedef struct fr_dist2d {
+  int w, h;
+  float *cdf_row;   /* h x (w + 1): each row's normalized cumulative sum */
+  float *cdf_marg;  /* h + 1 */
+  float *weight;    /* w x h, the weights themselves */
+  double total;     /* their sum */
+} fr_dist2d;
+
+/* FR_ERR_ARG when every weight is 0 (nothing to sample). */
+fr_error fr_dist2d_build(fr_dist2d *d, const float *weight, int w, int h);
+void fr_dist2d_free(fr_dist2d *d);
+/* A point (u, v) in [0, 1)^2 from u1 (column) and u2 (row), its cell in
+ * *x, *y, and the density over the unit square, w h weight / total. */
+float fr_dist2d_sample(const fr_dist2d *d, float u1, float u2, float *u, float *v, int *x, int *y);
+float fr_dist2d_pdf(const fr_dist2d *d, int x, int y);
+#endif

@@ -1,0 +1,115 @@
+#include "light/environment.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "base/alloc.h"
+#include "base/error.h"
+#include "io/image_read.h"
+
+#define PI_F 3.14159265358979323846f
+
+void fr_env_constant(fr_env *e, vec3 color) {
+  memset(e, 0, sizeof *e);
+  e->color = color;
+  e->black = !(color.x > 0.0f || color.y > 0.0f || color.z > 0.0f);
+  fr_env_orient(e, v3(0, 1, 0), 0.0f, 1.0f);
+}
+
+fr_error fr_env_from_image(fr_env *e, float *rgb, int w, int h) {
+  memset(e, 0, sizeof *e);
+  e->rgb = rgb, e->w = w, e->h = h;
+  float *weight = malloc(fr_mul_size(fr_mul_size((size_t)w, (size_t)h), sizeof(float)));
+  if (!weight) { fr_env_free(e); return fr_fail(FR_ERR_NOMEM, "out of memory for the environment's distribution"); }
+  for (int y = 0; y < h; y++) {
+    const float s = sinf(PI_F * ((float)y + 0.5f) / (float)h);
+    for (int x = 0; x < w; x++) {
+      const float *c = rgb + 3 * ((size_t)y * w + x);
+      weight[(size_t)y * w + x] = (0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]) * s;
+    }
+  }
+  fr_error err = fr_dist2d_build(&e->dist, weight, w, h);
+  free(weight);
+  if (err == FR_ERR_ARG) e->black = 1, err = FR_OK; /* an all-black image lights nothing */
+  if (err) { fr_env_free(e); return err; }
+  fr_env_orient(e, v3(0, 1, 0), 0.0f, 1.0f);
+  return FR_OK;
+}
+
+fr_error fr_env_load(fr_env *e, const char *path) {
+  memset(e, 0, sizeof *e);
+  int w, h;
+  float *rgb;
+  fr_error err = fr_image_read(path, &w, &h, &rgb);
+  if (err) return err;
+  return fr_env_from_image(e, rgb, w, h);
+}
+
+void fr_env_orient(fr_env *e, vec3 up, float rotate_deg, float intensity) {
+  e->az = v3_norm(up);
+  v3_onb(e->az, &e->ax, &e->ay);
+  e->rotate = rotate_deg * PI_F / 180.0f;
+  e->intensity = intensity;
+}
+
+void fr_env_free(fr_env *e) {
+  free(e->rgb);
+  fr_dist2d_free(&e->dist);
+  memset(e, 0, sizeof *e);
+}
+
+/* dir to image coordinates (u, v) in [0, 1)^2 and sin(theta) */
+static void to_uv(const fr_env *e, vec3 d, float *u, float *v, float *sin_t) {
+  const float z = fr_maxf(-1.0f, fr_minf(1.0f, v3_dot(d, e->az)));
+  const float theta = acosf(z);
+  float phi = atan2f(v3_dot(d, e->ay), v3_dot(d, e->ax)) - e->rotate;
+  float uu = phi * (0.5f / PI_F);
+  uu -= floorf(uu);
+  *u = uu < 1.0f ? uu : 0.0f;
+  *v = fr_minf(theta / PI_F, 0.99999994f);
+  *sin_t = sqrtf(fr_maxf(0.0f, 1.0f - z * z));
+}
+
+static vec3 texel(const fr_env *e, float u, float v, int *x, int *y) {
+  *x = (int)(u * (float)e->w), *y = (int)(v * (float)e->h);
+  if (*x >= e->w) *x = e->w - 1;
+  if (*y >= e->h) *y = e->h - 1;
+  return v3_load(e->rgb + 3 * ((size_t)*y * e->w + *x));
+}
+
+vec3 fr_env_eval(const fr_env *e, vec3 dir) {
+  if (!e->rgb) return v3_scale(e->color, e->intensity);
+  float u, v, s;
+  int x, y;
+  to_uv(e, dir, &u, &v, &s);
+  return v3_scale(texel(e, u, v, &x, &y), e->intensity);
+}
+
+vec3 fr_env_sample(const fr_env *e, float u1, float u2, vec3 *dir, float *pdf) {
+  if (e->black) { *pdf = 0.0f; return v3(0, 0, 0); }
+  if (!e->rgb) { /* uniform over the sphere */
+    const float z = 1.0f - 2.0f * u1, r = sqrtf(fr_maxf(0.0f, 1.0f - z * z)), phi = 2.0f * PI_F * u2;
+    *dir = v3(r * cosf(phi), r * sinf(phi), z);
+    *pdf = 1.0f / (4.0f * PI_F);
+    return v3_scale(e->color, e->intensity);
+  }
+  float u, v;
+  int x, y;
+  const float puv = fr_dist2d_sample(&e->dist, u1, u2, &u, &v, &x, &y);
+  const float theta = v * PI_F, phi = u * 2.0f * PI_F + e->rotate, st = sinf(theta);
+  if (!(puv > 0.0f) || !(st > 0.0f)) { *pdf = 0.0f; return v3(0, 0, 0); }
+  const vec3 l = v3(st * cosf(phi), st * sinf(phi), cosf(theta));
+  *dir = v3_add(v3_add(v3_scale(e->ax, l.x), v3_scale(e->ay, l.y)), v3_scale(e->az, l.z));
+  *pdf = puv / (2.0f * PI_F * PI_F * st);
+  return v3_scale(v3_load(e->rgb + 3 * ((size_t)y * e->w + x)), e->intensity);
+}
+
+float fr_env_pdf(const fr_env *e, vec3 dir) {
+  if (e->black) return 0.0f;
+  if (!e->rgb) return 1.0f / (4.0f * PI_F);
+  float u, v, s;
+  int x, y;
+  to_uv(e, dir, &u, &v, &s);
+  texel(e, u, v, &x, &y);
+  if (!(s > 0.0f)) return 0.0f;
+  return fr_dist2d_pdf(&e->dist, x, y) / (2.0f * PI_F * PI_F * s);
+}

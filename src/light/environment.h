@@ -1,0 +1,41 @@
+/*
+ * The environment: light arriving from infinitely far away, either one
+ * colour from every direction or a latitude-longitude (equirectangular)
+ * HDR image, its zenith along the scene's up vector, turned about it by
+ * `rotate` degrees and scaled by `intensity`. An image is importance-sampled
+ * by a piecewise-constant distribution over its pixels weighted by
+ * luminance times sin(theta), the solid angle a pixel covers.
+ */
+#ifndef FR_LIGHT_ENVIRONMENT_H
+#define FR_LIGHT_ENVIRONMENT_H
+#include "base/vec3.h"
+#include "light/distribution2d.h"
+
+typedef struct fr_env {
+  vec3 color;       /* the constant environment (no image) */
+  int w, h;
+  float *rgb;       /* the image, or NULL */
+  fr_dist2d dist;
+  vec3 ax, ay, az;  /* world frame: az the zenith */
+  float intensity;
+  float rotate;     /* radians */
+  int black;        /* emits nothing: never sampled */
+} fr_env;
+
+/* A constant environment of the given radiance. */
+void fr_env_constant(fr_env *e, vec3 color);
+/* An image (EXR or Radiance HDR, read with io/image_read.h); errors name the file. */
+fr_error fr_env_load(fr_env *e, const char *path);
+/* An image already in memory (taken over: freed by fr_env_free). */
+fr_error fr_env_from_image(fr_env *e, float *rgb, int w, int h);
+/* Orientation and scale; call before use. */
+void fr_env_orient(fr_env *e, vec3 up, float rotate_deg, float intensity);
+void fr_env_free(fr_env *e);
+
+/* Radiance arriving along -dir (dir points from the scene to the sky). */
+vec3 fr_env_eval(const fr_env *e, vec3 dir);
+/* A direction toward the sky with its solid-angle pdf, and the radiance from
+ * it; pdf 0 when the environment is black. */
+vec3 fr_env_sample(const fr_env *e, float u1, float u2, vec3 *dir, float *pdf);
+float fr_env_pdf(const fr_env *e, vec3 dir);
+#endif

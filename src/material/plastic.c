@@ -1,0 +1,54 @@
+/*
+ * Plastic: a smooth dielectric coat (index ior) over a Lambertian base.
+ * Light reflects off the coat with the Fresnel factor F; what enters
+ * scatters in the base, bouncing between base and coat, and leaves through
+ * the coat, as in Weidlich and Wilkie's layered model with the internal
+ * bounces summed in closed form:
+ *   f_d = (1 - F(wo)) (1 - F(wi)) color / (pi ior^2 (1 - color Fdr_in)),
+ * Fdr_in = 1 - (1 - Fdr_out) / ior^2 the coat's reflectance of diffuse light
+ * from below. With white color the albedo comes to 1 (up to the Fresnel fit).
+ * The coat's mirror lobe is picked with probability F / (F + (1 - F) max(color)).
+ */
+#include "material/bsdf_kinds.h"
+#include "material/fresnel.h"
+
+static vec3 diffuse_f(const fr_bsdf *m, float fo, float fi) {
+  const float e2 = m->ior * m->ior, fdr_in = 1.0f - (1.0f - fr_fresnel_diffuse(m->ior)) / e2;
+  const vec3 c = m->color;
+  const float s = (1.0f - fo) * (1.0f - fi) * FR_INV_PI / e2;
+  return v3(s * c.x / (1.0f - c.x * fdr_in), s * c.y / (1.0f - c.y * fdr_in), s * c.z / (1.0f - c.z * fdr_in));
+}
+
+static float coat_probability(const fr_bsdf *m, float fo) {
+  const float d = (1.0f - fo) * fr_max3(m->color);
+  return fo + d > 0.0f ? fo / (fo + d) : 1.0f;
+}
+
+int fr_plastic_sample(const fr_bsdf *m, const fr_shading_point *sp, vec3 wo, float uc, float u1, float u2,
+                      fr_bsdf_sample *out) {
+  (void)sp;
+  if (wo.z <= 0.0f) return 0;
+  const float fo = fr_fresnel_dielectric(wo.z, m->ior, NULL), ps = coat_probability(m, fo);
+  if (uc < ps) {
+    out->wi = fr_reflect_z(wo);
+    out->pdf = ps;
+    out->weight = v3(fo / ps, fo / ps, fo / ps);
+    out->delta = 1;
+    return 1;
+  }
+  out->wi = fr_sample_cosine(u1, u2);
+  if (out->wi.z <= 0.0f) return 0;
+  out->pdf = (1.0f - ps) * out->wi.z * FR_INV_PI;
+  const float fi = fr_fresnel_dielectric(out->wi.z, m->ior, NULL);
+  out->weight = v3_scale(diffuse_f(m, fo, fi), out->wi.z / out->pdf);
+  out->delta = 0;
+  return 1;
+}
+
+vec3 fr_plastic_eval(const fr_bsdf *m, const fr_shading_point *sp, vec3 wo, vec3 wi, float *pdf) {
+  (void)sp;
+  if (wo.z <= 0.0f || wi.z <= 0.0f) { *pdf = 0.0f; return v3(0, 0, 0); }
+  const float fo = fr_fresnel_dielectric(wo.z, m->ior, NULL), fi = fr_fresnel_dielectric(wi.z, m->ior, NULL);
+  *pdf = (1.0f - coat_probability(m, fo)) * wi.z * FR_INV_PI;
+  return v3_scale(diffuse_f(m, fo, fi), wi.z);
+}

@@ -1,0 +1,285 @@
+/*
+ * The path tracer's tiles (see path.h).
+ *
+ * Sample dimensions: pair 0 the position within the pixel, pair 1 the lens,
+ * and at bounce b the pairs 2 + 4b (light choice, BSDF lobe choice),
+ * 3 + 4b (point on the light), 4 + 4b (BSDF direction), 5 + 4b (Russian
+ * roulette).
+ */
+#include "render/path.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "base/alloc.h"
+#include "base/error.h"
+#include "base/timer.h"
+#include "render/tile.h"
+
+#define WAVE (TILE_PIX * FR_PATH_CHUNK)
+
+typedef struct path_state {
+  vec3 weight;     /* throughput: what the radiance found next is multiplied by */
+  float pdf;       /* solid-angle pdf of the BSDF sample that made the ray (for MIS at an emitter it hits) */
+  uint32_t sample; /* sample index within the pixel */
+  uint16_t pix;    /* pixel within the tile */
+  uint8_t delta;   /* the ray left a delta lobe (or the camera): emitters it hits count whole */
+  uint8_t depth;   /* segments before this one */
+} path_state;
+
+struct fr_path_scratch {
+  fr_ray ray[WAVE];
+  fr_hit hit[WAVE];
+  path_state st[WAVE];
+  fr_ray sray[WAVE];
+  uint8_t occ[WAVE];
+  vec3 scontrib[WAVE];
+  uint16_t spix[WAVE];
+  vec3 acc[TILE_PIX], alb[TILE_PIX], nrm[TILE_PIX];
+  double stage[FR_STAGES];
+};
+
+fr_path_scratch *fr_path_scratch_new(void) { return fr_alloc_aligned(sizeof(fr_path_scratch), 64); }
+void fr_path_scratch_free(fr_path_scratch *s) { fr_free_aligned(s); }
+void fr_path_scratch_stages(const fr_path_scratch *s, double *stage) {
+  if (s)
+    for (int k = 0; k < FR_STAGES; k++) stage[k] += s->stage[k];
+}
+
+static float power_heuristic(float a, float b) {
+  const float a2 = a * a, b2 = b * b;
+  return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+/* The number of lights next-event estimation chooses among, uniformly. */
+static int light_count(const fr_path_lights *L) { return !L->env->black + L->area + L->point; }
+
+/* t of the ray (o, d) through the area light within (tnear, tfar), or 0. */
+static float area_hit(const fr_path_lights *L, vec3 o, vec3 d, float tnear, float tfar) {
+  const vec3 nq = v3_cross(L->area_e1, L->area_e2);
+  const float den = v3_dot(d, nq), n2 = v3_dot(nq, nq);
+  if (den == 0.0f || !(n2 > 0.0f)) return 0.0f;
+  const float t = v3_dot(v3_sub(L->area_c, o), nq) / den;
+  if (!(t > tnear && t < tfar)) return 0.0f;
+  const vec3 x = v3_sub(v3_add(o, v3_scale(d, t)), L->area_c);
+  const float s = v3_dot(v3_cross(x, L->area_e2), nq) / n2, u = v3_dot(v3_cross(L->area_e1, x), nq) / n2;
+  return s >= 0.0f && s <= 1.0f && u >= 0.0f && u <= 1.0f ? t : 0.0f;
+}
+
+/* Solid-angle pdf of sampling the area light's point at distance dist along unit d. */
+static float area_pdf(const fr_path_lights *L, vec3 d, float dist) {
+  const vec3 nq = v3_cross(L->area_e1, L->area_e2);
+  const float a = v3_len(nq), c = fabsf(v3_dot(nq, d)) / a;
+  return c > 0.0f ? dist * dist / (a * c) : 0.0f;
+}
+
+/* One light sample from p: direction, distance (INFINITY for the
+ * environment), radiance arriving, solid-angle pdf including the choice
+ * of light, and whether it is a delta light. 0 when none. */
+static int sample_light(const fr_path_lights *L, vec3 p, float uc, float u1, float u2, vec3 *wi, float *dist, vec3 *le,
+                        float *pdf, int *delta) {
+  const int n = light_count(L);
+  if (!n) return 0;
+  int k = (int)(uc * (float)n);
+  if (k >= n) k = n - 1;
+  *delta = 0;
+  if (!L->env->black && k-- == 0) {
+    float pe;
+    *le = fr_env_sample(L->env, u1, u2, wi, &pe);
+    *dist = INFINITY;
+    *pdf = pe / (float)n;
+    return pe > 0.0f;
+  }
+  if (L->area && k-- == 0) {
+    const vec3 x = v3_add(L->area_c, v3_add(v3_scale(L->area_e1, u1), v3_scale(L->area_e2, u2)));
+    const vec3 to = v3_sub(x, p);
+    const float d = v3_len(to);
+    if (!(d > 0.0f)) return 0;
+    *wi = v3_scale(to, 1.0f / d);
+    *dist = d;
+    *le = L->area_radiance;
+    *pdf = area_pdf(L, *wi, d) / (float)n;
+    return *pdf > 0.0f;
+  }
+  const vec3 to = v3_sub(L->point_pos, p);
+  const float d = v3_len(to);
+  if (!(d > 0.0f)) return 0;
+  *wi = v3_scale(to, 1.0f / d);
+  *dist = d;
+  *le = v3_scale(L->point_intensity, 1.0f / (d * d));
+  *pdf = 1.0f / (float)n;
+  *delta = 1;
+  return 1;
+}
+
+static vec3 to_local(vec3 w, vec3 t, vec3 b, vec3 n) { return v3(v3_dot(w, t), v3_dot(w, b), v3_dot(w, n)); }
+static vec3 to_world(vec3 w, vec3 t, vec3 b, vec3 n) {
+  return v3_add(v3_add(v3_scale(t, w.x), v3_scale(b, w.y)), v3_scale(n, w.z));
+}
+static int nonzero(vec3 c) { return c.x > 0.0f || c.y > 0.0f || c.z > 0.0f; }
+
+/* Pixel i of a tile, in blocks of 4x4 (consecutive 16 are coherent). */
+static void tile_pixel(int i, int *x, int *y) {
+  const int b = i / 16, k = i % 16;
+  *x = 4 * (b % 4) + k % 4;
+  *y = 4 * (b / 4) + k / 4;
+}
+
+uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch *S, int tx, int ty) {
+  const fr_path_setup *P = w->path;
+  const fr_path_lights *L = &P->lights;
+  const fr_camera *c = &w->cam;
+  const int W = c->width, H = c->height;
+  const uint32_t n_spp = (uint32_t)P->spp, seed = (uint32_t)w->seed;
+  const float eps = w->eps;
+  const int nlights = light_count(L);
+  uint64_t rays = 0;
+  memset(S->acc, 0, sizeof S->acc);
+  memset(S->alb, 0, sizeof S->alb);
+  memset(S->nrm, 0, sizeof S->nrm);
+  const vec3 ru = v3_norm(c->right), uu = v3_norm(c->up);
+  for (int s0 = P->spp_begin; s0 < P->spp_end; s0 += FR_PATH_CHUNK) {
+    const int s1 = s0 + FR_PATH_CHUNK < P->spp_end ? s0 + FR_PATH_CHUNK : P->spp_end;
+    double t0 = fr_seconds();
+    size_t n = 0;
+    for (int s = s0; s < s1; s++)
+      for (int i = 0; i < TILE_PIX; i++) {
+        int x, y;
+        tile_pixel(i, &x, &y);
+        x += tx, y += ty;
+        if (x >= W || y >= H) continue;
+        const uint32_t pixel = (uint32_t)y * (uint32_t)W + (uint32_t)x;
+        float jx, jy, lx, ly;
+        fr_sample2d(P->sampler, seed, pixel, (uint32_t)s, n_spp, 0, &jx, &jy);
+        const float sx = 2.0f * ((float)x + jx) / (float)W - 1.0f, sy = 1.0f - 2.0f * ((float)y + jy) / (float)H;
+        vec3 d = v3_add(c->fwd, v3_add(v3_scale(c->right, sx), v3_scale(c->up, sy)));
+        vec3 o = c->eye;
+        if (P->aperture > 0.0f) {
+          fr_sample2d(P->sampler, seed, pixel, (uint32_t)s, n_spp, 1, &lx, &ly);
+          const float r = P->aperture * sqrtf(lx), phi = 6.28318530718f * ly;
+          const vec3 focus = v3_add(c->eye, v3_scale(d, P->focus)); /* the image plane lies at distance 1 along fwd */
+          o = v3_add(o, v3_add(v3_scale(ru, r * cosf(phi)), v3_scale(uu, r * sinf(phi))));
+          d = v3_sub(focus, o);
+        }
+        S->ray[n] = make_ray(o, v3_norm(d), 0.0f, INFINITY);
+        S->st[n] = (path_state){v3(1, 1, 1), 0.0f, (uint32_t)s, (uint16_t)i, 1, 0};
+        n++;
+      }
+    for (int depth = 0; n; depth++) {
+      double t1 = fr_seconds();
+      S->stage[FR_STAGE_SHADE] += t1 - t0;
+      t->intersect(t->ctx, S->ray, S->hit, n, depth == 0);
+      rays += n;
+      double t2 = fr_seconds();
+      S->stage[depth ? FR_STAGE_SECONDARY : FR_STAGE_CAMERA] += t2 - t1;
+      size_t nn = 0, ns = 0;
+      for (size_t k = 0; k < n; k++) {
+        path_state st = S->st[k];
+        const fr_ray r = S->ray[k];
+        const fr_hit h = S->hit[k];
+        const vec3 o = v3_load(r.org), d = v3_load(r.dir);
+        int px, py;
+        tile_pixel(st.pix, &px, &py);
+        const uint32_t pixel = (uint32_t)(py + ty) * (uint32_t)W + (uint32_t)(px + tx);
+        const int hit = h.prim != FR_INVALID_ID;
+        const float tmax = hit ? h.t : INFINITY;
+        /* the area light, which is not in the scene's geometry, in front of the hit */
+        const float ta = L->area ? area_hit(L, o, d, r.tnear, tmax) : 0.0f;
+        if (ta > 0.0f) {
+          const float w_mis = st.delta ? 1.0f : power_heuristic(st.pdf, area_pdf(L, d, ta) / (float)nlights);
+          S->acc[st.pix] = v3_add(S->acc[st.pix], v3_scale(v3_mul(st.weight, L->area_radiance), w_mis));
+          continue;
+        }
+        if (!hit) {
+          const vec3 le = fr_env_eval(L->env, d);
+          const float w_mis = st.delta ? 1.0f : power_heuristic(st.pdf, fr_env_pdf(L->env, d) / (float)nlights);
+          S->acc[st.pix] = v3_add(S->acc[st.pix], v3_scale(v3_mul(st.weight, le), w_mis));
+          continue;
+        }
+        const vec3 p = v3_add(o, v3_scale(d, h.t));
+        float g[3];
+        const float pp[3] = {p.x, p.y, p.z};
+        fr_scene_geometric_normal(w->scene, h.prim, pp, g);
+        vec3 ng = v3_norm(v3_load(g));
+        const uint32_t mi = fr_scene_prim_material(w->scene, h.prim);
+        const fr_bsdf *m = &P->mats[mi < P->count - 1 ? mi : P->count - 1];
+        const int front = v3_dot(ng, d) < 0.0f;
+        if (m->kind == FR_BSDF_GLASS && !front) { /* the segment ran inside: Beer's law */
+          const float k = h.t / m->attenuation_distance;
+          const vec3 a = m->attenuation_color;
+          st.weight = v3_mul(st.weight, v3(powf(a.x, k), powf(a.y, k), powf(a.z, k)));
+        }
+        if (front && nonzero(m->emission)) S->acc[st.pix] = v3_add(S->acc[st.pix], v3_mul(st.weight, m->emission));
+        /* the shading frame: the outward normal for glass, else the side the ray came from */
+        const vec3 n = m->kind == FR_BSDF_GLASS || front ? ng : v3_scale(ng, -1.0f);
+        vec3 tb, bb;
+        v3_onb(n, &tb, &bb);
+        const vec3 wo = to_local(v3_scale(d, -1.0f), tb, bb, n);
+        fr_shading_point sp;
+        fr_bsdf_prepare(m, p, &sp);
+        if (depth == 0 && (w->gbuf_albedo || w->gbuf_normal)) {
+          S->alb[st.pix] = v3_add(S->alb[st.pix], fr_bsdf_albedo(m));
+          S->nrm[st.pix] = v3_add(S->nrm[st.pix], front ? ng : v3_scale(ng, -1.0f));
+        }
+        const uint32_t dim = 2u + 4u * (uint32_t)depth;
+        float uc, ul, u1, u2, v1, v2, ur, unused;
+        fr_sample2d(P->sampler, seed, pixel, st.sample, n_spp, dim, &uc, &ul);
+        /* next-event estimation */
+        if (nlights && fr_bsdf_has_smooth(m, &sp)) {
+          fr_sample2d(P->sampler, seed, pixel, st.sample, n_spp, dim + 1, &u1, &u2);
+          vec3 wi, le;
+          float dist, pl;
+          int delta;
+          if (sample_light(L, p, uc, u1, u2, &wi, &dist, &le, &pl, &delta)) {
+            float pb;
+            const vec3 f = fr_bsdf_eval(m, &sp, wo, to_local(wi, tb, bb, n), &pb);
+            if (nonzero(f) && nonzero(le)) {
+              const float w_mis = delta ? 1.0f : power_heuristic(pl, pb);
+              S->scontrib[ns] = v3_scale(v3_mul(v3_mul(st.weight, f), le), w_mis / pl);
+              S->sray[ns] = make_ray(p, wi, eps, isinf(dist) ? INFINITY : dist * (1.0f - 1e-4f));
+              S->spix[ns++] = st.pix;
+            }
+          }
+        }
+        /* the next segment */
+        if (depth + 1 >= P->max_depth) continue;
+        fr_sample2d(P->sampler, seed, pixel, st.sample, n_spp, dim + 2, &v1, &v2);
+        fr_bsdf_sample bs;
+        if (!fr_bsdf_sample_dir(m, &sp, wo, ul, v1, v2, &bs)) continue;
+        st.weight = v3_mul(st.weight, bs.weight);
+        const float q = fr_maxf(st.weight.x, fr_maxf(st.weight.y, st.weight.z)) / FR_PATH_RR_WEIGHT;
+        if (q < 1.0f) {
+          fr_sample2d(P->sampler, seed, pixel, st.sample, n_spp, dim + 3, &ur, &unused);
+          if (!(ur < q)) continue;
+          st.weight = v3_scale(st.weight, 1.0f / q);
+        }
+        st.pdf = bs.pdf;
+        st.delta = (uint8_t)bs.delta;
+        st.depth = (uint8_t)(depth + 1);
+        S->st[nn] = st;
+        S->ray[nn++] = make_ray(p, to_world(bs.wi, tb, bb, n), eps, INFINITY);
+      }
+      double t3 = fr_seconds();
+      S->stage[FR_STAGE_SHADE] += t3 - t2;
+      if (ns) {
+        t->occluded(t->ctx, S->sray, S->occ, ns, 0);
+        rays += ns;
+        for (size_t k = 0; k < ns; k++)
+          if (!S->occ[k]) S->acc[S->spix[k]] = v3_add(S->acc[S->spix[k]], S->scontrib[k]);
+      }
+      t0 = fr_seconds();
+      S->stage[FR_STAGE_SHADOW] += t0 - t3;
+      n = nn;
+    }
+  }
+  for (int i = 0; i < TILE_PIX; i++) {
+    int x, y;
+    tile_pixel(i, &x, &y);
+    x += tx, y += ty;
+    if (x >= W || y >= H) continue;
+    const size_t o = 3 * ((size_t)y * (size_t)W + (size_t)x);
+    if (w->image) { w->image[o] += S->acc[i].x; w->image[o + 1] += S->acc[i].y; w->image[o + 2] += S->acc[i].z; }
+    if (w->gbuf_albedo) { w->gbuf_albedo[o] += S->alb[i].x; w->gbuf_albedo[o + 1] += S->alb[i].y; w->gbuf_albedo[o + 2] += S->alb[i].z; }
+    if (w->gbuf_normal) { w->gbuf_normal[o] += S->nrm[i].x; w->gbuf_normal[o + 1] += S->nrm[i].y; w->gbuf_normal[o + 2] += S->nrm[i].z; }
+  }
+  return rays;
+}

@@ -1,0 +1,61 @@
+/*
+ * The path tracer: unidirectional paths with next-event estimation and
+ * multiple importance sampling (the power heuristic) between light
+ * sampling and BSDF sampling, for the environment, a quad area light and a
+ * point light; Russian roulette once a path's weight falls below
+ * FR_PATH_RR_WEIGHT (the MIC paper's 15%); thin-lens depth of field.
+ *
+ * Rays travel in waves through the tracer (render/tracer.h), so any trace
+ * mode, and Embree, trace the same rays: a tile's paths for up to
+ * FR_PATH_CHUNK samples per pixel at once, then at every bounce one call
+ * for their next segments and one for their shadow rays.
+ */
+#ifndef FR_RENDER_PATH_H
+#define FR_RENDER_PATH_H
+#include <stddef.h>
+#include <stdint.h>
+#include "frusta.h"
+#include "light/environment.h"
+#include "material/bsdf.h"
+#include "render/sampler.h"
+
+#define FR_PATH_CHUNK 8          /* samples per pixel in one wave */
+#define FR_PATH_RR_WEIGHT 0.15f
+#define FR_PATH_MAX_DEPTH 64
+
+typedef struct fr_path_lights {
+  const fr_env *env;            /* never NULL; a black one is not sampled */
+  int area;                     /* the quad c + s e1 + t e2 (s, t in [0, 1]), emitting area_radiance on both sides */
+  vec3 area_c, area_e1, area_e2, area_radiance;
+  int point;                    /* a point light at point_pos of intensity point_intensity (W/sr) */
+  vec3 point_pos, point_intensity;
+} fr_path_lights;
+
+typedef struct fr_path_setup {
+  const fr_bsdf *mats;          /* one per scene material, and one more (the last) for surfaces without */
+  size_t count;                 /* including that last one */
+  fr_path_lights lights;
+  int max_depth;                /* segments per path, 1..FR_PATH_MAX_DEPTH (13 by default) */
+  fr_sampler_kind sampler;
+  int spp;                      /* samples per pixel of the whole image (the sampler's pattern size) */
+  int spp_begin, spp_end;       /* this frame's share of them */
+  float aperture, focus;        /* lens radius (0: pinhole) and focus distance */
+} fr_path_setup;
+
+/* The materials of a scene for path tracing: MTL rules (material/material_mtl.h),
+ * with the named materials made mirrors (chrome) and glass (NULL: the
+ * scene's suggestions, views.h). out->mats is malloc'd. */
+fr_error fr_path_mats_build(const fr_scene *s, const char *mirror, const char *glass, fr_bsdf **mats, size_t *count);
+
+struct fr_workload;
+struct fr_tracer;
+typedef struct fr_path_scratch fr_path_scratch;
+fr_path_scratch *fr_path_scratch_new(void);
+void fr_path_scratch_free(fr_path_scratch *s);
+/* Adds what s's tiles spent tracing (camera, shadow, bounce rays) and shading to stage[]. */
+void fr_path_scratch_stages(const fr_path_scratch *s, double *stage);
+/* One 16x16 tile: adds the samples' radiance to w->image (sums, not
+ * means) and, where set, first-hit albedo and normals to w->gbuf_albedo
+ * and w->gbuf_normal; returns the rays traced. */
+uint64_t fr_path_tile(const struct fr_workload *w, const struct fr_tracer *t, fr_path_scratch *s, int tx, int ty);
+#endif

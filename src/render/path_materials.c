@@ -1,0 +1,65 @@
+/* The path tracer's materials for a scene (path.h). */
+#include <stdlib.h>
+#include <string.h>
+#include "api/scene.h"
+#include "base/error.h"
+#include "material/material_mtl.h"
+#include "render/path.h"
+#include "render/views.h"
+
+/* The built-in material showcase's materials by name. */
+static void showcase(const char *name, fr_bsdf *m) {
+  if (!strcmp(name, "chrome") || !strcmp(name, "gold")) {
+    *m = fr_bsdf_default(FR_BSDF_METAL);
+    fr_bsdf_metal_preset(name, m);
+    m->roughness = !strcmp(name, "gold") ? 0.3f : 0.0f;
+  } else if (!strcmp(name, "carpaint")) {
+    *m = fr_bsdf_default(FR_BSDF_CARPAINT);
+    m->flake_scale = 60.0f;
+  } else if (!strcmp(name, "glass")) {
+    *m = fr_bsdf_default(FR_BSDF_GLASS);
+    m->attenuation_color = v3(0.85f, 0.95f, 0.9f);
+    m->attenuation_distance = 2.0f;
+  }
+}
+
+static int in_list(const char *list, const char *name) {
+  if (!list) return 0;
+  const size_t n = strlen(name);
+  for (const char *p = list; *p;) {
+    const char *e = strchr(p, ',');
+    const size_t len = e ? (size_t)(e - p) : strlen(p);
+    if (len == n && !strncmp(p, name, n)) return 1;
+    if (!e) break;
+    p = e + 1;
+  }
+  return 0;
+}
+
+fr_error fr_path_mats_build(const fr_scene *s, const char *mirror, const char *glass, fr_bsdf **mats, size_t *count) {
+  if (!mirror && !glass) fr_view_surfaces(s->name, &mirror, &glass);
+  float lo[3], hi[3];
+  fr_scene_bounds(s, lo, hi);
+  const float scale = v3_len(v3_sub(v3_load(hi), v3_load(lo)));
+  const size_t nm = fr_scene_material_count(s);
+  fr_bsdf *m = malloc((nm + 1) * sizeof *m);
+  if (!m) return fr_fail(FR_ERR_NOMEM, "out of memory for %zu materials", nm + 1);
+  for (size_t i = 0; i < nm; i++) {
+    const fr_material *mt = fr_scene_material(s, i);
+    m[i] = fr_bsdf_from_mtl(mt, 0.5f * scale);
+    if (in_list(glass, mt->name)) {
+      m[i] = fr_bsdf_default(FR_BSDF_GLASS);
+      m[i].ior = mt->ior > 1.0f && mt->ior < 4.0f ? mt->ior : 1.5f;
+    } else if (in_list(mirror, mt->name)) {
+      m[i] = fr_bsdf_default(FR_BSDF_METAL);
+      fr_bsdf_metal_preset("chrome", &m[i]);
+    }
+  }
+  if (!strcmp(s->name, "materials"))
+    for (size_t i = 0; i < nm; i++) showcase(fr_scene_material(s, i)->name, &m[i]);
+  m[nm] = fr_bsdf_default(FR_BSDF_LAMBERT);
+  *mats = m;
+  *count = nm + 1;
+  return FR_OK;
+}
+

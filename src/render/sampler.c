@@ -1,0 +1,84 @@
+#include "render/sampler.h"
+#include <string.h>
+
+static const char *const names[FR_SAMPLER_COUNT] = {"hammersley", "sobol"};
+const char *fr_sampler_name(fr_sampler_kind k) { return k < FR_SAMPLER_COUNT ? names[k] : "?"; }
+int fr_sampler_parse(const char *name, fr_sampler_kind *k) {
+  for (int i = 0; i < FR_SAMPLER_COUNT; i++)
+    if (!strcmp(name, names[i])) { *k = (fr_sampler_kind)i; return 1; }
+  return 0;
+}
+
+static uint32_t mix(uint32_t h) {
+  h ^= h >> 16; h *= 0x21f0aaadu; h ^= h >> 15; h *= 0x735a2d97u; h ^= h >> 15;
+  return h;
+}
+static uint32_t hash4(uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
+  return mix(a ^ mix(b ^ mix(c ^ mix(d + 0x9e3779b9u))));
+}
+static uint32_t reverse(uint32_t x) {
+  x = (x << 16) | (x >> 16);
+  x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
+  x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
+  x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
+  return ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
+}
+static float to_unit(uint32_t x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
+
+/* A bijection of [0, n) keyed by key: a bijection of the enclosing power of
+ * two (xor, odd multiply and xorshift, each invertible modulo it), walked
+ * until it lands below n. */
+static uint32_t permute(uint32_t i, uint32_t n, uint32_t key) {
+  if (n <= 1) return 0;
+  const unsigned bits = 32u - (unsigned)__builtin_clz(n - 1);
+  const uint32_t mask = bits >= 32 ? 0xffffffffu : (1u << bits) - 1u;
+  const unsigned sh = bits / 2u + 1u;
+  do {
+    i = (i ^ key) & mask;
+    i = (i * 0x2c1b3c6du) & mask;
+    i ^= i >> sh;
+    i = (i * 0x297a2d39u) & mask;
+    i ^= (i >> 3) & mask;
+    i = (i + (key >> 7)) & mask;
+  } while (i >= n);
+  return i;
+}
+
+/* Owen scrambling of a base-2 fraction by a Laine-Karras style hash
+ * (bit k's flip depends on the bits above it only). */
+static uint32_t owen(uint32_t x, uint32_t seed) {
+  x = reverse(x);
+  x += seed;
+  x ^= x * 0x6c50b47cu;
+  x ^= x * 0xb82f1e52u;
+  x ^= x * 0xc7afe638u;
+  x ^= x * 0x8d22f6e6u;
+  return reverse(x);
+}
+
+/* Sobol's second dimension: direction numbers of the polynomial x + 1. */
+static uint32_t sobol1(uint32_t i) {
+  uint32_t v = 1u << 31, r = 0;
+  for (; i; i >>= 1, v ^= v >> 1)
+    if (i & 1) r ^= v;
+  return r;
+}
+
+void fr_sample2d(fr_sampler_kind k, uint32_t seed, uint32_t pixel, uint32_t i, uint32_t n, uint32_t d, float *u1,
+                 float *u2) {
+  const uint32_t key = hash4(seed, pixel, d, 0x51ed27u);
+  if (k == FR_SAMPLER_SOBOL) {
+    const uint32_t j = owen(i, key);
+    *u1 = to_unit(owen(reverse(j), hash4(key, 1, 0, 0)));
+    *u2 = to_unit(owen(sobol1(j), hash4(key, 2, 0, 0)));
+    return;
+  }
+  const uint32_t j = permute(i, n, key);
+  /* (j + r) / n with one random offset r per pattern, and the radical
+   * inverse with its bits flipped by a random mask: both keep the
+   * pattern's strata */
+  const float r = to_unit(hash4(key, 3, 0, 0));
+  float x = ((float)j + r) / (float)n;
+  *u1 = x < 1.0f ? x : 0.99999994f;
+  *u2 = to_unit(reverse(j) ^ hash4(key, 4, 0, 0));
+}

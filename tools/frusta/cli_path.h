@@ -1,0 +1,35 @@
+/* The path tracer's flags, shared by render and bench, and what they set up:
+ * materials, lights and the environment (render/path.h). */
+#ifndef FR_TOOL_CLI_PATH_H
+#define FR_TOOL_CLI_PATH_H
+#include "flags.h"
+#include "light/environment.h"
+#include "render/path.h"
+#include "render/workload.h"
+
+enum { CLI_LIGHT_ENV = 1, CLI_LIGHT_AREA = 2, CLI_LIGHT_POINT = 4 };
+
+typedef struct cli_path {
+  int spp, max_depth, lights;
+  fr_sampler_kind sampler;
+  unsigned seed;
+  const char *env_file, *mirror, *glass;
+  vec3 env_color;
+  float env_intensity, env_rotate, aperture, focus, exposure; /* focus < 0: not given */
+  int aov;
+} cli_path;
+
+typedef struct cli_path_run {
+  fr_env env;
+  fr_bsdf *mats;
+  fr_path_setup setup;
+} cli_path_run;
+
+/* The flags; 0, or 2 after reporting a usage error. */
+int cli_path_from_args(const cli_args *a, cli_path *o);
+/* Loads the environment, builds the materials and lights for w's scene
+ * and view, and points w->path at r->setup (whole frame: spp 0..spp);
+ * 0, or the exit code after reporting. Prints one line of what it set. */
+int cli_path_setup(const cli_path *o, fr_workload *w, cli_path_run *r);
+void cli_path_free(cli_path_run *r);
+#endif
