@@ -10,7 +10,9 @@
  * up to flake_spread; a flake is a rough conductor-like mirror (Schlick
  * Fresnel from flake_color, GGX of flake_roughness) about its own normal.
  * The base is Lambertian with a colour that turns from `color` seen head-on
- * to flipflop_color at grazing angles, the sooner the larger flipflop_falloff.
+ * to flipflop_color at grazing angles (by the mean cosine of the two
+ * directions, so that the BSDF stays reciprocal), the sooner the larger
+ * flipflop_falloff.
  */
 #include <stddef.h>
 #include <stdint.h>
@@ -67,7 +69,7 @@ static vec3 flake_eval(const fr_bsdf *m, vec3 n, vec3 wo, vec3 wi, float *pdf) {
   const vec3 h = v3_norm(v3_add(lo, li));
   const float oh = v3_dot(lo, h);
   if (oh <= 0.0f) return v3(0, 0, 0);
-  *pdf = fr_ggx_pdf_reflect(lo, h, a) / oh;
+  *pdf = fr_ggx_pdf_reflect(lo, h, a);
   return v3_scale(schlick(m->flake_color, oh), fr_ggx_d(h, a) * fr_ggx_g2(lo, li, a) / (4.0f * lo.z) * wi.z / li.z);
 }
 static int flake_sample(const fr_bsdf *m, vec3 n, vec3 wo, float u1, float u2, vec3 *wi) {
@@ -89,7 +91,7 @@ static float coat_probability(const fr_bsdf *m, const fr_shading_point *sp, floa
 static vec3 layer_eval(const fr_bsdf *m, const fr_shading_point *sp, vec3 wo, vec3 wi, float *pdf) {
   if (sp->flake) return flake_eval(m, sp->flake_n, wo, wi, pdf);
   *pdf = wi.z * FR_INV_PI;
-  return v3_scale(base_color(m, wo.z), wi.z * FR_INV_PI);
+  return v3_scale(base_color(m, 0.5f * (wo.z + wi.z)), wi.z * FR_INV_PI); /* symmetric in wo, wi: reciprocal */
 }
 
 int fr_carpaint_sample(const fr_bsdf *m, const fr_shading_point *sp, vec3 wo, float uc, float u1, float u2,

@@ -35,8 +35,10 @@ static inline vec3 fr_fresnel_conductor(float c, vec3 eta, vec3 k) {
             fr_fresnel_conductor1(c, eta.z, k.z));
 }
 
-/* The hemispherical average of the dielectric reflectance from outside,
- * 2 int F(cos) cos dcos, by the fit of d'Eon and Irving (eta > 1). */
+/* The reflectance of an interface for diffuse light arriving from inside a
+ * medium of relative index eta > 1, 2 int F(cos) cos dcos, by the fit of
+ * d'Eon and Irving (about 0.6 at 1.5; from outside it is
+ * 1 - (1 - that) eta^2, about 0.09). */
 static inline float fr_fresnel_diffuse(float eta) {
   if (eta < 1.0f) return 0.0f;
   return -1.4399f / (eta * eta) + 0.7099f / eta + 0.6681f + 0.0636f * eta;

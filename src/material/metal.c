@@ -26,7 +26,7 @@ int fr_metal_sample(const fr_bsdf *m, const fr_shading_point *sp, vec3 wo, float
   const float oh = v3_dot(wo, h);
   out->wi = fr_reflect(wo, h);
   if (out->wi.z <= 0.0f || oh <= 0.0f) return 0;
-  out->pdf = fr_ggx_pdf_reflect(wo, h, a) / oh;
+  out->pdf = fr_ggx_pdf_reflect(wo, h, a);
   out->weight = v3_scale(fr_fresnel_conductor(oh, m->eta, m->k), fr_ggx_g2(wo, out->wi, a) / fr_ggx_g1(wo, a));
   out->delta = 0;
   return out->pdf > 0.0f;
@@ -41,6 +41,6 @@ vec3 fr_metal_eval(const fr_bsdf *m, const fr_shading_point *sp, vec3 wo, vec3 w
   const float oh = v3_dot(wo, h);
   if (oh <= 0.0f) return v3(0, 0, 0);
   const float d = fr_ggx_d(h, a);
-  *pdf = fr_ggx_pdf_reflect(wo, h, a) / oh;
+  *pdf = fr_ggx_pdf_reflect(wo, h, a);
   return v3_scale(fr_fresnel_conductor(oh, m->eta, m->k), d * fr_ggx_g2(wo, wi, a) / (4.0f * wo.z));
 }

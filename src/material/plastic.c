@@ -5,15 +5,16 @@
  * the coat, as in Weidlich and Wilkie's layered model with the internal
  * bounces summed in closed form:
  *   f_d = (1 - F(wo)) (1 - F(wi)) color / (pi ior^2 (1 - color Fdr_in)),
- * Fdr_in = 1 - (1 - Fdr_out) / ior^2 the coat's reflectance of diffuse light
- * from below. With white color the albedo comes to 1 (up to the Fresnel fit).
+ * Fdr_in the coat's reflectance of diffuse light from below. Since
+ * 1 - Fdr_in = (1 - Fdr_out) / ior^2, white color reflects 1 - F(wo) by the
+ * base and F(wo) by the coat: all of it (up to the Fresnel fit).
  * The coat's mirror lobe is picked with probability F / (F + (1 - F) max(color)).
  */
 #include "material/bsdf_kinds.h"
 #include "material/fresnel.h"
 
 static vec3 diffuse_f(const fr_bsdf *m, float fo, float fi) {
-  const float e2 = m->ior * m->ior, fdr_in = 1.0f - (1.0f - fr_fresnel_diffuse(m->ior)) / e2;
+  const float e2 = m->ior * m->ior, fdr_in = fr_fresnel_diffuse(m->ior);
   const vec3 c = m->color;
   const float s = (1.0f - fo) * (1.0f - fi) * FR_INV_PI / e2;
   return v3(s * c.x / (1.0f - c.x * fdr_in), s * c.y / (1.0f - c.y * fdr_in), s * c.z / (1.0f - c.z * fdr_in));

@@ -21,6 +21,7 @@ typedef struct path_state {
   vec3 weight;     /* throughput: what the radiance found next is multiplied by */
   float pdf;       /* solid-angle pdf of the BSDF sample that made the ray (for MIS at an emitter it hits) */
   uint32_t sample; /* sample index within the pixel */
+  uint32_t key;    /* the pixel's sampler key */
   uint16_t pix;    /* pixel within the tile */
   uint8_t delta;   /* the ray left a delta lobe (or the camera): emitters it hits count whole */
   uint8_t depth;   /* segments before this one */
@@ -38,7 +39,11 @@ struct fr_path_scratch {
   double stage[FR_STAGES];
 };
 
-fr_path_scratch *fr_path_scratch_new(void) { return fr_alloc_aligned(sizeof(fr_path_scratch), 64); }
+fr_path_scratch *fr_path_scratch_new(void) {
+  fr_path_scratch *s = fr_alloc_aligned(sizeof(fr_path_scratch), 64);
+  if (s) memset(s->stage, 0, sizeof s->stage);
+  return s;
+}
 void fr_path_scratch_free(fr_path_scratch *s) { fr_free_aligned(s); }
 void fr_path_scratch_stages(const fr_path_scratch *s, double *stage) {
   if (s)
@@ -147,21 +152,21 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         tile_pixel(i, &x, &y);
         x += tx, y += ty;
         if (x >= W || y >= H) continue;
-        const uint32_t pixel = (uint32_t)y * (uint32_t)W + (uint32_t)x;
+        const uint32_t key = fr_sampler_pixel_key(seed, (uint32_t)y * (uint32_t)W + (uint32_t)x);
         float jx, jy, lx, ly;
-        fr_sample2d(P->sampler, seed, pixel, (uint32_t)s, n_spp, 0, &jx, &jy);
+        fr_sample2d(P->sampler, key, (uint32_t)s, n_spp, 0, &jx, &jy);
         const float sx = 2.0f * ((float)x + jx) / (float)W - 1.0f, sy = 1.0f - 2.0f * ((float)y + jy) / (float)H;
         vec3 d = v3_add(c->fwd, v3_add(v3_scale(c->right, sx), v3_scale(c->up, sy)));
         vec3 o = c->eye;
         if (P->aperture > 0.0f) {
-          fr_sample2d(P->sampler, seed, pixel, (uint32_t)s, n_spp, 1, &lx, &ly);
+          fr_sample2d(P->sampler, key, (uint32_t)s, n_spp, 1, &lx, &ly);
           const float r = P->aperture * sqrtf(lx), phi = 6.28318530718f * ly;
           const vec3 focus = v3_add(c->eye, v3_scale(d, P->focus)); /* the image plane lies at distance 1 along fwd */
           o = v3_add(o, v3_add(v3_scale(ru, r * cosf(phi)), v3_scale(uu, r * sinf(phi))));
           d = v3_sub(focus, o);
         }
         S->ray[n] = make_ray(o, v3_norm(d), 0.0f, INFINITY);
-        S->st[n] = (path_state){v3(1, 1, 1), 0.0f, (uint32_t)s, (uint16_t)i, 1, 0};
+        S->st[n] = (path_state){v3(1, 1, 1), 0.0f, (uint32_t)s, key, (uint16_t)i, 1, 0};
         n++;
       }
     for (int depth = 0; n; depth++) {
@@ -177,9 +182,6 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         const fr_ray r = S->ray[k];
         const fr_hit h = S->hit[k];
         const vec3 o = v3_load(r.org), d = v3_load(r.dir);
-        int px, py;
-        tile_pixel(st.pix, &px, &py);
-        const uint32_t pixel = (uint32_t)(py + ty) * (uint32_t)W + (uint32_t)(px + tx);
         const int hit = h.prim != FR_INVALID_ID;
         const float tmax = hit ? h.t : INFINITY;
         /* the area light, which is not in the scene's geometry, in front of the hit */
@@ -222,10 +224,10 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         }
         const uint32_t dim = 2u + 4u * (uint32_t)depth;
         float uc, ul, u1, u2, v1, v2, ur, unused;
-        fr_sample2d(P->sampler, seed, pixel, st.sample, n_spp, dim, &uc, &ul);
+        fr_sample2d(P->sampler, st.key, st.sample, n_spp, dim, &uc, &ul);
         /* next-event estimation */
         if (nlights && fr_bsdf_has_smooth(m, &sp)) {
-          fr_sample2d(P->sampler, seed, pixel, st.sample, n_spp, dim + 1, &u1, &u2);
+          fr_sample2d(P->sampler, st.key, st.sample, n_spp, dim + 1, &u1, &u2);
           vec3 wi, le;
           float dist, pl;
           int delta;
@@ -242,13 +244,13 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         }
         /* the next segment */
         if (depth + 1 >= P->max_depth) continue;
-        fr_sample2d(P->sampler, seed, pixel, st.sample, n_spp, dim + 2, &v1, &v2);
+        fr_sample2d(P->sampler, st.key, st.sample, n_spp, dim + 2, &v1, &v2);
         fr_bsdf_sample bs;
         if (!fr_bsdf_sample_dir(m, &sp, wo, ul, v1, v2, &bs)) continue;
         st.weight = v3_mul(st.weight, bs.weight);
         const float q = fr_maxf(st.weight.x, fr_maxf(st.weight.y, st.weight.z)) / FR_PATH_RR_WEIGHT;
         if (q < 1.0f) {
-          fr_sample2d(P->sampler, seed, pixel, st.sample, n_spp, dim + 3, &ur, &unused);
+          fr_sample2d(P->sampler, st.key, st.sample, n_spp, dim + 3, &ur, &unused);
           if (!(ur < q)) continue;
           st.weight = v3_scale(st.weight, 1.0f / q);
         }

@@ -13,9 +13,7 @@ static uint32_t mix(uint32_t h) {
   h ^= h >> 16; h *= 0x21f0aaadu; h ^= h >> 15; h *= 0x735a2d97u; h ^= h >> 15;
   return h;
 }
-static uint32_t hash4(uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
-  return mix(a ^ mix(b ^ mix(c ^ mix(d + 0x9e3779b9u))));
-}
+uint32_t fr_sampler_pixel_key(uint32_t seed, uint32_t pixel) { return mix(seed ^ mix(pixel + 0x9e3779b9u)); }
 static uint32_t reverse(uint32_t x) {
   x = (x << 16) | (x >> 16);
   x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
@@ -64,21 +62,20 @@ static uint32_t sobol1(uint32_t i) {
   return r;
 }
 
-void fr_sample2d(fr_sampler_kind k, uint32_t seed, uint32_t pixel, uint32_t i, uint32_t n, uint32_t d, float *u1,
-                 float *u2) {
-  const uint32_t key = hash4(seed, pixel, d, 0x51ed27u);
+void fr_sample2d(fr_sampler_kind k, uint32_t pixel_key, uint32_t i, uint32_t n, uint32_t d, float *u1, float *u2) {
+  const uint32_t key = mix(pixel_key + d * 0x51ed2705u);
   if (k == FR_SAMPLER_SOBOL) {
     const uint32_t j = owen(i, key);
-    *u1 = to_unit(owen(reverse(j), hash4(key, 1, 0, 0)));
-    *u2 = to_unit(owen(sobol1(j), hash4(key, 2, 0, 0)));
+    *u1 = to_unit(owen(reverse(j), mix(key ^ 0x68e31da4u)));
+    *u2 = to_unit(owen(sobol1(j), mix(key ^ 0xb5297a4du)));
     return;
   }
   const uint32_t j = permute(i, n, key);
   /* (j + r) / n with one random offset r per pattern, and the radical
    * inverse with its bits flipped by a random mask: both keep the
    * pattern's strata */
-  const float r = to_unit(hash4(key, 3, 0, 0));
+  const float r = to_unit(mix(key ^ 0x1b56c4e9u));
   float x = ((float)j + r) / (float)n;
   *u1 = x < 1.0f ? x : 0.99999994f;
-  *u2 = to_unit(reverse(j) ^ hash4(key, 4, 0, 0));
+  *u2 = to_unit(reverse(j) ^ mix(key ^ 0x7f4a7c15u));
 }

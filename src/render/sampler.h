@@ -16,8 +16,9 @@
 
 typedef enum fr_sampler_kind { FR_SAMPLER_HAMMERSLEY, FR_SAMPLER_SOBOL, FR_SAMPLER_COUNT } fr_sampler_kind;
 
-void fr_sample2d(fr_sampler_kind k, uint32_t seed, uint32_t pixel, uint32_t i, uint32_t n, uint32_t d, float *u1,
-                 float *u2);
+/* A pixel's key, made once per pixel from the seed. */
+uint32_t fr_sampler_pixel_key(uint32_t seed, uint32_t pixel);
+void fr_sample2d(fr_sampler_kind k, uint32_t pixel_key, uint32_t i, uint32_t n, uint32_t d, float *u1, float *u2);
 const char *fr_sampler_name(fr_sampler_kind k);
 int fr_sampler_parse(const char *name, fr_sampler_kind *k);
 #endif

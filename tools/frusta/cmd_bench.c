@@ -14,6 +14,7 @@
 #include "api/scene.h"
 #include "cli.h"
 #include "commands.h"
+#include "cli_path.h"
 #include "embree_tracer.h"
 #include "render/workload.h"
 #include "trace/counters.h"
@@ -73,16 +74,19 @@ static void report(const fr_workload *w0, const bench_run *r, const char *scene,
   printf("scene=%s tris=%zu workload=%s tracer=%s mode=%s threads=%d rays=%llu seconds=%.4f mrays=%.2f median_seconds=%.4f median_mrays=%.2f%s\n",
          scene, tris, fr_workload_name(w0->kind), tracer, mode, w0->threads, (unsigned long long)rays, best,
          (double)rays / best * 1e-6, med, (double)rays / med * 1e-6, embree);
-  if (w0->kind == FR_WL_WHITTED) {
+  if (w0->kind == FR_WL_WHITTED || w0->kind == FR_WL_PATH) {
     /* the stages of the fastest repetition, in thread-seconds: which part of
-     * a Whitted frame the tracer speeds up, and how much is the renderer's */
+     * a Whitted or path-traced frame the tracer speeds up, and how much is
+     * the renderer's (shading, sampling, lights) */
     int b = 0;
     for (int i = 1; i < repeat; i++)
       if (r->secs[i] < r->secs[b]) b = i;
     const double *st = r->stage[b];
-    printf("stages tracer=%s mode=%s workload=%s camera_s=%.4f shadow_s=%.4f secondary_s=%.4f shade_s=%.4f\n", tracer,
-           mode, fr_workload_name(w0->kind), st[FR_STAGE_CAMERA], st[FR_STAGE_SHADOW], st[FR_STAGE_SECONDARY],
-           st[FR_STAGE_SHADE]);
+    const double all = st[FR_STAGE_CAMERA] + st[FR_STAGE_SHADOW] + st[FR_STAGE_SECONDARY] + st[FR_STAGE_SHADE];
+    printf("stages tracer=%s mode=%s workload=%s camera_s=%.4f shadow_s=%.4f secondary_s=%.4f shade_s=%.4f "
+           "outside_tracing=%.1f%%\n",
+           tracer, mode, fr_workload_name(w0->kind), st[FR_STAGE_CAMERA], st[FR_STAGE_SHADOW], st[FR_STAGE_SECONDARY],
+           st[FR_STAGE_SHADE], all > 0.0 ? 100.0 * st[FR_STAGE_SHADE] / all : 0.0);
   }
   fr_counters c = r->c;
   if (fr_counters_enabled() && c.rays)
@@ -193,12 +197,13 @@ typedef struct bench_opts {
   fr_light_sets light_sets;
   cli_view view;
   cli_whitted whitted;
+  cli_path path;
 } bench_opts;
 
 /* --workload: all, or a comma-separated list */
 static int parse_workloads(const char *list, unsigned *sel) {
   *sel = 0;
-  if (!strcmp(list, "all")) { *sel = (1u << FR_WL_COUNT) - 1; return 0; }
+  if (!strcmp(list, "all")) { *sel = ((1u << FR_WL_COUNT) - 1) & ~(1u << FR_WL_PATH); return 0; } /* path: by name */
   char buf[256];
   if (strlen(list) >= sizeof buf) return cli_error(CLI_USAGE_ERROR, "--workload: list too long");
   memcpy(buf, list, strlen(list) + 1);
@@ -206,7 +211,7 @@ static int parse_workloads(const char *list, unsigned *sel) {
     fr_workload_kind k;
     if (!fr_workload_parse(tok, &k))
       return cli_error(CLI_USAGE_ERROR, "unknown workload '%s' (primary, shadow, soft16, ao16, diffuse8, specular8, "
-                                        "whitted, all)", tok);
+                                        "whitted, path, all)", tok);
     *sel |= 1u << k;
   }
   return *sel ? 0 : cli_error(CLI_USAGE_ERROR, "--workload: none given");
@@ -257,6 +262,7 @@ static int bench_options(const cli_args *a, bench_opts *o) {
   static const char *const tracers[] = {"frusta", "embree", "both"};
   int ef = 0, ep = 0, tracer = 0, rc;
   if ((rc = cli_view_from_args(a, &o->view)) || (rc = cli_whitted_from_args(a, &o->whitted)) ||
+      (rc = cli_path_from_args(a, &o->path)) ||
       (rc = cli_common_from_args(a, &o->threads)) || (rc = cli_arg_int(a, F_REPEAT, 1, 64, &o->repeat)) ||
       (rc = cli_arg_choice(a, F_EMBREE_FLAG, flags, 4, &ef)) ||
       (rc = cli_arg_choice(a, F_EMBREE_PACKING, packings, 3, &ep)) ||
@@ -279,6 +285,7 @@ typedef struct bench_setup {
   fr_bvh2 shallow;        /* --mft-leaf's tree */
   fr_mft_tracer mctx;
   fr_whitted_mats mats;
+  cli_path_run path;
   ebr_scene *e;
   int width;              /* the single-ray BVH width */
 } bench_setup;
@@ -287,6 +294,7 @@ static void setup_free(bench_setup *b) {
   ebr_release(b->e);
   fr_bvh2_free(&b->shallow);
   fr_whitted_mats_free(&b->mats);
+  cli_path_free(&b->path);
   fr_scene_release(b->s);
 }
 
@@ -345,6 +353,7 @@ static int bench_prepare(const bench_opts *o, bench_setup *b) {
            m->shrink == FR_MFT_SHRINK_ALL ? "on" : m->shrink == FR_MFT_SHRINK_CORNERS ? "corners" : "off",
            o->mft_no_fallback ? "off" : "on", o->mft_no_shaft ? "off" : "on");
   if (((o->workloads >> FR_WL_WHITTED) & 1) && (rc = cli_whitted_setup(s, &o->whitted, &b->mats, &b->w))) return rc;
+  if (((o->workloads >> FR_WL_PATH) & 1) && (rc = cli_path_setup(&o->path, &b->w, &b->path))) return rc;
   if (o->esel) {
     ebr_options eo = {.threads = o->threads, .quality = 2}; /* high quality, not robust: Embree's fastest tracing */
     if (ebr_create(s, eo, &b->e)) return cli_error(1, "embree: cannot build the scene");

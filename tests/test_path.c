@@ -1,0 +1,242 @@
+/*
+ * The path tracer (render/path.h) as a whole:
+ *   - white furnace: inside a constant environment of radiance 1, a closed
+ *     white Lambert sphere and a clear glass sphere render 1 everywhere
+ *     (mean within 0.5% at 256 samples per pixel);
+ *   - the environment's importance sampling (render/light) has the same
+ *     mean as uniform sampling, and states the pdf it samples by;
+ *   - the samplers stratify: n points of a pixel's pattern fall one per
+ *     stratum of 1/n in each coordinate;
+ *   - the image is the same bits on 1 and 3 threads and in every trace mode
+ *     (up to rays that graze an edge: none on these spheres), and equals
+ *     the one traced through Embree with the same seed but for a few
+ *     pixels.
+ */
+#include "test_util.h"
+#include "embree_tracer.h"
+#include "light/environment.h"
+#include "render/path.h"
+#include "render/sampler.h"
+
+typedef struct furnace {
+  fr_scene *s;
+  fr_bsdf mats[2];
+  fr_env env;
+  fr_path_setup P;
+  fr_workload w;
+} furnace;
+
+/* A unit sphere of material kind at the origin, seen from z = 3.5, in a
+ * constant white environment. */
+static void furnace_setup(furnace *f, fr_bsdf m, int size, int spp) {
+  memset(f, 0, sizeof *f);
+  assert_int_equal(fr_scene_new(&f->s), FR_OK);
+  fr_material mt;
+  memset(&mt, 0, sizeof mt);
+  snprintf(mt.name, sizeof mt.name, "ball");
+  uint32_t id;
+  assert_int_equal(fr_scene_add_material(f->s, &mt, &id), FR_OK);
+  const float c[3] = {0, 0, 0};
+  assert_int_equal(fr_scene_add_sphere(f->s, c, 1.0f, id), FR_OK);
+  assert_int_equal(fr_scene_commit(f->s), FR_OK);
+  f->mats[0] = m;
+  f->mats[1] = fr_bsdf_default(FR_BSDF_LAMBERT);
+  fr_env_constant(&f->env, v3(1, 1, 1));
+  f->P.mats = f->mats, f->P.count = 2;
+  f->P.lights.env = &f->env;
+  f->P.max_depth = 13, f->P.sampler = FR_SAMPLER_HAMMERSLEY, f->P.spp = spp, f->P.spp_end = spp;
+  f->P.focus = 3.5f;
+  fr_workload *w = &f->w;
+  w->kind = FR_WL_PATH;
+  w->scene = f->s;
+  assert_int_equal(fr_camera_setup(&w->cam, v3(0, 0, 3.5f), v3(0, 0, 0), v3(0, 1, 0), 40.0f, size, size), FR_OK);
+  w->view.up = v3(0, 1, 0);
+  w->eps = 1e-4f;
+  w->threads = 2;
+  w->seed = 3;
+  w->path = &f->P;
+  w->image = calloc((size_t)size * size * 3, sizeof(float));
+}
+
+static void furnace_free(furnace *f) {
+  free(f->w.image);
+  fr_env_free(&f->env);
+  fr_scene_release(f->s);
+}
+
+static double render_mean(furnace *f, const fr_tracer *t, uint64_t *rays) {
+  const fr_workload_result r = fr_workload_run(&f->w, t);
+  if (rays) *rays = r.rays;
+  const size_t n = (size_t)f->w.cam.width * f->w.cam.height * 3;
+  double sum = 0.0;
+  for (size_t i = 0; i < n; i++) sum += f->w.image[i];
+  return sum / (double)n / f->P.spp;
+}
+
+static void white_furnace(void **st) {
+  (void)st;
+  fr_bsdf kinds[2] = {fr_bsdf_default(FR_BSDF_LAMBERT), fr_bsdf_default(FR_BSDF_GLASS)};
+  kinds[0].color = v3(1, 1, 1);
+  const char *names[2] = {"white Lambert", "clear glass"};
+  for (int k = 0; k < 2; k++) {
+    furnace f;
+    furnace_setup(&f, kinds[k], FR_TEST_SANITIZED ? 16 : 32, FR_TEST_SANITIZED ? 64 : 256);
+    const fr_tracer t = fr_tracer_frusta(f.s);
+    const double mean = render_mean(&f, &t, NULL);
+    /* the sphere's own pixels too: the largest deviation of any 4x4 block */
+    const int W = f.w.cam.width;
+    double worst = 0.0;
+    for (int by = 0; by < W; by += 4)
+      for (int bx = 0; bx < W; bx += 4) {
+        double s = 0.0;
+        for (int y = by; y < by + 4; y++)
+          for (int x = bx; x < bx + 4; x++) s += f.w.image[3 * ((size_t)y * W + x)];
+        worst = fmax(worst, fabs(s / 16.0 / f.P.spp - 1.0));
+      }
+    print_message("%s sphere in a white furnace: mean %.5f, worst 4x4 block off by %.4f\n", names[k], mean, worst);
+    assert_true(fabs(mean - 1.0) < 0.005);
+    assert_true(worst < 0.05);
+    furnace_free(&f);
+  }
+}
+
+static void environment_sampling(void **st) {
+  (void)st;
+  /* a made-up sky: a gradient, a hot spot (a sun) and a black band */
+  const int w = 128, h = 64;
+  float *rgb = malloc((size_t)w * h * 3 * sizeof(float));
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      float *c = rgb + 3 * ((size_t)y * w + x);
+      const float sun = (abs(x - 90) < 3 && abs(y - 14) < 2) ? 2000.0f : 0.0f;
+      c[0] = 0.2f + (float)y / h + sun, c[1] = 0.5f + sun, c[2] = y > 40 && y < 44 ? 0.0f : 1.0f + sun;
+      if (y > 40 && y < 44) c[0] = c[1] = 0.0f;
+    }
+  fr_env env;
+  assert_int_equal(fr_env_from_image(&env, rgb, w, h), FR_OK);
+  fr_env_orient(&env, v3(0.2f, 1, 0.1f), 30.0f, 1.5f);
+  fr_rng r = fr_rng_seed(3, 3);
+  const int n = FR_TEST_ROUNDS(2000000);
+  double imp = 0.0, uni = 0.0, uni2 = 0.0, imp2 = 0.0;
+  int other_texel = 0;
+  for (int k = 0; k < n; k++) {
+    vec3 d;
+    float pdf;
+    const vec3 le = fr_env_sample(&env, fr_rng_float(&r), fr_rng_float(&r), &d, &pdf);
+    assert_true(pdf > 0.0f);
+    /* the pdf it states is the pdf fr_env_pdf gives, and the radiance eval's,
+     * but where rounding puts the direction on a neighbouring texel */
+    const vec3 le2 = fr_env_eval(&env, d);
+    other_texel += !(fabsf(fr_env_pdf(&env, d) - pdf) <= 2e-3f * pdf && fabsf(le2.y - le.y) <= 1e-5f * le2.y);
+    const double x = le2.y / pdf;
+    imp += x, imp2 += x * x;
+    /* uniform over the sphere */
+    const float z = 1.0f - 2.0f * fr_rng_float(&r), rr = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 6.2831853f * fr_rng_float(&r);
+    const double y = fr_env_eval(&env, v3(rr * cosf(phi), rr * sinf(phi), z)).y * 4.0 * M_PI;
+    uni += y, uni2 += y * y;
+  }
+  imp /= n, uni /= n;
+  assert_true(other_texel <= n / 10000);
+  const double se_imp = sqrt((imp2 / n - imp * imp) / n), se_uni = sqrt((uni2 / n - uni * uni) / n);
+  print_message("environment: importance %.4f +- %.4f, uniform %.4f +- %.4f (%d of %d samples on a neighbouring texel)\n",
+                imp, se_imp, uni, se_uni, other_texel, n);
+  assert_true(fabs(imp - uni) < 4.0 * sqrt(se_imp * se_imp + se_uni * se_uni));
+  /* and the exact integral: each texel's radiance times its solid angle */
+  double exact = 0.0;
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++)
+      exact += env.rgb[3 * ((size_t)y * w + x) + 1] * env.intensity * (2.0 * M_PI / w) *
+               (cos(M_PI * y / h) - cos(M_PI * (y + 1) / h));
+  print_message("environment: exact %.4f\n", exact);
+  assert_true(fabs(imp - exact) < 4.0 * se_imp + 1e-4 * exact);
+  assert_true(se_imp < se_uni); /* and it pays */
+  fr_env_free(&env);
+}
+
+static void samplers_stratify(void **st) {
+  (void)st;
+  for (int k = 0; k < FR_SAMPLER_COUNT; k++)
+    for (uint32_t n = 1; n <= 256; n *= 4)
+      for (uint32_t pixel = 0; pixel < 50; pixel++)
+        for (uint32_t d = 0; d < 6; d++) {
+          unsigned char hit1[256] = {0}, hit2[256] = {0};
+          for (uint32_t i = 0; i < n; i++) {
+            float u1, u2;
+            fr_sample2d((fr_sampler_kind)k, fr_sampler_pixel_key(7, pixel), i, n, d, &u1, &u2);
+            assert_true(u1 >= 0.0f && u1 < 1.0f && u2 >= 0.0f && u2 < 1.0f);
+            hit1[(int)(u1 * n)]++, hit2[(int)(u2 * n)]++;
+          }
+          for (uint32_t i = 0; i < n; i++) assert_true(hit1[i] == 1 && hit2[i] == 1);
+        }
+}
+
+/* The same image on 1 and 3 threads, in every trace mode, and through Embree. */
+static void same_image_everywhere(void **st) {
+  (void)st;
+  fr_scene *s;
+  assert_int_equal(fr_scene_builtin_materials(&s), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  fr_bsdf *mats;
+  size_t count;
+  assert_int_equal(fr_path_mats_build(s, NULL, NULL, &mats, &count), FR_OK);
+  fr_env env;
+  fr_env_constant(&env, v3(0.6f, 0.7f, 1.0f));
+  fr_view v;
+  assert_true(fr_view_lookup("materials", &v));
+  fr_path_setup P = {mats, count, {&env, 1, v.area_c, v.area_e1, v.area_e2, v3(20, 20, 20), 1, v.light, v3(50, 50, 50)},
+                     13, FR_SAMPLER_SOBOL, 8, 0, 8, 0.05f, 9.0f};
+  fr_workload w;
+  memset(&w, 0, sizeof w);
+  w.kind = FR_WL_PATH, w.scene = s, w.view = v, w.eps = 1e-4f * 60.0f, w.seed = 5, w.path = &P;
+  const int W = FR_TEST_SANITIZED ? 48 : 96, H = W / 2;
+  assert_int_equal(fr_camera_setup(&w.cam, v.eye, v.at, v.up, v.fov, W, H), FR_OK);
+  const size_t n = (size_t)W * H * 3;
+  float *ref = calloc(n, sizeof(float)), *img = calloc(n, sizeof(float));
+  w.image = ref, w.threads = 1;
+  fr_tracer t = fr_tracer_frusta(s);
+  fr_workload_run(&w, &t);
+  static const fr_trace_mode modes[] = {FR_TRACE_AUTO, FR_TRACE_SINGLE, FR_TRACE_PACKET16, FR_TRACE_HYBRID16, FR_TRACE_RAYSTREAM};
+  for (size_t m = 0; m < sizeof modes / sizeof modes[0]; m++) {
+    assert_int_equal(fr_scene_set_trace_mode(s, modes[m]), FR_OK);
+    memset(img, 0, n * sizeof(float));
+    w.image = img, w.threads = 3;
+    fr_workload_run(&w, &t);
+    size_t differ = 0;
+    for (size_t i = 0; i < n; i++) differ += memcmp(&img[i], &ref[i], sizeof(float)) != 0;
+    print_message("trace mode %d on 3 threads: %zu of %zu values differ from auto on 1 thread\n", (int)modes[m], differ, n);
+    assert_int_equal(differ, 0);
+  }
+  assert_int_equal(fr_scene_set_trace_mode(s, FR_TRACE_AUTO), FR_OK);
+  /* Embree: its own t, u, v bits move the paths by rounding; pixels agree
+   * to within noise of their own, and the image's mean to 0.2% */
+  ebr_options eo = {2, 2, 1, 0};
+  ebr_scene *e;
+  assert_int_equal(ebr_create(s, eo, &e), FR_OK);
+  fr_tracer et = ebr_tracer(e, EBR_STREAM, EBR_FLAG_HINT, EBR_PACK_RAYS);
+  memset(img, 0, n * sizeof(float));
+  w.image = img, w.threads = 2;
+  fr_workload_run(&w, &et);
+  size_t far = 0;
+  double sa = 0.0, sb = 0.0;
+  for (size_t i = 0; i < n; i++) {
+    sa += ref[i], sb += img[i];
+    far += fabsf(img[i] - ref[i]) > 1e-3f * fmaxf(1.0f, ref[i]);
+  }
+  print_message("through Embree: %zu of %zu values differ by more than 0.1%%; means %.5f and %.5f\n", far, n, sa / n, sb / n);
+  assert_true(far <= n / 50);
+  assert_true(fabs(sa - sb) <= 2e-3 * sa);
+  ebr_release(e);
+  free(ref); free(img); free(mats);
+  fr_env_free(&env);
+  fr_scene_release(s);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(white_furnace),
+      cmocka_unit_test(environment_sampling),
+      cmocka_unit_test(samplers_stratify),
+      cmocka_unit_test(same_image_everywhere),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
