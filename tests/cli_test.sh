@@ -175,6 +175,81 @@ expect 2 "$F" bench --builtin --workload soft16 --mode mft --mft-shaft maybe
 expect 2 "$F" bench --builtin --workload soft16 --mode mft --mft-leaf 16
 expect 2 "$F" bench --builtin --workload soft16 --mode mft --corner-rays sometimes
 
+# the path tracer: images (PNG tone-mapped, EXR linear, the AOVs), bad input
+expect 0 "$F" render --builtin=materials --shade path --size 48x24 --spp 4 --out "$T/p.exr" --aov
+[ -s "$T/p.exr" ] && [ -s "$T/p.albedo.exr" ] && [ -s "$T/p.normal.exr" ] && ok || bad "path render with --aov"
+grep -q 'shade=path spp=4 ' "$T/out" && ok || bad "path render line"
+expect 0 "$F" render --builtin=materials --shade path --size 48x24 --spp 2 --env "$SHARED/hdri/studio.exr" --env-rotate 90 \
+  --aperture 0.1 --focus 8 --sampler sobol --max-depth 5 --lights env,point --exposure 1 --out "$T/p.png"
+[ -s "$T/p.png" ] && grep -q 'sampler=sobol lights=env,point env=' "$T/out" && ok || bad "path render with an HDRI"
+expect 0 "$F" bench --builtin=materials --size 32x32 --spp 2 --workload path --mode auto,stream --tracer both --repeat 1
+grep -q 'workload=path tracer=frusta mode=auto' "$T/out" && grep -q 'workload=path tracer=embree mode=stream' "$T/out" \
+  && grep -q 'stages tracer=frusta mode=auto workload=path .* outside_tracing=' "$T/out" && ok || bad "bench path both tracers"
+expect 1 "$F" render --builtin --shade path --env "$T/missing.exr" --out "$T/q.png"
+printf 'not an exr at all' >"$T/bad.exr"
+expect 1 "$F" render --builtin --shade path --env "$T/bad.exr" --out "$T/q.png"
+printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 100000 +X 100000\n' >"$T/liar.hdr"
+expect 1 "$F" render --builtin --shade path --env "$T/liar.hdr" --out "$T/q.png"
+head -c 300 "$SHARED/hdri/city.exr" >"$T/cut.exr"
+expect 1 "$F" render --builtin --shade path --env "$T/cut.exr" --out "$T/q.png"
+expect 2 "$F" render --builtin --shade path --spp 0 --out "$T/q.png"
+expect 2 "$F" render --builtin --shade path --aperture -1 --out "$T/q.png"
+expect 2 "$F" render --builtin --shade path --max-depth 0 --out "$T/q.png"
+expect 2 "$F" render --builtin --shade path --env-color 1,nan,1 --out "$T/q.png"
+expect 2 "$F" render --builtin --shade path --env-color -1,1,1 --out "$T/q.png"
+expect 2 "$F" render --builtin --shade path --lights sun --out "$T/q.png"
+expect 2 "$F" render --builtin --shade path --sampler halton --out "$T/q.png"
+expect 2 "$F" render --builtin --shade path --env "$SHARED/hdri/city.exr" --env-color 1,1,1 --out "$T/q.png"
+expect 2 "$F" bench --builtin --workload path --mode auto --spp 0
+[ ! -e "$T/q.png" ] && ok || bad "a failed path render left an output file"
+
+# scene files: meshes, materials, camera, lights and settings; flags win; errors name the key
+mkdir -p "$T/sc/sub" "$T/out_of"
+printf 'ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n-1 0 -1\n1 0 -1\n1 0 1\n-1 0 1\n3 0 2 1\n3 0 3 2\n' >"$T/sc/sub/floor.ply"
+cp "$T/sc/sub/floor.ply" "$T/out_of/floor.ply"
+cat >"$T/sc/s.json" <<'JSON'
+{
+  "meshes": [ { "file": "sub/floor.ply", "material": "gold" },
+              { "file": "sub/floor.ply", "scale": 0.5, "translate": [0, 0.5, 0], "material": "paint" } ],
+  "materials": { "gold": { "type": "metal", "preset": "gold", "roughness": 0.3 },
+                 "paint": { "type": "carpaint", "color": [0.1, 0.2, 0.6] } },
+  "camera": { "eye": [0, 2, 3], "at": [0, 0, 0], "fov": 50 },
+  "environment": { "color": [0.8, 0.9, 1.0] },
+  "lights": { "point": { "position": [0, 3, 0], "intensity": [20, 20, 20] } },
+  "render": { "shade": "path", "size": [40, 30], "spp": 3, "sampler": "sobol", "seed": 9 }
+}
+JSON
+expect 0 "$F" render "$T/sc/s.json" --out "$T/s1.png"
+grep -q 'shade=path spp=3 ' "$T/out" && grep -q 'size=40x30' "$T/out" && grep -q 'sampler=sobol lights=env,point env=constant' "$T/out" \
+  && grep -q 'tris=4 ' "$T/out" && ok || bad "scene file settings"
+expect 0 "$F" render "$T/sc/s.json" --out "$T/s2.png" --spp 2 --size 20x10 --shade eyelight
+grep -q 'size=20x10 shade=eyelight' "$T/out" && ok || bad "flags override a scene file"
+bad_scene() { # bad_scene EXPECTED_TEXT JSON: a one-line error naming the key
+  printf '%s' "$2" >"$T/sc/b.json"
+  expect 1 "$F" render "$T/sc/b.json" --out "$T/sb.png"
+  grep -q -- "$1" "$T/err" && ok || { bad "scene file error lacks '$1'"; cat "$T/err"; }
+}
+bad_scene 'line 1: not valid JSON' '{"meshes": ['
+bad_scene 'meshes: expected an array' '{"meshes": {}}'
+bad_scene 'meshes\[0\].colour: unknown key' '{"meshes": [{"file": "sub/floor.ply", "colour": 1}]}'
+bad_scene 'meshes\[0\].file' '{"meshes": [{"file": "../out_of/floor.ply"}]}'
+bad_scene 'meshes\[0\].file' '{"meshes": [{"file": "/etc/passwd"}]}'
+bad_scene 'meshes\[0\].file' '{"meshes": [{"file": "sub/none.ply"}]}'
+bad_scene 'materials.m.type' '{"meshes": [{"file": "sub/floor.ply"}], "materials": {"m": {"type": "velvet"}}}'
+bad_scene 'materials.m.ior: expected a number' '{"meshes": [{"file": "sub/floor.ply"}], "materials": {"m": {"type": "glass", "ior": "high"}}}'
+bad_scene 'materials.m.preset' '{"meshes": [{"file": "sub/floor.ply"}], "materials": {"m": {"type": "metal", "preset": "unobtainium"}}}'
+bad_scene "meshes\[0\].material: 'x' is not" '{"meshes": [{"file": "sub/floor.ply", "material": "x"}]}'
+bad_scene 'camera.fov' '{"meshes": [{"file": "sub/floor.ply"}], "camera": {"fov": 500}}'
+bad_scene 'render.size' '{"meshes": [{"file": "sub/floor.ply"}], "render": {"size": [0, 5]}}'
+bad_scene 'environment.file' '{"meshes": [{"file": "sub/floor.ply"}], "environment": {"file": "/etc/passwd"}}'
+bad_scene 'lights.area' '{"meshes": [{"file": "sub/floor.ply"}], "lights": {"area": {"corner": [0, 1, 0]}}}'
+[ ! -e "$T/sb.png" ] && ok || bad "a failed scene file left an output file"
+# --scene-root widens where a scene file may reach
+printf '{"meshes": [{"file": "../out_of/floor.ply"}]}' >"$T/sc/up.json"
+expect 1 "$F" render "$T/sc/up.json" --out "$T/u.png" --size 16x16
+expect 0 "$F" render "$T/sc/up.json" --scene-root "$T" --out "$T/u.png" --size 16x16
+expect 1 "$F" render "$T/sc/up.json" --scene-root "$T/sc" --out "$T/u.png" --size 16x16
+
 # help, version and the manual page, all from the one flag table
 for c in render bench trace stats; do
   expect 0 "$F" $c --help

@@ -134,10 +134,11 @@ static config make(const char *what, fr_bsdf_kind kind) {
 
 static void every_kind(void **st) {
   (void)st;
-  config cs[8];
+  config cs[10];
   int n = 0;
   cs[n++] = make("lambert", FR_BSDF_LAMBERT);
   cs[n] = make("plastic", FR_BSDF_PLASTIC); cs[n++].m.color = v3(0.5f, 0.3f, 0.9f);
+  cs[n] = make("plastic roughness 0.4", FR_BSDF_PLASTIC); cs[n].m.color = v3(0.2f, 0.6f, 0.3f); cs[n++].m.roughness = 0.4f;
   cs[n] = make("metal gold roughness 0.3", FR_BSDF_METAL); fr_bsdf_metal_preset("gold", &cs[n].m); cs[n++].m.roughness = 0.3f;
   cs[n] = make("metal aluminium roughness 0.7", FR_BSDF_METAL); fr_bsdf_metal_preset("aluminium", &cs[n].m); cs[n++].m.roughness = 0.7f;
   cs[n++] = make("metal chrome mirror", FR_BSDF_METAL);
@@ -163,10 +164,14 @@ static void energy_conserved(void **st) {
   l.m.color = v3(1, 1, 1);
   config p = make("plastic white", FR_BSDF_PLASTIC);
   p.m.color = v3(1, 1, 1);
+  config r = make("plastic white, roughness 0.3", FR_BSDF_PLASTIC);
+  r.m.color = v3(1, 1, 1);
+  r.m.roughness = 0.3f;
   for (int a = 0; a < 3; a++) {
     const float th = 0.2f + 0.5f * (float)a;
     albedo(&l, th, 1.0f);
     albedo(&p, th, 1.0f);
+    albedo(&r, th, 0.0f); /* at most 1, less what the microfacets lose */
   }
 }
 

@@ -17,6 +17,7 @@
 #include "light/environment.h"
 #include "render/path.h"
 #include "render/sampler.h"
+#include "render/surfaces.h"
 
 typedef struct furnace {
   fr_scene *s;
@@ -183,8 +184,12 @@ static void same_image_everywhere(void **st) {
   fr_env_constant(&env, v3(0.6f, 0.7f, 1.0f));
   fr_view v;
   assert_true(fr_view_lookup("materials", &v));
-  fr_path_setup P = {mats, count, {&env, 1, v.area_c, v.area_e1, v.area_e2, v3(20, 20, 20), 1, v.light, v3(50, 50, 50)},
-                     13, FR_SAMPLER_SOBOL, 8, 0, 8, 0.05f, 9.0f};
+  fr_surface *surf;
+  size_t nsurf;
+  assert_int_equal(fr_surfaces_build(s, (int32_t)count - 1, &surf, &nsurf), FR_OK);
+  const fr_path_lights L = {&env, 1, v.area_c, v.area_e1, v.area_e2, v3(20, 20, 20), 1, v.light, v3(50, 50, 50)};
+  fr_path_setup P = {.mats = mats, .count = count, .surf = surf, .nsurf = nsurf, .lights = L, .max_depth = 13,
+                     .sampler = FR_SAMPLER_SOBOL, .spp = 8, .spp_begin = 0, .spp_end = 8, .aperture = 0.05f, .focus = 9.0f};
   fr_workload w;
   memset(&w, 0, sizeof w);
   w.kind = FR_WL_PATH, w.scene = s, w.view = v, w.eps = 1e-4f * 60.0f, w.seed = 5, w.path = &P;
@@ -226,7 +231,7 @@ static void same_image_everywhere(void **st) {
   assert_true(far <= n / 50);
   assert_true(fabs(sa - sb) <= 2e-3 * sa);
   ebr_release(e);
-  free(ref); free(img); free(mats);
+  free(ref); free(img); free(mats); free(surf);
   fr_env_free(&env);
   fr_scene_release(s);
 }

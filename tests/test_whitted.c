@@ -374,7 +374,7 @@ static void test_shade_kernel(void **state) {
     fr_ray rays[FR_WS_LANES];
     fr_wpath path[FR_WS_LANES];
     fr_hit hits[FR_WS_LANES];
-    fr_whitted_tri surf[FR_WS_LANES];
+    fr_surface surf[FR_WS_LANES];
     int n = 1 + (int)(fr_rng_u32(&rng) % FR_WS_LANES);
     /* lanes past n hold NaNs: the kernel must not let them in */
     memset(rays, 0xFF, sizeof rays);

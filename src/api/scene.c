@@ -10,7 +10,9 @@
 #include "base/timer.h"
 #include "base/tuning.h"
 #include "geom/builtin_scene.h"
+#include "io/file_read.h"
 #include "io/import.h"
+#include "io/scene_file.h"
 #include "trace/bvh2_reference.h"
 #include "trace/kernels.h"
 #include "trace/sphere_traverse.h"
@@ -86,9 +88,60 @@ static void scene_name(const char *path, char *out, size_t cap) {
   snprintf(out, cap, "%s", file);
 }
 
+/* Appends mesh `add` (scaled and moved) to m, its materials merged by
+ * name, or all of its triangles given the material `only` (if not empty). */
+static fr_error append_mesh(fr_mesh *m, const fr_mesh *add, vec3 scale, vec3 move, const char *only) {
+  if (add->nverts > UINT32_MAX - m->nverts) return fr_fail(FR_ERR_UNSUPPORTED, "too many vertices");
+  const uint32_t base = (uint32_t)m->nverts;
+  fr_error e = FR_OK;
+  uint32_t *remap = calloc(add->nmats + 1, sizeof *remap), only_id = FR_INVALID_ID;
+  if (!remap) return fr_fail(FR_ERR_NOMEM, "out of memory");
+  for (size_t i = 0; i < add->nmats && !e; i++) {
+    const size_t before = m->nmats;
+    e = fr_mesh_material(m, add->mats[i].name, &remap[i]);
+    if (!e && m->nmats > before) m->mats[remap[i]] = add->mats[i]; /* new here: the file's parameters */
+  }
+  if (!e && only && only[0]) e = fr_mesh_material(m, only, &only_id);
+  for (size_t v = 0; v < add->nverts && !e; v++) {
+    const float *p = add->pos + 3 * v;
+    e = fr_mesh_add_vertex(m, p[0] * scale.x + move.x, p[1] * scale.y + move.y, p[2] * scale.z + move.z);
+  }
+  for (size_t t = 0; t < add->ntris && !e; t++) {
+    const uint32_t *ix = add->idx + 3 * t, am = add->mat ? add->mat[t] : FR_INVALID_ID;
+    const uint32_t mat = only_id != FR_INVALID_ID ? only_id : am < add->nmats ? remap[am] : FR_INVALID_ID;
+    e = fr_mesh_add_triangle(m, ix[0] + base, ix[1] + base, ix[2] + base, mat);
+  }
+  free(remap);
+  return e;
+}
+
+fr_error fr_scene_load_json(const char *path, const char *root, fr_scene_file *desc, fr_scene **out) {
+  *out = NULL;
+  fr_scene_file f;
+  fr_error e = fr_scene_file_read(path, root, &f);
+  if (e) return e;
+  fr_scene *s = scene_new();
+  if (!s) { fr_scene_file_free(&f); return fr_fail(FR_ERR_NOMEM, "out of memory"); }
+  for (int i = 0; i < f.nmeshes && !e; i++) {
+    fr_mesh m;
+    fr_mesh_init(&m);
+    e = fr_import(f.meshes[i].path, &m);
+    if (!e) e = append_mesh(&s->mesh, &m, f.meshes[i].scale, f.meshes[i].translate, f.meshes[i].material);
+    fr_mesh_free(&m);
+  }
+  if (!e) e = fr_mesh_validate(&s->mesh, path);
+  if (e) { fr_scene_release(s); fr_scene_file_free(&f); return e; }
+  scene_name(path, s->name, sizeof s->name);
+  if (desc) *desc = f;
+  else fr_scene_file_free(&f);
+  *out = s;
+  return FR_OK;
+}
+
 fr_error fr_scene_load(const char *path, fr_scene **out) {
   if (!out) return fr_fail(FR_ERR_ARG, "fr_scene_load: out is NULL");
   *out = NULL;
+  if (path && fr_has_suffix(path, ".json")) return fr_scene_load_json(path, NULL, NULL, out);
   fr_scene *s = scene_new();
   if (!s) return fr_fail(FR_ERR_NOMEM, "out of memory");
   fr_error e = fr_import(path, &s->mesh);

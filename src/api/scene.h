@@ -57,6 +57,12 @@ fr_error fr_scene_build_bvh2(fr_scene *s, int max_leaf, fr_bvh2 *out);
  * scene's trace mode: for callers that know their rays diverge at the
  * scale of the triangles (multi-frusta tiles that fell back to rays). */
 void fr_occluded_raystream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n);
+/* A scene file's meshes (io/scene_file.h) as one scene, named after the
+ * file; files it names stay under root (NULL: the file's folder). *desc
+ * gets the rest of the file (camera, lights, materials, render settings)
+ * when not NULL; the caller frees it with fr_scene_file_free. */
+struct fr_scene_file;
+fr_error fr_scene_load_json(const char *path, const char *root, struct fr_scene_file *desc, fr_scene **out);
 /* The first sphere's prim number (the triangle count). */
 static inline uint32_t fr_scene_sphere_base(const fr_scene *s) { return (uint32_t)s->mesh.ntris; }
 #endif

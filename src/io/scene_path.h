@@ -13,4 +13,8 @@
  * the scene's folder, 0 if it does not exist or would leave the folder (an
  * absolute name, a '..' component, a symlink whose target lies outside). */
 int fr_scene_ref_path(const char *scene, const char *ref, char *out, size_t cap);
+/* The same with the bound widened to the folder root, which the user
+ * names (NULL: the scene's folder): ref may climb with '..' but the file
+ * it names, symlinks followed, must lie under root. */
+int fr_scene_ref_path_within(const char *scene, const char *ref, const char *root, char *out, size_t cap);
 #endif

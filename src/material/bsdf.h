@@ -32,7 +32,7 @@ typedef struct fr_bsdf {
   float ior;           /* glass; the coat of plastic and car paint */
   /* metal */
   vec3 eta, k;         /* complex index of refraction per RGB channel */
-  float roughness;     /* metal: GGX roughness (alpha = roughness^2); 0 a mirror */
+  float roughness;     /* metal, plastic's coat: GGX roughness (alpha = roughness^2); 0 a mirror */
   /* glass: the colour white light takes on after attenuation_distance inside */
   vec3 attenuation_color;
   float attenuation_distance;

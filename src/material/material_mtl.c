@@ -25,7 +25,7 @@ fr_bsdf fr_bsdf_from_mtl(const fr_material *m, float scale) {
     const int tinted = tfmax > 0.0f && (tf.x != tf.y || tf.y != tf.z);
     b.attenuation_color = tinted ? v3_scale(tf, 1.0f / tfmax) : v3(1, 1, 1);
     b.attenuation_distance = scale > 0.0f ? scale : 1.0f;
-  } else if (m->illum == 3 && ksmax > 0.0f) {
+  } else if (m->illum == 3 && ksmax > 0.0f && fr_maxf(kd.x, fr_maxf(kd.y, kd.z)) <= FR_MTL_METAL_MAX_KD) {
     b = fr_bsdf_default(FR_BSDF_METAL);
     fr_bsdf_metal_from_reflectance(&b, ks);
     b.roughness = 0.0f;
@@ -33,6 +33,10 @@ fr_bsdf fr_bsdf_from_mtl(const fr_material *m, float scale) {
     b = fr_bsdf_default(FR_BSDF_PLASTIC);
     b.color = kd;
     b.ior = ior;
+    /* a Phong exponent as a microfacet roughness: alpha = sqrt(2 / (Ns + 2)),
+     * Walter et al.'s match of Blinn-Phong to Beckmann, which GGX follows
+     * closely; no exponent, or a large one, is a smooth coat */
+    b.roughness = m->shininess > 0.0f && m->shininess < 1000.0f ? sqrtf(sqrtf(2.0f / (m->shininess + 2.0f))) : 0.0f;
   } else {
     b = fr_bsdf_default(FR_BSDF_LAMBERT);
     b.color = kd;

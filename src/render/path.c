@@ -13,6 +13,7 @@
 #include "base/alloc.h"
 #include "base/error.h"
 #include "base/timer.h"
+#include "render/surfaces.h"
 #include "render/tile.h"
 
 #define WAVE (TILE_PIX * FR_PATH_CHUNK)
@@ -98,7 +99,7 @@ static int sample_light(const fr_path_lights *L, vec3 p, float uc, float u1, flo
     const vec3 x = v3_add(L->area_c, v3_add(v3_scale(L->area_e1, u1), v3_scale(L->area_e2, u2)));
     const vec3 to = v3_sub(x, p);
     const float d = v3_len(to);
-    if (!(d > 0.0f)) return 0;
+    if (!(d > 0.0f) || v3_dot(to, v3_cross(L->area_e1, L->area_e2)) >= 0.0f) return 0; /* behind the lamp */
     *wi = v3_scale(to, 1.0f / d);
     *dist = d;
     *le = L->area_radiance;
@@ -186,9 +187,11 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         const float tmax = hit ? h.t : INFINITY;
         /* the area light, which is not in the scene's geometry, in front of the hit */
         const float ta = L->area ? area_hit(L, o, d, r.tnear, tmax) : 0.0f;
-        if (ta > 0.0f) {
-          const float w_mis = st.delta ? 1.0f : power_heuristic(st.pdf, area_pdf(L, d, ta) / (float)nlights);
-          S->acc[st.pix] = v3_add(S->acc[st.pix], v3_scale(v3_mul(st.weight, L->area_radiance), w_mis));
+        if (ta > 0.0f) { /* the lamp: it emits from its front, its back is dark */
+          if (v3_dot(d, v3_cross(L->area_e1, L->area_e2)) < 0.0f) {
+            const float w_mis = st.delta ? 1.0f : power_heuristic(st.pdf, area_pdf(L, d, ta) / (float)nlights);
+            S->acc[st.pix] = v3_add(S->acc[st.pix], v3_scale(v3_mul(st.weight, L->area_radiance), w_mis));
+          }
           continue;
         }
         if (!hit) {
@@ -198,12 +201,16 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
           continue;
         }
         const vec3 p = v3_add(o, v3_scale(d, h.t));
-        float g[3];
-        const float pp[3] = {p.x, p.y, p.z};
-        fr_scene_geometric_normal(w->scene, h.prim, pp, g);
-        vec3 ng = v3_norm(v3_load(g));
-        const uint32_t mi = fr_scene_prim_material(w->scene, h.prim);
-        const fr_bsdf *m = &P->mats[mi < P->count - 1 ? mi : P->count - 1];
+        fr_surface sf;
+        if (h.prim < P->nsurf) {
+          sf = P->surf[h.prim];
+        } else { /* a sphere: the normal is p - c */
+          const float pp[3] = {p.x, p.y, p.z};
+          fr_scene_geometric_normal(w->scene, h.prim, pp, sf.ng);
+          sf.mat = fr_surface_material(w->scene, h.prim, (int32_t)P->count - 1);
+        }
+        const vec3 ng = v3_norm(v3_load(sf.ng));
+        const fr_bsdf *m = &P->mats[sf.mat];
         const int front = v3_dot(ng, d) < 0.0f;
         if (m->kind == FR_BSDF_GLASS && !front) { /* the segment ran inside: Beer's law */
           const float k = h.t / m->attenuation_distance;

@@ -25,7 +25,8 @@
 
 typedef struct fr_path_lights {
   const fr_env *env;            /* never NULL; a black one is not sampled */
-  int area;                     /* the quad c + s e1 + t e2 (s, t in [0, 1]), emitting area_radiance on both sides */
+  int area;                     /* the quad c + s e1 + t e2 (s, t in [0, 1]), emitting area_radiance from the side
+                                   e1 x e2 faces (the scenes' lamps face down); its back is dark */
   vec3 area_c, area_e1, area_e2, area_radiance;
   int point;                    /* a point light at point_pos of intensity point_intensity (W/sr) */
   vec3 point_pos, point_intensity;
@@ -34,6 +35,8 @@ typedef struct fr_path_lights {
 typedef struct fr_path_setup {
   const fr_bsdf *mats;          /* one per scene material, and one more (the last) for surfaces without */
   size_t count;                 /* including that last one */
+  const struct fr_surface *surf; /* per triangle: normal and material (render/surfaces.h) */
+  size_t nsurf;
   fr_path_lights lights;
   int max_depth;                /* segments per path, 1..FR_PATH_MAX_DEPTH (13 by default) */
   fr_sampler_kind sampler;

@@ -45,11 +45,6 @@ static fr_error check_list(const fr_scene *s, const char *list, const char *what
   return FR_OK;
 }
 
-static uint32_t mat_index(const fr_scene *s, const fr_whitted_mats *m, uint32_t prim) {
-  uint32_t i = fr_scene_prim_material(s, prim);
-  return i == FR_INVALID_ID || i + 1 >= m->count ? (uint32_t)m->count - 1 : i;
-}
-
 fr_error fr_whitted_mats_build(const fr_scene *s, const char *mirror, const char *glass, fr_whitted_mats *out) {
   memset(out, 0, sizeof *out);
   fr_error err;
@@ -90,14 +85,7 @@ fr_error fr_whitted_mats_build(const fr_scene *s, const char *mirror, const char
   out->soa = malloc(FR_WM_FIELDS * out->count * sizeof *out->soa);
   if (!out->soa) { fr_whitted_mats_free(out); return fr_fail(FR_ERR_NOMEM, "out of memory for %zu materials", nm + 1); }
   fr_whitted_mats_soa(out);
-  out->ntris = fr_scene_triangle_count(s);
-  out->tri = malloc(fr_mul_size(out->ntris ? out->ntris : 1, sizeof *out->tri));
-  if (!out->tri) { fr_whitted_mats_free(out); return fr_fail(FR_ERR_NOMEM, "out of memory for %zu triangles", fr_scene_triangle_count(s)); }
-  for (size_t t = 0; t < out->ntris; t++) {
-    const float none[3] = {0, 0, 0}; /* the point matters for spheres only */
-    fr_scene_geometric_normal(s, (uint32_t)t, none, out->tri[t].ng);
-    out->tri[t].mat = (int32_t)mat_index(s, out, (uint32_t)t);
-  }
+  if ((err = fr_surfaces_build(s, (int32_t)out->count - 1, &out->tri, &out->ntris))) { fr_whitted_mats_free(out); return err; }
   return FR_OK;
 }
 
@@ -130,14 +118,14 @@ void fr_whitted_mats_free(fr_whitted_mats *m) {
 }
 
 static const fr_whitted_mat *mat_of(const fr_scene *s, const fr_whitted_mats *m, uint32_t prim) {
-  return &m->mat[mat_index(s, m, prim)];
+  return &m->mat[fr_surface_material(s, prim, (int32_t)m->count - 1)];
 }
 
 void fr_whitted_mats_census(const fr_scene *s, const fr_whitted_mats *m, size_t *mirror_prims, size_t *glass_prims) {
   *mirror_prims = *glass_prims = 0;
   size_t n = fr_scene_triangle_count(s) + fr_scene_sphere_count(s);
   for (size_t t = 0; t < n; t++) {
-    fr_surface k = mat_of(s, m, (uint32_t)t)->kind;
+    fr_whitted_kind k = mat_of(s, m, (uint32_t)t)->kind;
     *mirror_prims += k == FR_SURF_MIRROR;
     *glass_prims += k == FR_SURF_GLASS;
   }
@@ -173,7 +161,7 @@ typedef struct fr_whitted_scratch {
   wgen cur, next, shadow;
   fr_hit *hits;
   uint8_t *occ;
-  fr_whitted_tri *surf;       /* a generation's geometric normals (not unit) and materials */
+  fr_surface *surf;       /* a generation's geometric normals (not unit) and materials */
   vec3 colour[WT_PIX];
   double stage[FR_STAGES];    /* seconds, over this thread's tiles */
 } fr_whitted_scratch;
@@ -286,17 +274,17 @@ static inline unsigned frustum_pix(unsigned i) {
 static void fetch_surfaces(const fr_workload *w, fr_whitted_scratch *S, size_t n) {
   for (size_t i = 0; i < n; i++) {
     const fr_hit *h = &S->hits[i];
-    fr_whitted_tri *sf = &S->surf[i];
+    fr_surface *sf = &S->surf[i];
     if (h->prim < w->mats->ntris) {
       *sf = w->mats->tri[h->prim];
       continue;
     }
-    *sf = (fr_whitted_tri){{0.0f, 0.0f, 0.0f}, 0};
+    *sf = (fr_surface){{0.0f, 0.0f, 0.0f}, 0};
     if (h->prim == FR_INVALID_ID) continue;
     const float *o = S->cur.r[i].org, *d = S->cur.r[i].dir; /* a sphere: the normal is p - c */
     float pp[3] = {o[0] + d[0] * h->t, o[1] + d[1] * h->t, o[2] + d[2] * h->t};
     fr_scene_geometric_normal(w->scene, h->prim, pp, sf->ng);
-    sf->mat = (int32_t)mat_index(w->scene, w->mats, h->prim);
+    sf->mat = fr_surface_material(w->scene, h->prim, (int32_t)w->mats->count - 1);
   }
 }
 

@@ -15,14 +15,15 @@
 #define FR_RENDER_WHITTED_H
 #include <stdint.h>
 #include "frusta.h"
+#include "render/surfaces.h"
 #include "render/workload.h"
 
 #define FR_WHITTED_MAX_DEPTH 8
 
-typedef enum fr_surface { FR_SURF_DIFFUSE, FR_SURF_MIRROR, FR_SURF_GLASS } fr_surface;
+typedef enum fr_whitted_kind { FR_SURF_DIFFUSE, FR_SURF_MIRROR, FR_SURF_GLASS } fr_whitted_kind;
 
 typedef struct fr_whitted_mat {
-  fr_surface kind;
+  fr_whitted_kind kind;
   float kd[3];   /* diffuse colour */
   float ks[3];   /* Phong highlight, or the mirror's reflectance */
   float ns;      /* Phong exponent */
@@ -30,21 +31,13 @@ typedef struct fr_whitted_mat {
   float ior;
 } fr_whitted_mat;
 
-/* What a hit on triangle t needs, in one 16-byte record: its geometric
- * normal (v1 - v0) x (v2 - v0) and its material index. Read straight from
- * the mesh, a hit cost two dependent loads and three vertex lines. */
-typedef struct fr_whitted_tri {
-  float ng[3];
-  int32_t mat;
-} fr_whitted_tri;
-
 /* One entry per scene material, and one more (the last) for triangles
  * without a material; and the per-triangle records. */
 typedef struct fr_whitted_mats {
   fr_whitted_mat *mat;
   size_t count;
   float *soa;          /* the same as the shading kernel reads it (render/whitted_shade.h) */
-  fr_whitted_tri *tri; /* one per scene triangle */
+  fr_surface *tri; /* one per scene triangle */
   size_t ntris;
 } fr_whitted_mats;
 

@@ -46,16 +46,16 @@ void FR_ISA_FN(fr_whitted_shade16)(const fr_wshade_in *in, fr_wshade_out *out) {
   _Static_assert(sizeof(fr_hit) % sizeof(float) == 0, "whole floats");
   _Static_assert(sizeof(fr_ray) == 8 * sizeof(float) && offsetof(fr_ray, dir) == 4 * sizeof(float),
                  "a ray record: org, tnear, dir, tfar");
-  _Static_assert(sizeof(fr_wpath) == 4 * sizeof(float) && sizeof(fr_whitted_tri) == 4 * sizeof(float),
+  _Static_assert(sizeof(fr_wpath) == 4 * sizeof(float) && sizeof(fr_surface) == 4 * sizeof(float),
                  "path and surface records of 4 floats");
   int32_t hi[FR_WS_LANES] __attribute__((aligned(64)));
   int32_t mi[FR_WS_LANES] __attribute__((aligned(64))); /* the gathers want aligned indices */
   const fr_ray *ray = in->ray;
   const fr_wpath *path = in->path;
-  const fr_whitted_tri *surf = in->surf;
+  const fr_surface *surf = in->surf;
   fr_ray ray_pad[FR_WS_LANES];
   fr_wpath path_pad[FR_WS_LANES];
-  fr_whitted_tri surf_pad[FR_WS_LANES];
+  fr_surface surf_pad[FR_WS_LANES];
   int first = __builtin_ctz(in->valid);
   if (in->valid != (1u << FR_WS_LANES) - 1u) { /* absent lanes copy a present one: whole records load below */
     for (int l = 0; l < FR_WS_LANES; l++) {

@@ -46,7 +46,7 @@ typedef struct fr_wshade_in {
   const fr_ray *ray;    /* 16 rays (lanes past `valid` are not read) */
   const fr_wpath *path; /* what they carry */
   const fr_hit *hit;    /* their hits */
-  const fr_whitted_tri *surf; /* per ray: geometric normal (not unit) and material index
+  const fr_surface *surf; /* per ray: geometric normal (not unit) and material index
                                  (any valid index for a miss) */
   unsigned valid, hits; /* lanes present; lanes that hit */
   const float *mats;    /* the material table, FR_WM_FIELDS x mat_count */

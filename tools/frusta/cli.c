@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include "api/scene.h"
+#include "cli_scene_file.h"
+#include "io/file_read.h"
 #include "render/whitted.h"
 #include "render/workload.h"
 
@@ -125,6 +127,7 @@ int cli_load_scene(const char *arg, fr_scene **s) {
   else if (strcmp(arg, "--builtin=materials") == 0) e = fr_scene_builtin_materials(s);
   else if (cli_is_builtin(arg))
     return cli_error(CLI_USAGE_ERROR, "unknown built-in scene '%s' (default, sphereflake or materials)", arg + 10);
+  else if (fr_has_suffix(arg, ".json")) e = fr_scene_load_json(arg, cli_scene_root(), NULL, s);
   else e = fr_scene_load(arg, s);
   if (e) return cli_error(1, "%s", fr_last_error());
   e = fr_scene_commit(*s);

@@ -5,6 +5,8 @@
 #include <string.h>
 #include "api/scene.h"
 #include "cli.h"
+#include "cli_scene_file.h"
+#include "render/surfaces.h"
 
 int cli_path_from_args(const cli_args *a, cli_path *o) {
   memset(o, 0, sizeof *o);
@@ -65,8 +67,15 @@ int cli_path_setup(const cli_path *o, fr_workload *w, cli_path_run *r) {
     cli_path_free(r);
     return cli_error(CLI_USAGE_ERROR, "%s", fr_last_error());
   }
+  const fr_scene_file *file = cli_scene_file();
+  for (size_t i = 0; file && i + 1 < count; i++) { /* the scene file's materials, by name */
+    const fr_bsdf *b = fr_scene_file_find_material(file, fr_scene_material(w->scene, i)->name);
+    if (b) r->mats[i] = *b;
+  }
   fr_path_setup *P = &r->setup;
   P->mats = r->mats, P->count = count;
+  if (fr_surfaces_build(w->scene, (int32_t)count - 1, &r->surf, &P->nsurf)) { cli_path_free(r); return cli_error(1, "%s", fr_last_error()); }
+  P->surf = r->surf;
   P->lights.env = &r->env;
   /* the area and point lights bright enough that a white surface where the
    * camera looks, facing them, is as bright as under a white sky (irradiance pi) */
@@ -76,11 +85,11 @@ int cli_path_setup(const cli_path *o, fr_workload *w, cli_path_run *r) {
   P->lights.area = (o->lights & CLI_LIGHT_AREA) && area > 0.0f;
   P->lights.area_c = v->area_c, P->lights.area_e1 = v->area_e1, P->lights.area_e2 = v->area_e2;
   const float la = area > 0.0f ? 3.14159265f * da * da / area : 0.0f;
-  P->lights.area_radiance = v3(la, la, la);
+  P->lights.area_radiance = file && file->has_area_radiance ? file->area_radiance : v3(la, la, la);
   P->lights.point = (o->lights & CLI_LIGHT_POINT) != 0;
   P->lights.point_pos = v->light;
   const float ip = 3.14159265f * dp * dp;
-  P->lights.point_intensity = v3(ip, ip, ip);
+  P->lights.point_intensity = file && file->has_point_intensity ? file->point_intensity : v3(ip, ip, ip);
   P->max_depth = o->max_depth;
   P->sampler = o->sampler;
   P->spp = o->spp, P->spp_begin = 0, P->spp_end = o->spp;
@@ -92,12 +101,13 @@ int cli_path_setup(const cli_path *o, fr_workload *w, cli_path_run *r) {
          "aperture=%g focus=%g\n",
          o->spp, o->max_depth, fr_sampler_name(o->sampler), (o->lights & CLI_LIGHT_ENV) ? "env," : "",
          P->lights.area ? "area," : "", P->lights.point ? "point" : "", o->env_file ? o->env_file : "constant",
-         (double)la, (double)ip, (double)P->aperture, (double)P->focus);
+         (double)P->lights.area_radiance.x, (double)P->lights.point_intensity.x, (double)P->aperture, (double)P->focus);
   return 0;
 }
 
 void cli_path_free(cli_path_run *r) {
   fr_env_free(&r->env);
   free(r->mats);
+  free(r->surf);
   memset(r, 0, sizeof *r);
 }

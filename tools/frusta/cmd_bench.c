@@ -13,6 +13,7 @@
 #include <string.h>
 #include "api/scene.h"
 #include "cli.h"
+#include "cli_scene_file.h"
 #include "commands.h"
 #include "cli_path.h"
 #include "embree_tracer.h"
@@ -417,6 +418,7 @@ int cmd_bench(int argc, char **argv) {
   cli_args a;
   int rc = cli_args_parse(CLI_BENCH, argc, argv, 1, &a);
   if (rc) return rc == CLI_HELP_SHOWN ? 0 : rc;
+  if ((rc = cli_scene_file_defaults(&a))) return rc;
   bench_opts o;
   if ((rc = bench_options(&a, &o))) return rc;
   bench_setup b;

@@ -6,6 +6,7 @@
 #include <string.h>
 #include "api/scene.h"
 #include "cli.h"
+#include "cli_scene_file.h"
 #include "commands.h"
 #include "base/timer.h"
 #include "cli_path.h"
@@ -142,6 +143,7 @@ int cmd_render(int argc, char **argv) {
   cli_args a;
   int rc = cli_args_parse(CLI_RENDER, argc, argv, 1, &a);
   if (rc) return rc == CLI_HELP_SHOWN ? 0 : rc;
+  if ((rc = cli_scene_file_defaults(&a))) return rc;
   const char *scene = a.pos[0], *out = a.val[F_OUT], *ref_out = a.val[F_REFERENCE_OUT];
   int threads = omp_get_num_procs(), mft = -1; /* -1: not given */
   fr_softshadow_opts so = {16, 1, FR_LIGHT_SETS_CELLS};

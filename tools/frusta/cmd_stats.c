@@ -8,6 +8,7 @@
 #include <string.h>
 #include "api/scene.h"
 #include "cli.h"
+#include "cli_scene_file.h"
 #include "commands.h"
 #include "embree_tracer.h"
 #include "embree_tree.h"
@@ -73,6 +74,7 @@ int cmd_stats(int argc, char **argv) {
   cli_args a;
   int rc = cli_args_parse(CLI_STATS, argc, argv, 1, &a);
   if (rc) return rc == CLI_HELP_SHOWN ? 0 : rc;
+  if ((rc = cli_scene_file_defaults(&a))) return rc;
   const char *path = a.pos[0], *workload = a.val[F_WORKLOAD];
   const int embree = a.val[F_EMBREE] != NULL;
   int threads = omp_get_num_procs(), threshold = 7, coherent = -1, width = 8;

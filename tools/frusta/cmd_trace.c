@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "cli.h"
+#include "cli_scene_file.h"
 #include "commands.h"
 #include "embree_tracer.h"
 #include "io/file_read.h"
@@ -16,6 +17,7 @@ int cmd_trace(int argc, char **argv) {
   cli_args a;
   int rc = cli_args_parse(CLI_TRACE, argc, argv, 2, &a);
   if (rc) return rc == CLI_HELP_SHOWN ? 0 : rc;
+  if ((rc = cli_scene_file_defaults(&a))) return rc;
   const char *scene = a.pos[0], *rays_path = a.pos[1], *out = a.val[F_OUT];
   static const char *const modes[] = {"auto", "single", "packet8", "packet16", "hybrid16", "raystream"}; /* fr_trace_mode order */
   static const char *const queries[] = {"any", "closest"}, *const tracers[] = {"frusta", "embree"};

@@ -22,6 +22,8 @@ const cli_flag cli_flags[F_COUNT] = {
     [F_THREADS] = {"--threads", "N", R | B | S, "threads, 1..1024 (default: every core)"},
     [F_ISA] = {"--isa", "avx512|avx2|scalar", R | B | T | S,
                "instruction set of the kernels (default: the best the CPU has; also FRUSTA_ISA)"},
+    [F_SCENE_ROOT] = {"--scene-root", "DIR", R | B | T | S,
+                       "a scene file's meshes and maps may lie anywhere under DIR (default: its own folder only)"},
     [F_OUT] = {"--out", "FILE", R | T, "render: the image, .png, .exr or .pfm; trace: the hit or occlusion file"},
     [F_SHADE] = {"--shade", "eyelight|normals|shadows|softshadow|whitted|path", R, "what to render (default eyelight)"},
     [F_LIGHT_SAMPLES] = {"--light-samples", "N", R,
@@ -103,7 +105,8 @@ static const struct {
   cli_cmd cmd;
   const char *name, *synopsis, *what;
 } commands[] = {
-    {CLI_RENDER, "render", "SCENE|--builtin[=sphereflake|materials] --out FILE [flags]", "renders an image"},
+    {CLI_RENDER, "render", "SCENE|SCENE.json|--builtin[=sphereflake|materials] --out FILE [flags]",
+     "renders an image (a scene file's settings are the defaults of the flags)"},
     {CLI_BENCH, "bench", "SCENE --workload W --mode M [flags]",
      "measures Mrays/s of frusta's and Embree's modes on a workload, side by side"},
     {CLI_TRACE, "trace", "SCENE RAYS --query closest|any --out FILE [flags]",
