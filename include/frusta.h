@@ -105,6 +105,13 @@ fr_error fr_scene_builtin_sphereflake(int depth, fr_scene **out);
  * chrome, gold, glass, carpaint) on a floor (material "floor") at y = 0. */
 fr_error fr_scene_builtin_materials(fr_scene **out);
 
+/* Smooth shading normals for the triangles whose file gives none (OBJ vn,
+ * PLY nx ny nz and Assimp's are kept): angle-weighted vertex normals shared
+ * between faces within crease_deg (0..180) of each other, so edges sharper
+ * than that stay sharp. Before the commit (FR_ERR_STATE after). The
+ * renderers shade with them; tracing never uses them. */
+fr_error fr_scene_smooth(fr_scene *s, float crease_deg);
+
 /* Builds the acceleration structures; must be called before tracing.
  * Triangles that are degenerate or too small for float arithmetic (edge
  * cross products that underflow) are left out (fr_scene_skipped_triangles);

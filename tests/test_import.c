@@ -182,6 +182,82 @@ static void test_degenerate_only(void **st) {
   fr_scene_release(s);
 }
 
+/* Shading normals: read from OBJ (vn), PLY (nx ny nz) and Assimp, made
+ * where a file has none (angle-weighted, sharp past the crease angle). */
+static void expect_normal(const fr_scene *s, uint32_t prim, float u, float v, float x, float y, float z) {
+  float n[3];
+  assert_true(fr_scene_shading_normal(s, prim, u, v, n));
+  if (fabsf(n[0] - x) > 1e-5f || fabsf(n[1] - y) > 1e-5f || fabsf(n[2] - z) > 1e-5f)
+    print_message("prim %u at (%g, %g): normal %g %g %g, wanted %g %g %g\n", prim, u, v, n[0], n[1], n[2], x, y, z);
+  assert_true(fabsf(n[0] - x) <= 1e-5f && fabsf(n[1] - y) <= 1e-5f && fabsf(n[2] - z) <= 1e-5f);
+}
+
+static void test_normals(void **st) {
+  (void)st;
+  fr_scene *s;
+  const float r = 0.70710678f;
+  /* OBJ: v//vn and v/vt/vn corners; a face without normals has none */
+  const char *obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvn 0 0 1\nvn 1 0 1\n"
+                    "f 1//1 2//2 3//1\nf 2/1/2 4/1/2 3/1/1\nf 1 2 4\n";
+  assert_int_equal(load("n.obj", obj, strlen(obj), &s), FR_OK);
+  expect_normal(s, 0, 0.0f, 0.0f, 0, 0, 1);
+  expect_normal(s, 0, 1.0f, 0.0f, r, 0, r);
+  float n[3];
+  assert_false(fr_scene_shading_normal(s, 2, 0.3f, 0.3f, n));
+  fr_scene_release(s);
+  /* PLY: per-vertex nx ny nz */
+  const char *ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                    "property float nx\nproperty float ny\nproperty float nz\nelement face 1\n"
+                    "property list uchar int vertex_indices\nend_header\n0 0 0 0 0 2\n1 0 0 0 1 0\n0 1 0 1 0 0\n3 0 1 2\n";
+  assert_int_equal(load("n.ply", ply, strlen(ply), &s), FR_OK);
+  expect_normal(s, 0, 0.0f, 0.0f, 0, 0, 1);
+  expect_normal(s, 0, 0.0f, 1.0f, 1, 0, 0);
+  expect_normal(s, 0, 0.5f, 0.0f, 0, r, r);
+  fr_scene_release(s);
+  /* Assimp (an OFF file has no normals: none; glTF with NORMAL would) */
+  const char *off = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  assert_int_equal(load("n.off", off, strlen(off), &s), FR_OK);
+  assert_false(fr_scene_shading_normal(s, 0, 0.3f, 0.3f, n));
+  fr_scene_release(s);
+  /* made: a cube's faces meet at 90 degrees and stay flat at a crease of
+   * 30; a gentle fold of 20 degrees is smoothed across, to the mean */
+  const char *cube = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                     "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+  assert_int_equal(load("cube.obj", cube, strlen(cube), &s), FR_OK);
+  assert_int_equal(fr_scene_smooth(s, 30.0f), FR_OK);
+  for (uint32_t t = 0; t < 12; t++) {
+    float g[3], p[3] = {0, 0, 0};
+    fr_scene_geometric_normal(s, t, p, g);
+    const float l = sqrtf(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    for (int c = 0; c < 3; c++) expect_normal(s, t, c == 1 ? 1.0f : 0.0f, c == 2 ? 1.0f : 0.0f, g[0] / l, g[1] / l, g[2] / l);
+  }
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  assert_int_equal(fr_scene_smooth(s, 30.0f), FR_ERR_STATE);
+  fr_scene_release(s);
+  const float c20 = cosf(20.0f * (float)M_PI / 180.0f), s20 = sinf(20.0f * (float)M_PI / 180.0f);
+  char fold[256];
+  snprintf(fold, sizeof fold, "v 0 0 0\nv 0 1 0\nv -1 0 0\nv %.7f 0 %.7f\nf 1 2 3\nf 1 4 2\n", c20, s20);
+  assert_int_equal(load("fold.obj", fold, strlen(fold), &s), FR_OK);
+  assert_int_equal(fr_scene_smooth(s, 30.0f), FR_OK);
+  /* the shared edge's corners: the mean of the two faces' normals (equal angles there) */
+  float g0[3], g1[3], p[3] = {0, 0, 0};
+  fr_scene_geometric_normal(s, 0, p, g0);
+  fr_scene_geometric_normal(s, 1, p, g1);
+  float m[3];
+  for (int a = 0; a < 3; a++) m[a] = g0[a] / sqrtf(g0[0] * g0[0] + g0[1] * g0[1] + g0[2] * g0[2]) + g1[a] / sqrtf(g1[0] * g1[0] + g1[1] * g1[1] + g1[2] * g1[2]);
+  const float ml = sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+  expect_normal(s, 0, 0.0f, 0.0f, m[0] / ml, m[1] / ml, m[2] / ml);
+  expect_normal(s, 1, 0.0f, 1.0f, m[0] / ml, m[1] / ml, m[2] / ml);
+  fr_scene_release(s);
+  assert_int_equal(load("fold.obj", fold, strlen(fold), &s), FR_OK);
+  assert_int_equal(fr_scene_smooth(s, 10.0f), FR_OK); /* a crease under the fold: flat */
+  fr_scene_geometric_normal(s, 0, p, g0);
+  const float gl = sqrtf(g0[0] * g0[0] + g0[1] * g0[1] + g0[2] * g0[2]);
+  expect_normal(s, 0, 0.0f, 0.0f, g0[0] / gl, g0[1] / gl, g0[2] / gl);
+  assert_int_equal(fr_scene_smooth(s, 200.0f), FR_ERR_ARG);
+  fr_scene_release(s);
+}
+
 int main(void) {
   snprintf(tmpdir, sizeof tmpdir, "/tmp/frusta_test_import_%d", (int)getpid());
   char cmd[300];
@@ -190,6 +266,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_ply_ascii_fan),  cmocka_unit_test(test_ply_binary),   cmocka_unit_test(test_ply_hostile),
       cmocka_unit_test(test_obj_mtl_and_zst), cmocka_unit_test(test_assimp_path), cmocka_unit_test(test_degenerate_only),
+      cmocka_unit_test(test_normals),
   };
   int rc = cmocka_run_group_tests(tests, NULL, NULL);
   snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);

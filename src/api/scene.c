@@ -106,10 +106,19 @@ static fr_error append_mesh(fr_mesh *m, const fr_mesh *add, vec3 scale, vec3 mov
     const float *p = add->pos + 3 * v;
     e = fr_mesh_add_vertex(m, p[0] * scale.x + move.x, p[1] * scale.y + move.y, p[2] * scale.z + move.z);
   }
+  const uint32_t nbase = (uint32_t)m->nnrm;
+  for (size_t i = 0; i < add->nnrm && !e; i++) { /* a normal scales by the inverse */
+    const float *n = add->nrm + 3 * i;
+    e = fr_mesh_add_normal(m, n[0] / scale.x, n[1] / scale.y, n[2] / scale.z);
+  }
   for (size_t t = 0; t < add->ntris && !e; t++) {
     const uint32_t *ix = add->idx + 3 * t, am = add->mat ? add->mat[t] : FR_INVALID_ID;
     const uint32_t mat = only_id != FR_INVALID_ID ? only_id : am < add->nmats ? remap[am] : FR_INVALID_ID;
     e = fr_mesh_add_triangle(m, ix[0] + base, ix[1] + base, ix[2] + base, mat);
+    if (!e && fr_mesh_has_normals(add, t)) {
+      const uint32_t *nx = add->nidx + 3 * t;
+      e = fr_mesh_set_normals(m, m->ntris - 1, nx[0] + nbase, nx[1] + nbase, nx[2] + nbase);
+    }
   }
   free(remap);
   return e;
@@ -149,6 +158,26 @@ fr_error fr_scene_load(const char *path, fr_scene **out) {
   scene_name(path, s->name, sizeof s->name);
   *out = s;
   return FR_OK;
+}
+
+fr_error fr_scene_smooth(fr_scene *s, float crease_deg) {
+  if (!s) return fr_fail(FR_ERR_ARG, "fr_scene_smooth: scene is NULL");
+  if (s->committed) return fr_fail(FR_ERR_STATE, "fr_scene_smooth: scene already committed");
+  if (!(crease_deg >= 0.0f && crease_deg <= 180.0f)) return fr_fail(FR_ERR_ARG, "crease angle %g is not in [0, 180]", crease_deg);
+  return fr_mesh_smooth_normals(&s->mesh, crease_deg);
+}
+
+int fr_scene_shading_normal(const fr_scene *s, uint32_t prim, float u, float v, float n[3]) {
+  const fr_mesh *m = &s->mesh;
+  if (prim >= m->ntris || !fr_mesh_has_normals(m, prim)) return 0;
+  const float *a = m->nrm + 3 * (size_t)m->nidx[3 * (size_t)prim], *b = m->nrm + 3 * (size_t)m->nidx[3 * (size_t)prim + 1],
+              *c = m->nrm + 3 * (size_t)m->nidx[3 * (size_t)prim + 2];
+  const float w = 1.0f - u - v;
+  float x = w * a[0] + u * b[0] + v * c[0], y = w * a[1] + u * b[1] + v * c[1], z = w * a[2] + u * b[2] + v * c[2];
+  const float l = sqrtf(x * x + y * y + z * z);
+  if (!(l > 0.0f)) return 0;
+  n[0] = x / l, n[1] = y / l, n[2] = z / l;
+  return 1;
 }
 
 fr_error fr_scene_builtin(fr_scene **out) {

@@ -63,6 +63,9 @@ void fr_occluded_raystream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, 
  * when not NULL; the caller frees it with fr_scene_file_free. */
 struct fr_scene_file;
 fr_error fr_scene_load_json(const char *path, const char *root, struct fr_scene_file *desc, fr_scene **out);
+/* The unit shading normal of triangle prim at barycentrics (u, v): its
+ * corner normals interpolated; 0 where it has none (flat). */
+int fr_scene_shading_normal(const fr_scene *s, uint32_t prim, float u, float v, float n[3]);
 /* The first sphere's prim number (the triangle count). */
 static inline uint32_t fr_scene_sphere_base(const fr_scene *s) { return (uint32_t)s->mesh.ntris; }
 #endif

@@ -13,6 +13,8 @@ void fr_mesh_free(fr_mesh *m) {
   free(m->idx);
   free(m->mat);
   free(m->mats);
+  free(m->nrm);
+  free(m->nidx);
   fr_mesh_init(m);
 }
 
@@ -51,9 +53,134 @@ fr_error fr_mesh_add_triangle(fr_mesh *m, uint32_t a, uint32_t b, uint32_t c, ui
     for (size_t i = 0; i < m->ntris; i++) m->mat[i] = FR_INVALID_ID;
   }
   if (m->mat) m->mat[m->ntris] = mat;
+  if (m->nidx && m->cap_tris != old_cap) { /* normal indices: like the materials */
+    uint32_t *q = realloc(m->nidx, fr_mul_size(m->cap_tris, 3 * sizeof(uint32_t)));
+    if (!q) return fr_fail(FR_ERR_NOMEM, "out of memory at triangle %zu", m->ntris);
+    m->nidx = q;
+  }
+  if (m->nidx) m->nidx[3 * m->ntris] = m->nidx[3 * m->ntris + 1] = m->nidx[3 * m->ntris + 2] = FR_INVALID_ID;
   uint32_t *t = m->idx + 3 * m->ntris++;
   t[0] = a; t[1] = b; t[2] = c;
   return FR_OK;
+}
+
+fr_error fr_mesh_add_normal(fr_mesh *m, float x, float y, float z) {
+  if (m->nnrm >= 0xFFFFFFF0u) return fr_fail(FR_ERR_UNSUPPORTED, "too many normals");
+  if (!grow((void **)&m->nrm, &m->cap_nrm, m->nnrm, 3 * sizeof(float)))
+    return fr_fail(FR_ERR_NOMEM, "out of memory at normal %zu", m->nnrm);
+  const double l = sqrt((double)x * x + (double)y * y + (double)z * z);
+  float *n = m->nrm + 3 * m->nnrm++;
+  if (!(l > 0.0 && l < INFINITY)) { n[0] = n[1] = n[2] = 0.0f; return FR_OK; }
+  n[0] = (float)(x / l); n[1] = (float)(y / l); n[2] = (float)(z / l);
+  return FR_OK;
+}
+
+fr_error fr_mesh_set_normals(fr_mesh *m, size_t t, uint32_t a, uint32_t b, uint32_t c) {
+  if (!m->nidx) {
+    m->nidx = malloc(fr_mul_size(m->cap_tris ? m->cap_tris : 1, 3 * sizeof(uint32_t)));
+    if (!m->nidx) return fr_fail(FR_ERR_NOMEM, "out of memory for normal indices");
+    for (size_t i = 0; i < 3 * m->ntris; i++) m->nidx[i] = FR_INVALID_ID;
+  }
+  m->nidx[3 * t] = a; m->nidx[3 * t + 1] = b; m->nidx[3 * t + 2] = c;
+  return FR_OK;
+}
+
+int fr_mesh_has_normals(const fr_mesh *m, size_t t) {
+  if (!m->nidx) return 0;
+  for (int k = 0; k < 3; k++) {
+    const uint32_t i = m->nidx[3 * t + k];
+    if (i >= m->nnrm) return 0;
+    const float *n = m->nrm + 3 * (size_t)i;
+    if (n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f) return 0;
+  }
+  return 1;
+}
+
+/* Unit face normal of triangle t (in double, kept as float), and its angle at each corner. */
+static void face_normal(const fr_mesh *m, size_t t, float nf[6]) {
+  double n[3], angle[3];
+  const float *p[3];
+  for (int k = 0; k < 3; k++) p[k] = m->pos + 3 * (size_t)m->idx[3 * t + k];
+  double e[3][3];
+  for (int k = 0; k < 3; k++)
+    for (int a = 0; a < 3; a++) e[k][a] = (double)p[(k + 1) % 3][a] - p[k][a];
+  n[0] = e[0][1] * -e[2][2] - e[0][2] * -e[2][1];
+  n[1] = e[0][2] * -e[2][0] - e[0][0] * -e[2][2];
+  n[2] = e[0][0] * -e[2][1] - e[0][1] * -e[2][0];
+  const double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  for (int a = 0; a < 3; a++) n[a] = l > 0.0 ? n[a] / l : 0.0;
+  for (int k = 0; k < 3; k++) { /* between the edges leaving corner k */
+    const double *u = e[k], *w = e[(k + 2) % 3];
+    const double lu = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]), lw = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    const double c = lu > 0.0 && lw > 0.0 ? -(u[0] * w[0] + u[1] * w[1] + u[2] * w[2]) / (lu * lw) : 1.0;
+    angle[k] = acos(c < -1.0 ? -1.0 : c > 1.0 ? 1.0 : c);
+  }
+  for (int a = 0; a < 3; a++) nf[a] = (float)n[a], nf[3 + a] = (float)angle[a];
+}
+
+fr_error fr_mesh_smooth_normals(fr_mesh *m, float crease_deg) {
+  const size_t nt = m->ntris, nv = m->nverts;
+  size_t todo = 0;
+  for (size_t t = 0; t < nt; t++) todo += !fr_mesh_has_normals(m, t);
+  if (!todo) return FR_OK;
+  /* the faces around each vertex (CSR) and every face's normal and angles */
+  size_t *start = calloc(nv + 1, sizeof *start);
+  uint32_t *faces = malloc(fr_mul_size(nt ? nt : 1, 3 * sizeof(uint32_t)));
+  float *fn = malloc(fr_mul_size(nt ? nt : 1, 6 * sizeof(float)));
+  fr_error e = FR_OK;
+  if (!start || !faces || !fn) { e = fr_fail(FR_ERR_NOMEM, "out of memory for smooth normals"); goto done; }
+  for (size_t t = 0; t < nt; t++) {
+    face_normal(m, t, fn + 6 * t);
+    for (int k = 0; k < 3; k++) start[m->idx[3 * t + k] + 1]++;
+  }
+  for (size_t v = 0; v < nv; v++) start[v + 1] += start[v];
+  for (size_t t = 0; t < nt; t++)
+    for (int k = 0; k < 3; k++) faces[start[m->idx[3 * t + k]]++] = (uint32_t)t;
+  for (size_t v = nv; v > 0; v--) start[v] = start[v - 1];
+  start[0] = 0;
+  const double cos_crease = cos((double)crease_deg * 3.14159265358979323846 / 180.0);
+  /* vertex by vertex, so that the normals one vertex makes lie together and
+   * equal ones (a smooth vertex's corners) are stored once */
+  for (size_t v = 0; v < nv && !e; v++) {
+    const size_t first = m->nnrm;
+    for (size_t i = start[v]; i < start[v + 1] && !e; i++) {
+      const size_t t = faces[i];
+      if (fr_mesh_has_normals(m, t) || (i > start[v] && faces[i - 1] == t)) continue;
+      int k = 0;
+      while (k < 3 && m->idx[3 * t + k] != v) k++;
+      const float *nt0 = fn + 6 * t;
+      double s[3] = {0, 0, 0};
+      for (size_t j = start[v]; j < start[v + 1]; j++) {
+        const size_t f = faces[j];
+        if (j > start[v] && faces[j - 1] == f) continue; /* a face that uses v twice counts once */
+        const float *nf = fn + 6 * f;
+        if ((double)nf[0] * nt0[0] + (double)nf[1] * nt0[1] + (double)nf[2] * nt0[2] < cos_crease) continue;
+        int c = 0;
+        while (c < 3 && m->idx[3 * f + c] != v) c++;
+        for (int a = 0; a < 3; a++) s[a] += (double)nf[a] * nf[3 + c];
+      }
+      const double l = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+      const float n[3] = {l > 0.0 ? (float)(s[0] / l) : 0.0f, l > 0.0 ? (float)(s[1] / l) : 0.0f, l > 0.0 ? (float)(s[2] / l) : 0.0f};
+      uint32_t id = FR_INVALID_ID;
+      for (size_t q = first; q < m->nnrm && id == FR_INVALID_ID; q++)
+        if (!memcmp(m->nrm + 3 * q, n, sizeof n)) id = (uint32_t)q;
+      if (id == FR_INVALID_ID) {
+        id = (uint32_t)m->nnrm;
+        if (m->nnrm >= 0xFFFFFFF0u || !grow((void **)&m->nrm, &m->cap_nrm, m->nnrm, 3 * sizeof(float))) {
+          e = fr_fail(FR_ERR_NOMEM, "out of memory for smooth normals");
+          break;
+        }
+        memcpy(m->nrm + 3 * m->nnrm++, n, sizeof n);
+      }
+      if (!e && !m->nidx) e = fr_mesh_set_normals(m, t, FR_INVALID_ID, FR_INVALID_ID, FR_INVALID_ID);
+      if (!e) m->nidx[3 * t + k] = id;
+    }
+  }
+done:
+  free(start);
+  free(faces);
+  free(fn);
+  return e;
 }
 
 void fr_material_default(fr_material *mat, const char *name) {

@@ -13,12 +13,27 @@ typedef struct fr_mesh {
   size_t ntris, cap_tris;
   fr_material *mats;
   size_t nmats, cap_mats;
+  float *nrm;        /* shading normals, 3 floats each (unit) */
+  size_t nnrm, cap_nrm;
+  uint32_t *nidx;    /* 3 normal indices per triangle (FR_INVALID_ID: none), or NULL when none has */
 } fr_mesh;
 
 void fr_mesh_init(fr_mesh *m);
 void fr_mesh_free(fr_mesh *m);
 fr_error fr_mesh_add_vertex(fr_mesh *m, float x, float y, float z);
 fr_error fr_mesh_add_triangle(fr_mesh *m, uint32_t a, uint32_t b, uint32_t c, uint32_t mat);
+/* A shading normal (normalized here; a zero or non-finite one is kept as
+ * 0, 0, 0, which means none). */
+fr_error fr_mesh_add_normal(fr_mesh *m, float x, float y, float z);
+/* Triangle t's corner normals, indices into nrm. */
+fr_error fr_mesh_set_normals(fr_mesh *m, size_t t, uint32_t a, uint32_t b, uint32_t c);
+/* Gives the triangles without normals angle-weighted vertex normals: a
+ * corner averages the normals of the faces around its vertex that lie
+ * within crease_deg of its own face's, each weighted by its angle there
+ * (so that a sharp edge stays sharp and a cube stays faceted). */
+fr_error fr_mesh_smooth_normals(fr_mesh *m, float crease_deg);
+/* Whether triangle t has normals at all three corners. */
+int fr_mesh_has_normals(const fr_mesh *m, size_t t);
 /* Index of the material called name, created with defaults if new. */
 fr_error fr_mesh_material(fr_mesh *m, const char *name, uint32_t *out);
 void fr_material_default(fr_material *mat, const char *name);

@@ -61,6 +61,21 @@ static fr_error add_mesh(const struct aiMesh *am, const struct aiMatrix4x4 *t, u
     if (t) aiTransformVecByMatrix4(&p, t);
     e = fr_mesh_add_vertex(m, p.x, p.y, p.z);
   }
+  /* normals per vertex, aligned with the vertices (0, 0, 0 where a mesh has
+   * none), turned by the transform's linear part: exact for rotations and
+   * uniform scales, which is what scene graphs hold */
+  for (unsigned v = 0; v < am->mNumVertices && !e; v++) {
+    struct aiVector3D n = {0, 0, 0};
+    if (am->mNormals) {
+      n = am->mNormals[v];
+      if (t) {
+        struct aiMatrix3x3 r;
+        aiMatrix3FromMatrix4(&r, t);
+        aiTransformVecByMatrix3(&n, &r);
+      }
+    }
+    e = fr_mesh_add_normal(m, n.x, n.y, n.z);
+  }
   for (unsigned f = 0; f < am->mNumFaces && !e; f++) {
     const struct aiFace *face = &am->mFaces[f];
     for (unsigned j = 2; j < face->mNumIndices && face->mIndices && !e; j++)
@@ -185,10 +200,14 @@ static void send_mesh(int fd, fr_error e, const fr_mesh *m) {
     return;
   }
   const uint64_t counts[3] = {m->nverts, m->ntris, m->nmats};
-  const uint8_t has_mat = m->mat != NULL;
-  if (put(fd, counts, sizeof counts) && put(fd, &has_mat, 1) && put(fd, m->pos, m->nverts * 3 * sizeof(float)) &&
-      put(fd, m->idx, m->ntris * 3 * sizeof(uint32_t)) && (!has_mat || put(fd, m->mat, m->ntris * sizeof(uint32_t))))
-    put(fd, m->mats, m->nmats * sizeof(fr_material));
+  /* flags: 1 per-triangle materials follow the indices, 2 per-vertex
+   * normals follow the materials */
+  const uint8_t has_mat = m->mat != NULL, has_nrm = m->nverts && m->nnrm == m->nverts;
+  const uint8_t flags = (uint8_t)(has_mat | has_nrm << 1);
+  if (put(fd, counts, sizeof counts) && put(fd, &flags, 1) && put(fd, m->pos, m->nverts * 3 * sizeof(float)) &&
+      put(fd, m->idx, m->ntris * 3 * sizeof(uint32_t)) && (!has_mat || put(fd, m->mat, m->ntris * sizeof(uint32_t))) &&
+      put(fd, m->mats, m->nmats * sizeof(fr_material)) && has_nrm)
+    put(fd, m->nrm, m->nnrm * 3 * sizeof(float));
 }
 
 static void limit_child(size_t file_bytes) {
@@ -238,8 +257,9 @@ static fr_error receive_mesh(int fd, const char *path, fr_mesh *m, int *broke) {
     return fr_fail((fr_error)status, "%s", msg[0] ? msg : "Assimp could not read the file");
   }
   uint64_t counts[3];
-  uint8_t has_mat;
-  if (!get(fd, counts, sizeof counts) || !get(fd, &has_mat, 1)) return BROKE;
+  uint8_t flags;
+  if (!get(fd, counts, sizeof counts) || !get(fd, &flags, 1)) return BROKE;
+  const int has_mat = flags & 1, has_nrm = (flags >> 1) & 1;
   if (counts[0] > 0xFFFFFFF0u || counts[1] > 0xFFFFFFF0u || counts[2] > 0xFFFFFFu)
     return fr_fail(FR_ERR_FORMAT, "%s: too large", path);
   for (uint64_t i = 0; i < counts[0]; i++) {
@@ -260,8 +280,19 @@ static fr_error receive_mesh(int fd, const char *path, fr_mesh *m, int *broke) {
     fm.name[sizeof fm.name - 1] = 0;
     if (!(e = fr_mesh_material(m, fm.name, &k))) m->mats[k] = fm;
   }
-  for (uint64_t t = 0; t < counts[1] && !e; t++)
-    e = fr_mesh_add_triangle(m, idx[3 * t], idx[3 * t + 1], idx[3 * t + 2], mat ? mat[t] : FR_INVALID_ID);
+  for (uint64_t i = 0; i < counts[0] && has_nrm && !e; i++) {
+    float n[3];
+    e = get(fd, n, sizeof n) ? fr_mesh_add_normal(m, n[0], n[1], n[2]) : BROKE;
+  }
+  for (uint64_t t = 0; t < counts[1] && !e; t++) {
+    const uint32_t *ix = idx + 3 * t;
+    e = fr_mesh_add_triangle(m, ix[0], ix[1], ix[2], mat ? mat[t] : FR_INVALID_ID);
+    if (!e && has_nrm && ix[0] < m->nnrm && ix[1] < m->nnrm && ix[2] < m->nnrm) {
+      e = fr_mesh_set_normals(m, m->ntris - 1, ix[0], ix[1], ix[2]);
+      if (!e && !fr_mesh_has_normals(m, m->ntris - 1)) /* a mesh without normals among ones with */
+        e = fr_mesh_set_normals(m, m->ntris - 1, FR_INVALID_ID, FR_INVALID_ID, FR_INVALID_ID);
+    }
+  }
   free(idx);
   free(mat);
   return e;

@@ -59,6 +59,22 @@ static void parse_name(const char *p, const char *e, char *name, size_t cap) {
   name[n] = 0;
 }
 
+/* A 1-based OBJ index at *p (negative: counting back from the last of
+ * count), 0-based into *out; advances *p. 0 if malformed or out of range. */
+static int parse_index(const char **p, const char *e, long long count, long long *out) {
+  char *q;
+  errno = 0;
+  long long v = strtoll(*p, &q, 10);
+  if (q == *p || q > e || errno) return 0;
+  *p = q;
+  if (v < 0) v = count + v;
+  else if (v > 0) v -= 1;
+  else return 0;
+  if (v < 0 || v >= count) return 0;
+  *out = v;
+  return 1;
+}
+
 static int keyword(const char *s, size_t len, const char *kw) {
   size_t k = strlen(kw);
   return len > k && memcmp(s, kw, k) == 0 && (s[k] == ' ' || s[k] == '\t');
@@ -91,7 +107,7 @@ fr_error fr_import_obj(const char *path, const char *data, size_t size, fr_mesh 
   const char *s;
   size_t len;
   uint32_t mat = FR_INVALID_ID;
-  long long poly[MAX_POLY];
+  long long poly[MAX_POLY], pnrm[MAX_POLY];
   while (next_line(&l, &s, &len)) {
     if (len > MAX_LINE) return fr_fail(FR_ERR_FORMAT, "%s:%zu: line too long", path, l.lineno);
     const char *e = s + len;
@@ -102,29 +118,40 @@ fr_error fr_import_obj(const char *path, const char *data, size_t size, fr_mesh 
       if (parse_floats(s + 1, e, xyz, 3) != 3) return fr_fail(FR_ERR_FORMAT, "%s:%zu: vertex needs three numbers", path, l.lineno);
       fr_error err = fr_mesh_add_vertex(m, xyz[0], xyz[1], xyz[2]);
       if (err) return err;
+    } else if (keyword(s, len, "vn")) {
+      float xyz[3];
+      if (parse_floats(s + 2, e, xyz, 3) != 3) return fr_fail(FR_ERR_FORMAT, "%s:%zu: normal needs three numbers", path, l.lineno);
+      fr_error err = fr_mesh_add_normal(m, xyz[0], xyz[1], xyz[2]);
+      if (err) return err;
     } else if (keyword(s, len, "f")) {
-      int n = 0;
+      int n = 0, normals = 1;
       const char *p = s + 1;
       for (;;) {
         p = skip_ws(p, e);
         if (p >= e) break;
         if (n == MAX_POLY) return fr_fail(FR_ERR_FORMAT, "%s:%zu: face has more than %d vertices", path, l.lineno, MAX_POLY);
-        char *q;
-        errno = 0;
-        long long v = strtoll(p, &q, 10);
-        if (q == p || q > e || errno) return fr_fail(FR_ERR_FORMAT, "%s:%zu: bad face index", path, l.lineno);
-        /* OBJ indices are 1-based; negative ones count back from the last vertex */
-        if (v < 0) v = (long long)m->nverts + v;
-        else if (v > 0) v -= 1;
-        else return fr_fail(FR_ERR_FORMAT, "%s:%zu: face index 0", path, l.lineno);
-        if (v < 0 || v >= (long long)m->nverts)
-          return fr_fail(FR_ERR_FORMAT, "%s:%zu: face index out of range (%zu vertices so far)", path, l.lineno, m->nverts);
-        poly[n++] = v;
-        p = q;
-        while (p < e && *p != ' ' && *p != '\t' && *p != '\r') p++; /* skip /vt/vn */
+        long long v;
+        if (!parse_index(&p, e, (long long)m->nverts, &v))
+          return fr_fail(FR_ERR_FORMAT, "%s:%zu: bad face index (%zu vertices so far)", path, l.lineno, m->nverts);
+        poly[n] = v;
+        /* v/vt/vn or v//vn: the normal's index; a bad one only loses the normals */
+        long long vn = -1;
+        if (p < e && *p == '/') {
+          p++;
+          while (p < e && *p != '/' && *p != ' ' && *p != '\t' && *p != '\r') p++; /* vt */
+          if (p < e && *p == '/') {
+            p++;
+            if (!parse_index(&p, e, (long long)m->nnrm, &vn)) vn = -1;
+          }
+        }
+        while (p < e && *p != ' ' && *p != '\t' && *p != '\r') p++;
+        pnrm[n++] = vn;
+        normals &= vn >= 0;
       }
       for (int j = 2; j < n; j++) {
         fr_error err = fr_mesh_add_triangle(m, (uint32_t)poly[0], (uint32_t)poly[j - 1], (uint32_t)poly[j], mat);
+        if (!err && normals)
+          err = fr_mesh_set_normals(m, m->ntris - 1, (uint32_t)pnrm[0], (uint32_t)pnrm[j - 1], (uint32_t)pnrm[j]);
         if (err) return err;
       }
     } else if (keyword(s, len, "usemtl")) {
@@ -137,7 +164,7 @@ fr_error fr_import_obj(const char *path, const char *data, size_t size, fr_mesh 
       parse_name(s + 6, e, name, sizeof name);
       if (name[0]) load_mtllib(path, name, m);
     }
-    /* vt, vn, g, o, s, l and comments: not needed */
+    /* vt, g, o, s, l and comments: not needed */
   }
   return FR_OK;
 }

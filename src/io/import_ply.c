@@ -149,9 +149,11 @@ static int prop_index(const elem *e, const char *name) {
 
 static fr_error read_vertices(cursor *c, const elem *e, fr_mesh *m) {
   int ix = prop_index(e, "x"), iy = prop_index(e, "y"), iz = prop_index(e, "z");
+  int inx = prop_index(e, "nx"), iny = prop_index(e, "ny"), inz = prop_index(e, "nz");
+  const int normals = inx >= 0 && iny >= 0 && inz >= 0; /* one per vertex, as Blender and most tools write them */
   if (ix < 0 || iy < 0 || iz < 0) return fr_fail(FR_ERR_FORMAT, "%s: PLY vertex element lacks x, y or z", c->path);
   for (uint64_t i = 0; i < e->count; i++) {
-    double xyz[3] = {0, 0, 0};
+    double xyz[3] = {0, 0, 0}, nrm[3] = {0, 0, 0};
     for (int k = 0; k < e->nprops; k++) {
       const prop *pr = &e->props[k];
       double v;
@@ -164,8 +166,10 @@ static fr_error read_vertices(cursor *c, const elem *e, fr_mesh *m) {
       }
       if (!read_value(c, pr->type, &v)) return truncated(c, "vertex", i);
       if (k == ix) xyz[0] = v; else if (k == iy) xyz[1] = v; else if (k == iz) xyz[2] = v;
+      else if (k == inx) nrm[0] = v; else if (k == iny) nrm[1] = v; else if (k == inz) nrm[2] = v;
     }
     fr_error err = fr_mesh_add_vertex(m, (float)xyz[0], (float)xyz[1], (float)xyz[2]);
+    if (!err && normals) err = fr_mesh_add_normal(m, (float)nrm[0], (float)nrm[1], (float)nrm[2]);
     if (err) return err;
   }
   return FR_OK;
@@ -193,6 +197,9 @@ static fr_error read_faces(cursor *c, const elem *e, fr_mesh *m) {
     }
     for (int j = 2; j < npoly; j++) { /* fan: v0 v1 v2, v0 v2 v3, ... */
       fr_error err = fr_mesh_add_triangle(m, poly[0], poly[j - 1], poly[j], FR_INVALID_ID);
+      /* per-vertex normals share the vertices' numbers */
+      if (!err && m->nnrm == m->nverts && m->nnrm && poly[0] < m->nnrm && poly[j - 1] < m->nnrm && poly[j] < m->nnrm)
+        err = fr_mesh_set_normals(m, m->ntris - 1, poly[0], poly[j - 1], poly[j]);
       if (err) return err;
     }
   }

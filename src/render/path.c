@@ -121,6 +121,9 @@ static vec3 to_local(vec3 w, vec3 t, vec3 b, vec3 n) { return v3(v3_dot(w, t), v
 static vec3 to_world(vec3 w, vec3 t, vec3 b, vec3 n) {
   return v3_add(v3_add(v3_scale(t, w.x), v3_scale(b, w.y)), v3_scale(n, w.z));
 }
+/* Whether w lies on the same side of the shading normal n as of the
+ * geometric normal ng (both oriented alike). */
+static int same_side(vec3 w, vec3 n, vec3 ng) { return (v3_dot(w, n) > 0.0f) == (v3_dot(w, ng) > 0.0f); }
 static int nonzero(vec3 c) { return c.x > 0.0f || c.y > 0.0f || c.z > 0.0f; }
 
 /* Pixel i of a tile, in blocks of 4x4 (consecutive 16 are coherent). */
@@ -218,8 +221,18 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
           st.weight = v3_mul(st.weight, v3(powf(a.x, k), powf(a.y, k), powf(a.z, k)));
         }
         if (front && nonzero(m->emission)) S->acc[st.pix] = v3_add(S->acc[st.pix], v3_mul(st.weight, m->emission));
-        /* the shading frame: the outward normal for glass, else the side the ray came from */
-        const vec3 n = m->kind == FR_BSDF_GLASS || front ? ng : v3_scale(ng, -1.0f);
+        /* the shading frame: the outward normal for glass, else the side the
+         * ray came from; the interpolated normal where the mesh has one and
+         * it sees the ray on the same side as the geometric normal */
+        const int outward = m->kind == FR_BSDF_GLASS || front;
+        const vec3 ngo = outward ? ng : v3_scale(ng, -1.0f);
+        vec3 n = ngo;
+        float sn[3];
+        if (h.prim < P->nsurf && fr_scene_shading_normal(w->scene, h.prim, h.u, h.v, sn)) {
+          vec3 ns = v3_load(sn);
+          if (v3_dot(ns, ngo) < 0.0f) ns = v3_scale(ns, -1.0f);
+          if ((v3_dot(ns, d) < 0.0f) == (v3_dot(ngo, d) < 0.0f)) n = ns;
+        }
         vec3 tb, bb;
         v3_onb(n, &tb, &bb);
         const vec3 wo = to_local(v3_scale(d, -1.0f), tb, bb, n);
@@ -227,7 +240,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         fr_bsdf_prepare(m, p, &sp);
         if (depth == 0 && (w->gbuf_albedo || w->gbuf_normal)) {
           S->alb[st.pix] = v3_add(S->alb[st.pix], fr_bsdf_albedo(m));
-          S->nrm[st.pix] = v3_add(S->nrm[st.pix], front ? ng : v3_scale(ng, -1.0f));
+          S->nrm[st.pix] = v3_add(S->nrm[st.pix], front ? n : v3_scale(n, -1.0f));
         }
         const uint32_t dim = 2u + 4u * (uint32_t)depth;
         float uc, ul, u1, u2, v1, v2, ur, unused;
@@ -238,7 +251,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
           vec3 wi, le;
           float dist, pl;
           int delta;
-          if (sample_light(L, p, uc, u1, u2, &wi, &dist, &le, &pl, &delta)) {
+          if (sample_light(L, p, uc, u1, u2, &wi, &dist, &le, &pl, &delta) && same_side(wi, n, ngo)) {
             float pb;
             const vec3 f = fr_bsdf_eval(m, &sp, wo, to_local(wi, tb, bb, n), &pb);
             if (nonzero(f) && nonzero(le)) {
@@ -254,6 +267,8 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         fr_sample2d(P->sampler, st.key, st.sample, n_spp, dim + 2, &v1, &v2);
         fr_bsdf_sample bs;
         if (!fr_bsdf_sample_dir(m, &sp, wo, ul, v1, v2, &bs)) continue;
+        const vec3 wi = to_world(bs.wi, tb, bb, n);
+        if (!same_side(wi, n, ngo)) continue; /* through the surface by the shading normal alone: a leak */
         st.weight = v3_mul(st.weight, bs.weight);
         const float q = fr_maxf(st.weight.x, fr_maxf(st.weight.y, st.weight.z)) / FR_PATH_RR_WEIGHT;
         if (q < 1.0f) {
@@ -265,7 +280,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         st.delta = (uint8_t)bs.delta;
         st.depth = (uint8_t)(depth + 1);
         S->st[nn] = st;
-        S->ray[nn++] = make_ray(p, to_world(bs.wi, tb, bb, n), eps, INFINITY);
+        S->ray[nn++] = make_ray(p, wi, eps, INFINITY);
       }
       double t3 = fr_seconds();
       S->stage[FR_STAGE_SHADE] += t3 - t2;

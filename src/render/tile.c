@@ -116,8 +116,9 @@ static void shade_pixels(const fr_workload *w, const fr_tile_buffers *B, int n, 
     float *px = w->image + 3 * ((size_t)B->py[i] * (size_t)W + (size_t)B->px[i]);
     const fr_hit *h = &B->prim_hit[i];
     if (h->prim == FR_INVALID_ID) { px[0] = px[1] = px[2] = 0.05f; continue; }
-    vec3 d = v3_load(B->prim_ray[i].dir), nn = facing_normal(w->scene, h, &B->prim_ray[i]), c;
-    float cosv = fabsf(v3_dot(nn, d));
+    vec3 d = v3_load(B->prim_ray[i].dir), c;
+    const vec3 nn = shading_normal(w->scene, h, d, facing_normal(w->scene, h, &B->prim_ray[i]));
+    float cosv = fabsf(v3_dot(nn, v3_norm(d)));
     if (w->shade == FR_SHADE_NORMALS) {
       c = v3_scale(v3_add(nn, v3(1, 1, 1)), 0.5f);
     } else if (w->shade == FR_SHADE_LIGHT && w->kind == FR_WL_SHADOW) {

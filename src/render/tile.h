@@ -6,6 +6,7 @@
 #ifndef FR_RENDER_TILE_H
 #define FR_RENDER_TILE_H
 #include <math.h>
+#include "api/scene.h"
 #include "base/vec3.h"
 #include "render/workload.h"
 
@@ -53,6 +54,18 @@ static inline vec3 facing_normal(const fr_scene *s, const fr_hit *h, const fr_ra
   fr_scene_geometric_normal(s, h->prim, pp, g);
   vec3 n = v3_norm(v3_load(g));
   return v3_dot(n, d) > 0.0f ? v3_scale(n, -1.0f) : n;
+}
+
+/* The normal to shade with: the interpolated shading normal where the mesh
+ * has one, turned to face the ray like the geometric normal nf (facing
+ * the ray) and given up for nf where it does not (a grazing ray past a
+ * smooth silhouette). */
+static inline vec3 shading_normal(const fr_scene *s, const fr_hit *h, vec3 d, vec3 nf) {
+  float sn[3];
+  if (!fr_scene_shading_normal(s, h->prim, h->u, h->v, sn)) return nf;
+  vec3 n = v3_load(sn);
+  if (v3_dot(n, nf) < 0.0f) n = v3_scale(n, -1.0f);
+  return v3_dot(n, d) < 0.0f ? n : nf;
 }
 
 static inline vec3 cosine_dir(vec3 n, float u1, float u2) {

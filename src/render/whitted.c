@@ -277,6 +277,15 @@ static void fetch_surfaces(const fr_workload *w, fr_whitted_scratch *S, size_t n
     fr_surface *sf = &S->surf[i];
     if (h->prim < w->mats->ntris) {
       *sf = w->mats->tri[h->prim];
+      /* smooth shading: the interpolated normal, on the geometric normal's
+       * side and the same side of the ray (else the geometric one) */
+      float sn[3];
+      if (fr_scene_shading_normal(w->scene, h->prim, h->u, h->v, sn)) {
+        const float *d = S->cur.r[i].dir, *g = sf->ng;
+        const float sg = sn[0] * g[0] + sn[1] * g[1] + sn[2] * g[2], s = sg < 0.0f ? -1.0f : 1.0f;
+        const float dn = s * (sn[0] * d[0] + sn[1] * d[1] + sn[2] * d[2]), dg = g[0] * d[0] + g[1] * d[1] + g[2] * d[2];
+        if ((dn < 0.0f) == (dg < 0.0f)) sf->ng[0] = s * sn[0], sf->ng[1] = s * sn[1], sf->ng[2] = s * sn[2];
+      }
       continue;
     }
     *sf = (fr_surface){{0.0f, 0.0f, 0.0f}, 0};

@@ -67,6 +67,9 @@ int cli_parse_size(const char *s, int *w, int *h) {
 int cli_view_from_args(const cli_args *a, cli_view *v) {
   memset(v, 0, sizeof *v);
   v->width = v->height = 1024;
+  v->smooth = 30.0f;
+  int rc = cli_arg_float(a, F_SMOOTH, 0.0f, 180.0f, &v->smooth);
+  if (rc) return rc;
   static const cli_flag_id vecs[] = {F_EYE, F_AT, F_UP, F_LIGHT};
   vec3 *dst[] = {&v->eye, &v->at, &v->up, &v->light};
   int *has[] = {&v->has_eye, &v->has_at, &v->has_up, &v->has_light};
@@ -120,7 +123,9 @@ fr_view cli_resolve_view(const fr_scene *s, const cli_view *v) {
 
 int cli_is_builtin(const char *arg) { return strcmp(arg, "--builtin") == 0 || strncmp(arg, "--builtin=", 10) == 0; }
 
-int cli_load_scene(const char *arg, fr_scene **s) {
+int cli_load_scene(const char *arg, fr_scene **s) { return cli_load_scene_smooth(arg, 0.0f, s); }
+
+int cli_load_scene_smooth(const char *arg, float smooth, fr_scene **s) {
   fr_error e;
   if (strcmp(arg, "--builtin") == 0 || strcmp(arg, "--builtin=default") == 0) e = fr_scene_builtin(s);
   else if (strcmp(arg, "--builtin=sphereflake") == 0) e = fr_scene_builtin_sphereflake(3, s);
@@ -130,7 +135,8 @@ int cli_load_scene(const char *arg, fr_scene **s) {
   else if (fr_has_suffix(arg, ".json")) e = fr_scene_load_json(arg, cli_scene_root(), NULL, s);
   else e = fr_scene_load(arg, s);
   if (e) return cli_error(1, "%s", fr_last_error());
-  e = fr_scene_commit(*s);
+  if (smooth > 0.0f) e = fr_scene_smooth(*s, smooth);
+  if (!e) e = fr_scene_commit(*s);
   if (e) { fr_scene_release(*s); *s = NULL; return cli_error(1, "%s", fr_last_error()); }
   return 0;
 }
@@ -153,7 +159,7 @@ fr_lp_scene cli_lp_scene(const fr_scene *s) {
 }
 
 int cli_workload_setup(const char *scene, const cli_view *v, int threads, fr_scene **s, fr_workload *w) {
-  int rc = cli_load_scene(scene, s);
+  int rc = cli_load_scene_smooth(scene, v->smooth, s);
   if (rc) return rc;
   w->view = cli_resolve_view(*s, v);
   if (fr_camera_setup(&w->cam, w->view.eye, w->view.at, w->view.up, w->view.fov, v->width, v->height)) {

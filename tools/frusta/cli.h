@@ -22,6 +22,7 @@ typedef struct cli_view {
   vec3 eye, at, up, light, area[3];
   float fov;
   int width, height;
+  float smooth;   /* crease angle of the shading normals made where a file has none (0: flat) */
 } cli_view;
 
 /* The view flags (1024x1024 and the scene's view where not given), and
@@ -35,6 +36,8 @@ fr_view cli_resolve_view(const fr_scene *s, const cli_view *v);
 /* A scene argument: a file, --builtin, or --builtin=NAME (default, sphereflake). */
 int cli_is_builtin(const char *arg);
 int cli_load_scene(const char *arg, fr_scene **s);
+/* The same with smooth shading normals (fr_scene_smooth) of crease angle smooth, if > 0. */
+int cli_load_scene_smooth(const char *arg, float smooth, fr_scene **s);
 /* Applies FRUSTA_ISA / --isa; reports errors itself. */
 int cli_set_isa(const char *name);
 float cli_scene_eps(const fr_scene *s);

@@ -322,7 +322,9 @@ static void print_frusta_build(const bench_opts *o, const fr_scene *s) {
 static int bench_prepare(const bench_opts *o, bench_setup *b) {
   memset(b, 0, sizeof *b);
   omp_set_num_threads(o->threads);
-  int rc = cli_workload_setup(o->scene, &o->view, o->threads, &b->s, &b->w);
+  cli_view view = o->view;
+  if (!(o->workloads & (1u << FR_WL_PATH | 1u << FR_WL_WHITTED))) view.smooth = 0.0f; /* only they shade */
+  int rc = cli_workload_setup(o->scene, &view, o->threads, &b->s, &b->w);
   if (rc) return rc;
   fr_scene *s = b->s;
   b->w.seed = 7;

@@ -27,7 +27,9 @@ static int table5(const char *path, const cli_view *v, int threads, const char *
   fr_scene *s;
   fr_workload w;
   memset(&w, 0, sizeof w);
-  int rc = cli_workload_setup(path, v, threads, &s, &w);
+  cli_view flat = *v;
+  flat.smooth = 0.0f; /* nothing is shaded */
+  int rc = cli_workload_setup(path, &flat, threads, &s, &w);
   if (rc) return rc;
   w.kind = k;
   w.seed = 7;

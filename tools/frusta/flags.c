@@ -24,6 +24,8 @@ const cli_flag cli_flags[F_COUNT] = {
                "instruction set of the kernels (default: the best the CPU has; also FRUSTA_ISA)"},
     [F_SCENE_ROOT] = {"--scene-root", "DIR", R | B | T | S,
                        "a scene file's meshes and maps may lie anywhere under DIR (default: its own folder only)"},
+    [F_SMOOTH] = {"--smooth", "DEG", R | B,
+                  "smooth shading normals where the file has none, across edges under DEG degrees (default 30; 0: flat)"},
     [F_OUT] = {"--out", "FILE", R | T, "render: the image, .png, .exr or .pfm; trace: the hit or occlusion file"},
     [F_SHADE] = {"--shade", "eyelight|normals|shadows|softshadow|whitted|path", R, "what to render (default eyelight)"},
     [F_LIGHT_SAMPLES] = {"--light-samples", "N", R,

@@ -12,7 +12,7 @@ typedef enum cli_cmd { CLI_RENDER = 1, CLI_BENCH = 2, CLI_TRACE = 4, CLI_STATS =
 
 typedef enum cli_flag_id {
   /* scene and view */
-  F_SIZE, F_EYE, F_AT, F_UP, F_FOV, F_LIGHT, F_AREA, F_THREADS, F_ISA, F_SCENE_ROOT,
+  F_SIZE, F_EYE, F_AT, F_UP, F_FOV, F_LIGHT, F_AREA, F_THREADS, F_ISA, F_SCENE_ROOT, F_SMOOTH,
   /* render */
   F_OUT, F_SHADE, F_LIGHT_SAMPLES, F_FILTER, F_LIGHT_SETS, F_MFT, F_REFERENCE_OUT,
   /* path tracing */
