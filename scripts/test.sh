@@ -34,7 +34,9 @@ if [ "${FRUSTA_TSAN_TESTS:-1}" != 0 ]; then
   done
   "$TSAN/frusta" render "${FRUSTA_SHARED:-../shared}/scenes/kitchen/kitchen.ply.zst" --shade softshadow --size 64x64 \
     --threads 4 --out "$out/kitchen.png" >/dev/null
+  "$TSAN/frusta" render --builtin=materials --shade path --spp 2 --size 64x32 --threads 4 --out "$out/path.png" >/dev/null
   "$TSAN/frusta" bench --builtin --workload all --mode all --threads 4 --size 64x64 --repeat 1 >/dev/null
+  "$TSAN/frusta" bench --builtin=materials --workload path --mode all --threads 4 --size 32x32 --spp 2 --repeat 1 >/dev/null
   rm -rf "$out"
   unset TSAN_OPTIONS OMP_TOOL_LIBRARIES
   echo "ThreadSanitizer: threads, hybrid tuning, render and bench on 4 threads: no report"

@@ -54,7 +54,7 @@ static void furnace_setup(furnace *f, fr_bsdf m, int size, int spp) {
   w->view.up = v3(0, 1, 0);
   w->eps = 1e-4f;
   w->threads = 2;
-  w->seed = 3;
+  f->P.seed = 3;
   w->path = &f->P;
   w->image = calloc((size_t)size * size * 3, sizeof(float));
 }
@@ -189,10 +189,10 @@ static void same_image_everywhere(void **st) {
   assert_int_equal(fr_surfaces_build(s, (int32_t)count - 1, &surf, &nsurf), FR_OK);
   const fr_path_lights L = {&env, 1, v.area_c, v.area_e1, v.area_e2, v3(20, 20, 20), 1, v.light, v3(50, 50, 50)};
   fr_path_setup P = {.mats = mats, .count = count, .surf = surf, .nsurf = nsurf, .lights = L, .max_depth = 13,
-                     .sampler = FR_SAMPLER_SOBOL, .spp = 8, .spp_begin = 0, .spp_end = 8, .aperture = 0.05f, .focus = 9.0f};
+                     .sampler = FR_SAMPLER_SOBOL, .seed = 5, .spp = 8, .spp_begin = 0, .spp_end = 8, .aperture = 0.05f, .focus = 9.0f};
   fr_workload w;
   memset(&w, 0, sizeof w);
-  w.kind = FR_WL_PATH, w.scene = s, w.view = v, w.eps = 1e-4f * 60.0f, w.seed = 5, w.path = &P;
+  w.kind = FR_WL_PATH, w.scene = s, w.view = v, w.eps = 1e-4f * 60.0f, w.path = &P;
   const int W = FR_TEST_SANITIZED ? 48 : 96, H = W / 2;
   assert_int_equal(fr_camera_setup(&w.cam, v.eye, v.at, v.up, v.fov, W, H), FR_OK);
   const size_t n = (size_t)W * H * 3;

@@ -169,14 +169,16 @@ fr_error fr_scene_smooth(fr_scene *s, float crease_deg) {
 
 int fr_scene_shading_normal(const fr_scene *s, uint32_t prim, float u, float v, float n[3]) {
   const fr_mesh *m = &s->mesh;
-  if (prim >= m->ntris || !fr_mesh_has_normals(m, prim)) return 0;
-  const float *a = m->nrm + 3 * (size_t)m->nidx[3 * (size_t)prim], *b = m->nrm + 3 * (size_t)m->nidx[3 * (size_t)prim + 1],
-              *c = m->nrm + 3 * (size_t)m->nidx[3 * (size_t)prim + 2];
+  if (!m->nidx || prim >= m->ntris) return 0;
+  const uint32_t *ix = m->nidx + 3 * (size_t)prim;
+  if (ix[0] >= m->nnrm || ix[1] >= m->nnrm || ix[2] >= m->nnrm) return 0; /* FR_INVALID_ID: none */
+  const float *a = m->nrm + 3 * (size_t)ix[0], *b = m->nrm + 3 * (size_t)ix[1], *c = m->nrm + 3 * (size_t)ix[2];
   const float w = 1.0f - u - v;
-  float x = w * a[0] + u * b[0] + v * c[0], y = w * a[1] + u * b[1] + v * c[1], z = w * a[2] + u * b[2] + v * c[2];
-  const float l = sqrtf(x * x + y * y + z * z);
-  if (!(l > 0.0f)) return 0;
-  n[0] = x / l, n[1] = y / l, n[2] = z / l;
+  const float x = w * a[0] + u * b[0] + v * c[0], y = w * a[1] + u * b[1] + v * c[1], z = w * a[2] + u * b[2] + v * c[2];
+  const float l2 = x * x + y * y + z * z;
+  if (!(l2 > 1e-12f)) return 0; /* zero corners (none given) or opposite ones */
+  const float r = 1.0f / sqrtf(l2);
+  n[0] = x * r, n[1] = y * r, n[2] = z * r;
   return 1;
 }
 

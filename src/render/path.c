@@ -138,7 +138,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
   const fr_path_lights *L = &P->lights;
   const fr_camera *c = &w->cam;
   const int W = c->width, H = c->height;
-  const uint32_t n_spp = (uint32_t)P->spp, seed = (uint32_t)w->seed;
+  const uint32_t n_spp = (uint32_t)P->spp, seed = P->seed;
   const float eps = w->eps;
   const int nlights = light_count(L);
   uint64_t rays = 0;
@@ -240,7 +240,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         fr_bsdf_prepare(m, p, &sp);
         if (depth == 0 && (w->gbuf_albedo || w->gbuf_normal)) {
           S->alb[st.pix] = v3_add(S->alb[st.pix], fr_bsdf_albedo(m));
-          S->nrm[st.pix] = v3_add(S->nrm[st.pix], front ? n : v3_scale(n, -1.0f));
+          S->nrm[st.pix] = v3_add(S->nrm[st.pix], v3_dot(n, d) < 0.0f ? n : v3_scale(n, -1.0f)); /* facing the camera */
         }
         const uint32_t dim = 2u + 4u * (uint32_t)depth;
         float uc, ul, u1, u2, v1, v2, ur, unused;

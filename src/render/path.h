@@ -40,6 +40,7 @@ typedef struct fr_path_setup {
   fr_path_lights lights;
   int max_depth;                /* segments per path, 1..FR_PATH_MAX_DEPTH (13 by default) */
   fr_sampler_kind sampler;
+  uint32_t seed;                /* the sampler's */
   int spp;                      /* samples per pixel of the whole image (the sampler's pattern size) */
   int spp_begin, spp_end;       /* this frame's share of them */
   float aperture, focus;        /* lens radius (0: pinhole) and focus distance */

@@ -95,8 +95,8 @@ int cli_path_setup(const cli_path *o, fr_workload *w, cli_path_run *r) {
   P->spp = o->spp, P->spp_begin = 0, P->spp_end = o->spp;
   P->aperture = o->aperture;
   P->focus = o->focus > 0.0f ? o->focus : v3_len(v3_sub(v->at, v->eye));
+  P->seed = o->seed;
   w->path = P;
-  w->seed = o->seed;
   printf("path spp=%d max_depth=%d sampler=%s lights=%s%s%s env=%s area_radiance=%.4g point_intensity=%.4g "
          "aperture=%g focus=%g\n",
          o->spp, o->max_depth, fr_sampler_name(o->sampler), (o->lights & CLI_LIGHT_ENV) ? "env," : "",
