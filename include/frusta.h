@@ -64,6 +64,8 @@ typedef struct fr_material {
   float ior;             /* Ni */
   float emission[3];     /* Ke */
   int illum;             /* MTL illumination model (3: mirror reflection), 0 if not given */
+  char map_kd[512];      /* map_Kd: the diffuse colour's texture file, resolved and confined to the
+                            scene's folder ("" for none) */
 } fr_material;
 
 /* Loads a scene file: PLY and OBJ(+MTL) by frusta's own readers (triangle

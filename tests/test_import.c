@@ -6,6 +6,9 @@
 #include <unistd.h>
 #include <zstd.h>
 #include "test_util.h"
+#include "io/image_write.h"
+#include "material/texture.h"
+#include "render/path.h"
 
 static char tmpdir[256];
 
@@ -258,6 +261,57 @@ static void test_normals(void **st) {
   fr_scene_release(s);
 }
 
+/* Texture coordinates (OBJ vt) and diffuse textures (map_Kd), confined to
+ * the scene's folder, looked up by the path tracer's materials. */
+static void test_textures(void **st) {
+  (void)st;
+  /* a 2x2 image: red, green / blue, white (row 0 at the top) */
+  const float px[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
+  char png[600];
+  snprintf(png, sizeof png, "%s/checker.png", tmpdir);
+  assert_int_equal(fr_image_write(png, 2, 2, px), FR_OK);
+  const char *mtl = "newmtl tex\nKd 1 1 1\nmap_Kd -s 1 1 1 checker.png\nnewmtl away\nmap_Kd ../checker.png\n";
+  write_file("t.mtl", mtl, strlen(mtl));
+  const char *obj = "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl tex\nf 1/1 2/2 3/3\n"
+                    "usemtl away\nf 1 2 3\n";
+  fr_scene *s;
+  assert_int_equal(load("t.obj", obj, strlen(obj), &s), FR_OK);
+  const fr_material *mt = fr_scene_material(s, 0), *away = fr_scene_material(s, 1);
+  assert_string_equal(mt->name, "tex");
+  assert_non_null(strstr(mt->map_kd, "checker.png"));
+  assert_string_equal(away->map_kd, ""); /* outside the folder: not taken */
+  float stc[2];
+  assert_true(fr_scene_texcoord(s, 0, 0.25f, 0.5f, stc));
+  assert_true(fabsf(stc[0] - 0.25f) < 1e-6f && fabsf(stc[1] - 0.5f) < 1e-6f);
+  assert_false(fr_scene_texcoord(s, 1, 0.25f, 0.5f, stc));
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  fr_bsdf *mats;
+  size_t count, ntex;
+  fr_texture *tex;
+  assert_int_equal(fr_path_mats_build(s, NULL, NULL, &mats, &count, &tex, &ntex), FR_OK);
+  assert_int_equal(ntex, 1);
+  assert_int_equal(mats[0].color_tex, 0);
+  assert_int_equal(mats[1].color_tex, -1);
+  /* texel centres: (0.25, 0.75) is the top-left texel, red; (0.75, 0.25) the bottom-right, white */
+  vec3 c = fr_texture_lookup(&tex[0], 0.25f, 0.75f);
+  assert_true(fabsf(c.x - 1.0f) < 1e-5f && fabsf(c.y) < 1e-5f && fabsf(c.z) < 1e-5f);
+  c = fr_texture_lookup(&tex[0], 0.75f, 0.25f);
+  assert_true(fabsf(c.x - 1.0f) < 1e-5f && fabsf(c.y - 1.0f) < 1e-5f && fabsf(c.z - 1.0f) < 1e-5f);
+  c = fr_texture_lookup(&tex[0], 1.25f, -0.25f); /* repeats: as (0.25, 0.75) */
+  assert_true(fabsf(c.x - 1.0f) < 1e-5f && fabsf(c.y) < 1e-5f);
+  c = fr_texture_lookup(&tex[0], 0.5f, 0.75f); /* halfway between red and green */
+  assert_true(fabsf(c.x - 0.5f) < 1e-5f && fabsf(c.y - 0.5f) < 1e-5f);
+  free(mats);
+  fr_path_textures_free(tex, ntex);
+  fr_scene_release(s);
+  /* a texture that is not an image: the build says which */
+  write_file("checker.png", "not a png", 9);
+  assert_int_equal(load("t.obj", obj, strlen(obj), &s), FR_OK);
+  assert_int_not_equal(fr_path_mats_build(s, NULL, NULL, &mats, &count, &tex, &ntex), FR_OK);
+  assert_non_null(strstr(fr_last_error(), "checker.png"));
+  fr_scene_release(s);
+}
+
 int main(void) {
   snprintf(tmpdir, sizeof tmpdir, "/tmp/frusta_test_import_%d", (int)getpid());
   char cmd[300];
@@ -266,7 +320,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_ply_ascii_fan),  cmocka_unit_test(test_ply_binary),   cmocka_unit_test(test_ply_hostile),
       cmocka_unit_test(test_obj_mtl_and_zst), cmocka_unit_test(test_assimp_path), cmocka_unit_test(test_degenerate_only),
-      cmocka_unit_test(test_normals),
+      cmocka_unit_test(test_normals),     cmocka_unit_test(test_textures),
   };
   int rc = cmocka_run_group_tests(tests, NULL, NULL);
   snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);

@@ -16,6 +16,7 @@
 #include "embree_tracer.h"
 #include "light/environment.h"
 #include "render/path.h"
+#include "material/texture.h"
 #include "render/sampler.h"
 #include "render/surfaces.h"
 
@@ -179,7 +180,10 @@ static void same_image_everywhere(void **st) {
   assert_int_equal(fr_scene_commit(s), FR_OK);
   fr_bsdf *mats;
   size_t count;
-  assert_int_equal(fr_path_mats_build(s, NULL, NULL, &mats, &count), FR_OK);
+  fr_texture *tex;
+  size_t ntex;
+  assert_int_equal(fr_path_mats_build(s, NULL, NULL, &mats, &count, &tex, &ntex), FR_OK);
+  assert_int_equal(ntex, 0);
   fr_env env;
   fr_env_constant(&env, v3(0.6f, 0.7f, 1.0f));
   fr_view v;
@@ -232,6 +236,7 @@ static void same_image_everywhere(void **st) {
   assert_true(fabs(sa - sb) <= 2e-3 * sa);
   ebr_release(e);
   free(ref); free(img); free(mats); free(surf);
+  fr_path_textures_free(tex, ntex);
   fr_env_free(&env);
   fr_scene_release(s);
 }

@@ -106,18 +106,23 @@ static fr_error append_mesh(fr_mesh *m, const fr_mesh *add, vec3 scale, vec3 mov
     const float *p = add->pos + 3 * v;
     e = fr_mesh_add_vertex(m, p[0] * scale.x + move.x, p[1] * scale.y + move.y, p[2] * scale.z + move.z);
   }
-  const uint32_t nbase = (uint32_t)m->nnrm;
-  for (size_t i = 0; i < add->nnrm && !e; i++) { /* a normal scales by the inverse */
-    const float *n = add->nrm + 3 * i;
+  const uint32_t nbase = (uint32_t)m->nrm.n, tbase = (uint32_t)m->uv.n;
+  for (size_t i = 0; i < add->nrm.n && !e; i++) { /* a normal scales by the inverse */
+    const float *n = add->nrm.val + 3 * i;
     e = fr_mesh_add_normal(m, n[0] / scale.x, n[1] / scale.y, n[2] / scale.z);
   }
+  for (size_t i = 0; i < add->uv.n && !e; i++) e = fr_mesh_add_uv(m, add->uv.val[2 * i], add->uv.val[2 * i + 1]);
   for (size_t t = 0; t < add->ntris && !e; t++) {
     const uint32_t *ix = add->idx + 3 * t, am = add->mat ? add->mat[t] : FR_INVALID_ID;
     const uint32_t mat = only_id != FR_INVALID_ID ? only_id : am < add->nmats ? remap[am] : FR_INVALID_ID;
     e = fr_mesh_add_triangle(m, ix[0] + base, ix[1] + base, ix[2] + base, mat);
     if (!e && fr_mesh_has_normals(add, t)) {
-      const uint32_t *nx = add->nidx + 3 * t;
+      const uint32_t *nx = add->nrm.idx + 3 * t;
       e = fr_mesh_set_normals(m, m->ntris - 1, nx[0] + nbase, nx[1] + nbase, nx[2] + nbase);
+    }
+    if (!e && fr_mesh_has_uvs(add, t)) {
+      const uint32_t *tx = add->uv.idx + 3 * t;
+      e = fr_mesh_set_uvs(m, m->ntris - 1, tx[0] + tbase, tx[1] + tbase, tx[2] + tbase);
     }
   }
   free(remap);
@@ -169,16 +174,27 @@ fr_error fr_scene_smooth(fr_scene *s, float crease_deg) {
 
 int fr_scene_shading_normal(const fr_scene *s, uint32_t prim, float u, float v, float n[3]) {
   const fr_mesh *m = &s->mesh;
-  if (!m->nidx || prim >= m->ntris) return 0;
-  const uint32_t *ix = m->nidx + 3 * (size_t)prim;
-  if (ix[0] >= m->nnrm || ix[1] >= m->nnrm || ix[2] >= m->nnrm) return 0; /* FR_INVALID_ID: none */
-  const float *a = m->nrm + 3 * (size_t)ix[0], *b = m->nrm + 3 * (size_t)ix[1], *c = m->nrm + 3 * (size_t)ix[2];
+  if (!m->nrm.idx || prim >= m->ntris) return 0;
+  const uint32_t *ix = m->nrm.idx + 3 * (size_t)prim;
+  if (ix[0] >= m->nrm.n || ix[1] >= m->nrm.n || ix[2] >= m->nrm.n) return 0; /* FR_INVALID_ID: none */
+  const float *a = m->nrm.val + 3 * (size_t)ix[0], *b = m->nrm.val + 3 * (size_t)ix[1], *c = m->nrm.val + 3 * (size_t)ix[2];
   const float w = 1.0f - u - v;
   const float x = w * a[0] + u * b[0] + v * c[0], y = w * a[1] + u * b[1] + v * c[1], z = w * a[2] + u * b[2] + v * c[2];
   const float l2 = x * x + y * y + z * z;
   if (!(l2 > 1e-12f)) return 0; /* zero corners (none given) or opposite ones */
   const float r = 1.0f / sqrtf(l2);
   n[0] = x * r, n[1] = y * r, n[2] = z * r;
+  return 1;
+}
+
+int fr_scene_texcoord(const fr_scene *s, uint32_t prim, float u, float v, float st[2]) {
+  const fr_mesh *m = &s->mesh;
+  if (prim >= m->ntris || !fr_mesh_has_uvs(m, prim)) return 0;
+  const uint32_t *ix = m->uv.idx + 3 * (size_t)prim;
+  const float *a = m->uv.val + 2 * (size_t)ix[0], *b = m->uv.val + 2 * (size_t)ix[1], *c = m->uv.val + 2 * (size_t)ix[2];
+  const float w = 1.0f - u - v;
+  st[0] = w * a[0] + u * b[0] + v * c[0];
+  st[1] = w * a[1] + u * b[1] + v * c[1];
   return 1;
 }
 

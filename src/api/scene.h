@@ -66,6 +66,9 @@ fr_error fr_scene_load_json(const char *path, const char *root, struct fr_scene_
 /* The unit shading normal of triangle prim at barycentrics (u, v): its
  * corner normals interpolated; 0 where it has none (flat). */
 int fr_scene_shading_normal(const fr_scene *s, uint32_t prim, float u, float v, float n[3]);
+/* The texture coordinates of triangle prim at barycentrics (u, v); 0
+ * where it has none. */
+int fr_scene_texcoord(const fr_scene *s, uint32_t prim, float u, float v, float st[2]);
 /* The first sphere's prim number (the triangle count). */
 static inline uint32_t fr_scene_sphere_base(const fr_scene *s) { return (uint32_t)s->mesh.ntris; }
 #endif

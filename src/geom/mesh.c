@@ -13,8 +13,10 @@ void fr_mesh_free(fr_mesh *m) {
   free(m->idx);
   free(m->mat);
   free(m->mats);
-  free(m->nrm);
-  free(m->nidx);
+  free(m->nrm.val);
+  free(m->nrm.idx);
+  free(m->uv.val);
+  free(m->uv.idx);
   fr_mesh_init(m);
 }
 
@@ -53,48 +55,72 @@ fr_error fr_mesh_add_triangle(fr_mesh *m, uint32_t a, uint32_t b, uint32_t c, ui
     for (size_t i = 0; i < m->ntris; i++) m->mat[i] = FR_INVALID_ID;
   }
   if (m->mat) m->mat[m->ntris] = mat;
-  if (m->nidx && m->cap_tris != old_cap) { /* normal indices: like the materials */
-    uint32_t *q = realloc(m->nidx, fr_mul_size(m->cap_tris, 3 * sizeof(uint32_t)));
-    if (!q) return fr_fail(FR_ERR_NOMEM, "out of memory at triangle %zu", m->ntris);
-    m->nidx = q;
+  fr_corner_attr *attrs[2] = {&m->nrm, &m->uv};
+  for (int k = 0; k < 2; k++) { /* corner indices: like the materials */
+    fr_corner_attr *a = attrs[k];
+    if (a->idx && m->cap_tris != old_cap) {
+      uint32_t *q = realloc(a->idx, fr_mul_size(m->cap_tris, 3 * sizeof(uint32_t)));
+      if (!q) return fr_fail(FR_ERR_NOMEM, "out of memory at triangle %zu", m->ntris);
+      a->idx = q;
+    }
+    if (a->idx) a->idx[3 * m->ntris] = a->idx[3 * m->ntris + 1] = a->idx[3 * m->ntris + 2] = FR_INVALID_ID;
   }
-  if (m->nidx) m->nidx[3 * m->ntris] = m->nidx[3 * m->ntris + 1] = m->nidx[3 * m->ntris + 2] = FR_INVALID_ID;
   uint32_t *t = m->idx + 3 * m->ntris++;
   t[0] = a; t[1] = b; t[2] = c;
   return FR_OK;
 }
 
-fr_error fr_mesh_add_normal(fr_mesh *m, float x, float y, float z) {
-  if (m->nnrm >= 0xFFFFFFF0u) return fr_fail(FR_ERR_UNSUPPORTED, "too many normals");
-  if (!grow((void **)&m->nrm, &m->cap_nrm, m->nnrm, 3 * sizeof(float)))
-    return fr_fail(FR_ERR_NOMEM, "out of memory at normal %zu", m->nnrm);
-  const double l = sqrt((double)x * x + (double)y * y + (double)z * z);
-  float *n = m->nrm + 3 * m->nnrm++;
-  if (!(l > 0.0 && l < INFINITY)) { n[0] = n[1] = n[2] = 0.0f; return FR_OK; }
-  n[0] = (float)(x / l); n[1] = (float)(y / l); n[2] = (float)(z / l);
+static fr_error attr_add(fr_corner_attr *a, const float *v, int dim, const char *what) {
+  if (a->n >= 0xFFFFFFF0u) return fr_fail(FR_ERR_UNSUPPORTED, "too many %s", what);
+  if (!grow((void **)&a->val, &a->cap, a->n, (size_t)dim * sizeof(float)))
+    return fr_fail(FR_ERR_NOMEM, "out of memory at %s %zu", what, a->n);
+  memcpy(a->val + (size_t)dim * a->n++, v, (size_t)dim * sizeof(float));
   return FR_OK;
 }
 
-fr_error fr_mesh_set_normals(fr_mesh *m, size_t t, uint32_t a, uint32_t b, uint32_t c) {
-  if (!m->nidx) {
-    m->nidx = malloc(fr_mul_size(m->cap_tris ? m->cap_tris : 1, 3 * sizeof(uint32_t)));
-    if (!m->nidx) return fr_fail(FR_ERR_NOMEM, "out of memory for normal indices");
-    for (size_t i = 0; i < 3 * m->ntris; i++) m->nidx[i] = FR_INVALID_ID;
+static fr_error attr_set(const fr_mesh *m, fr_corner_attr *a, size_t t, uint32_t i, uint32_t j, uint32_t k) {
+  if (!a->idx) {
+    a->idx = malloc(fr_mul_size(m->cap_tris ? m->cap_tris : 1, 3 * sizeof(uint32_t)));
+    if (!a->idx) return fr_fail(FR_ERR_NOMEM, "out of memory for corner indices");
+    for (size_t q = 0; q < 3 * m->ntris; q++) a->idx[q] = FR_INVALID_ID;
   }
-  m->nidx[3 * t] = a; m->nidx[3 * t + 1] = b; m->nidx[3 * t + 2] = c;
+  a->idx[3 * t] = i; a->idx[3 * t + 1] = j; a->idx[3 * t + 2] = k;
   return FR_OK;
 }
+
+static int attr_has(const fr_corner_attr *a, size_t t) {
+  if (!a->idx) return 0;
+  for (int k = 0; k < 3; k++)
+    if (a->idx[3 * t + k] >= a->n) return 0;
+  return 1;
+}
+
+fr_error fr_mesh_add_normal(fr_mesh *m, float x, float y, float z) {
+  const double l = sqrt((double)x * x + (double)y * y + (double)z * z);
+  float n[3] = {0.0f, 0.0f, 0.0f};
+  if (l > 0.0 && l < INFINITY) n[0] = (float)(x / l), n[1] = (float)(y / l), n[2] = (float)(z / l);
+  return attr_add(&m->nrm, n, 3, "normals");
+}
+
+fr_error fr_mesh_set_normals(fr_mesh *m, size_t t, uint32_t a, uint32_t b, uint32_t c) { return attr_set(m, &m->nrm, t, a, b, c); }
 
 int fr_mesh_has_normals(const fr_mesh *m, size_t t) {
-  if (!m->nidx) return 0;
+  if (!attr_has(&m->nrm, t)) return 0;
   for (int k = 0; k < 3; k++) {
-    const uint32_t i = m->nidx[3 * t + k];
-    if (i >= m->nnrm) return 0;
-    const float *n = m->nrm + 3 * (size_t)i;
+    const float *n = m->nrm.val + 3 * (size_t)m->nrm.idx[3 * t + k];
     if (n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f) return 0;
   }
   return 1;
 }
+
+fr_error fr_mesh_add_uv(fr_mesh *m, float u, float v) {
+  const float uv[2] = {isfinite(u) ? u : 0.0f, isfinite(v) ? v : 0.0f};
+  return attr_add(&m->uv, uv, 2, "texture coordinates");
+}
+
+fr_error fr_mesh_set_uvs(fr_mesh *m, size_t t, uint32_t a, uint32_t b, uint32_t c) { return attr_set(m, &m->uv, t, a, b, c); }
+
+int fr_mesh_has_uvs(const fr_mesh *m, size_t t) { return attr_has(&m->uv, t); }
 
 /* Unit face normal of triangle t (in double, kept as float), and its angle at each corner. */
 static void face_normal(const fr_mesh *m, size_t t, float nf[6]) {
@@ -142,7 +168,7 @@ fr_error fr_mesh_smooth_normals(fr_mesh *m, float crease_deg) {
   /* vertex by vertex, so that the normals one vertex makes lie together and
    * equal ones (a smooth vertex's corners) are stored once */
   for (size_t v = 0; v < nv && !e; v++) {
-    const size_t first = m->nnrm;
+    const size_t first = m->nrm.n;
     for (size_t i = start[v]; i < start[v + 1] && !e; i++) {
       const size_t t = faces[i];
       if (fr_mesh_has_normals(m, t) || (i > start[v] && faces[i - 1] == t)) continue;
@@ -162,18 +188,14 @@ fr_error fr_mesh_smooth_normals(fr_mesh *m, float crease_deg) {
       const double l = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
       const float n[3] = {l > 0.0 ? (float)(s[0] / l) : 0.0f, l > 0.0 ? (float)(s[1] / l) : 0.0f, l > 0.0 ? (float)(s[2] / l) : 0.0f};
       uint32_t id = FR_INVALID_ID;
-      for (size_t q = first; q < m->nnrm && id == FR_INVALID_ID; q++)
-        if (!memcmp(m->nrm + 3 * q, n, sizeof n)) id = (uint32_t)q;
+      for (size_t q = first; q < m->nrm.n && id == FR_INVALID_ID; q++)
+        if (!memcmp(m->nrm.val + 3 * q, n, sizeof n)) id = (uint32_t)q;
       if (id == FR_INVALID_ID) {
-        id = (uint32_t)m->nnrm;
-        if (m->nnrm >= 0xFFFFFFF0u || !grow((void **)&m->nrm, &m->cap_nrm, m->nnrm, 3 * sizeof(float))) {
-          e = fr_fail(FR_ERR_NOMEM, "out of memory for smooth normals");
-          break;
-        }
-        memcpy(m->nrm + 3 * m->nnrm++, n, sizeof n);
+        id = (uint32_t)m->nrm.n;
+        e = attr_add(&m->nrm, n, 3, "normals");
       }
-      if (!e && !m->nidx) e = fr_mesh_set_normals(m, t, FR_INVALID_ID, FR_INVALID_ID, FR_INVALID_ID);
-      if (!e) m->nidx[3 * t + k] = id;
+      if (!e && !m->nrm.idx) e = fr_mesh_set_normals(m, t, FR_INVALID_ID, FR_INVALID_ID, FR_INVALID_ID);
+      if (!e) m->nrm.idx[3 * t + k] = id;
     }
   }
 done:

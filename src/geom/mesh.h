@@ -5,6 +5,14 @@
 #include <stdint.h>
 #include "frusta.h"
 
+/* Values attached to triangle corners by index, as OBJ attaches them:
+ * shading normals, texture coordinates. */
+typedef struct fr_corner_attr {
+  float *val;      /* dim floats per value */
+  size_t n, cap;
+  uint32_t *idx;   /* 3 indices per triangle (FR_INVALID_ID: none), or NULL while no triangle has any */
+} fr_corner_attr;
+
 typedef struct fr_mesh {
   float *pos;        /* 3 floats per vertex */
   size_t nverts, cap_verts;
@@ -13,9 +21,8 @@ typedef struct fr_mesh {
   size_t ntris, cap_tris;
   fr_material *mats;
   size_t nmats, cap_mats;
-  float *nrm;        /* shading normals, 3 floats each (unit) */
-  size_t nnrm, cap_nrm;
-  uint32_t *nidx;    /* 3 normal indices per triangle (FR_INVALID_ID: none), or NULL when none has */
+  fr_corner_attr nrm; /* shading normals (unit; 0, 0, 0: none) */
+  fr_corner_attr uv;  /* texture coordinates */
 } fr_mesh;
 
 void fr_mesh_init(fr_mesh *m);
@@ -27,6 +34,11 @@ fr_error fr_mesh_add_triangle(fr_mesh *m, uint32_t a, uint32_t b, uint32_t c, ui
 fr_error fr_mesh_add_normal(fr_mesh *m, float x, float y, float z);
 /* Triangle t's corner normals, indices into nrm. */
 fr_error fr_mesh_set_normals(fr_mesh *m, size_t t, uint32_t a, uint32_t b, uint32_t c);
+/* A texture coordinate, and triangle t's corners' (indices into uv). */
+fr_error fr_mesh_add_uv(fr_mesh *m, float u, float v);
+fr_error fr_mesh_set_uvs(fr_mesh *m, size_t t, uint32_t a, uint32_t b, uint32_t c);
+/* Whether triangle t has texture coordinates at all three corners. */
+int fr_mesh_has_uvs(const fr_mesh *m, size_t t);
 /* Gives the triangles without normals angle-weighted vertex normals: a
  * corner averages the normals of the faces around its vertex that lie
  * within crease_deg of its own face's, each weighted by its angle there

@@ -1,5 +1,6 @@
 #include "image_read.h"
 #include <OpenEXR/ImfCRgbaFile.h>
+#include <stb_image.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -154,4 +155,39 @@ fr_error fr_image_read(const char *path, int *width, int *height, float **rgb) {
   fclose(f);
   if (bytes < 0) return fr_fail(FR_ERR_IO, "%s: cannot read", path);
   return read_exr(path, (size_t)bytes, width, height, rgb);
+}
+
+static float srgb_to_linear(unsigned char c) {
+  const float v = (float)c / 255.0f;
+  return v <= 0.04045f ? v / 12.92f : powf((v + 0.055f) / 1.055f, 2.4f);
+}
+
+fr_error fr_image_decode_ldr(const char *what, const unsigned char *data, size_t size, int *width, int *height, float **out) {
+  if (size > (size_t)INT32_MAX) return fr_fail(FR_ERR_UNSUPPORTED, "%s: too large", what);
+  int w, h, comp;
+  if (!stbi_info_from_memory(data, (int)size, &w, &h, &comp))
+    return fr_fail(FR_ERR_FORMAT, "%s: not a readable image (%s)", what, stbi_failure_reason());
+  fr_error err = check_size(what, w, h, size);
+  if (err) return err;
+  unsigned char *px = stbi_load_from_memory(data, (int)size, &w, &h, &comp, 3);
+  if (!px) return fr_fail(FR_ERR_FORMAT, "%s: cannot decode the image (%s)", what, stbi_failure_reason());
+  const size_t n = (size_t)w * (size_t)h * 3;
+  float *rgb = malloc(n * sizeof(float));
+  if (!rgb) { stbi_image_free(px); return fr_fail(FR_ERR_NOMEM, "%s: out of memory", what); }
+  float lut[256];
+  for (int i = 0; i < 256; i++) lut[i] = srgb_to_linear((unsigned char)i);
+  for (size_t i = 0; i < n; i++) rgb[i] = lut[px[i]];
+  stbi_image_free(px);
+  *width = w, *height = h, *out = rgb;
+  return FR_OK;
+}
+
+fr_error fr_image_read_ldr(const char *path, int *width, int *height, float **rgb) {
+  char *data;
+  size_t size;
+  fr_error err = fr_read_file_max(path, (size_t)256 << 20, &data, &size);
+  if (err) return err;
+  err = fr_image_decode_ldr(path, (const unsigned char *)data, size, width, height, rgb);
+  free(data);
+  return err;
 }

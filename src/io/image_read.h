@@ -15,6 +15,12 @@
  * refused images whose claimed
  * size exceeds the limits above or what the file's bytes could hold. */
 fr_error fr_image_read(const char *path, int *width, int *height, float **rgb);
+/* An 8-bit image (PNG, JPEG, TGA, BMP; through Debian's stb_image) as
+ * linear RGB floats, its sRGB values decoded; its size is checked against
+ * the same limits before it is decoded. */
+fr_error fr_image_read_ldr(const char *path, int *width, int *height, float **rgb);
+/* The same from memory. */
+fr_error fr_image_decode_ldr(const char *what, const unsigned char *data, size_t size, int *width, int *height, float **rgb);
 /* A Radiance RGBE file held in memory (flat or run-length encoded scanlines). */
 fr_error fr_hdr_decode(const char *what, const unsigned char *data, size_t size, int *width, int *height, float **rgb);
 #endif

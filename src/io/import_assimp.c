@@ -29,6 +29,7 @@
 #include "io/assimp_files.h"
 #include "io/file_read.h"
 #include "io/import.h"
+#include "io/scene_path.h"
 
 /* The child's allowance: this much time, and memory beyond what the process
  * already maps of this many bytes plus a multiple of the file's size. */
@@ -60,6 +61,12 @@ static fr_error add_mesh(const struct aiMesh *am, const struct aiMatrix4x4 *t, u
     struct aiVector3D p = am->mVertices[v];
     if (t) aiTransformVecByMatrix4(&p, t);
     e = fr_mesh_add_vertex(m, p.x, p.y, p.z);
+  }
+  /* texture coordinates per vertex (the first set), aligned with the
+   * vertices (0, 0 where a mesh has none) */
+  for (unsigned v = 0; v < am->mNumVertices && !e; v++) {
+    const struct aiVector3D st = am->mTextureCoords[0] ? am->mTextureCoords[0][v] : (struct aiVector3D){0, 0, 0};
+    e = fr_mesh_add_uv(m, st.x, st.y);
   }
   /* normals per vertex, aligned with the vertices (0, 0, 0 where a mesh has
    * none), turned by the transform's linear part: exact for rotations and
@@ -111,7 +118,7 @@ static fr_error add_node(const struct aiScene *sc, const struct aiNode *node, co
   return e;
 }
 
-static fr_error convert(const struct aiScene *sc, fr_mesh *m) {
+static fr_error convert(const struct aiScene *sc, const char *path, fr_mesh *m) {
   uint32_t *matmap = calloc(sc->mNumMaterials + 1, sizeof(uint32_t));
   if (!matmap) return fr_fail(FR_ERR_NOMEM, "out of memory");
   for (unsigned i = 0; i < sc->mNumMaterials; i++) {
@@ -133,6 +140,11 @@ static fr_error convert(const struct aiScene *sc, fr_mesh *m) {
     if (aiGetMaterialFloatArray(am, AI_MATKEY_SHININESS, &f, &one) == aiReturn_SUCCESS) fm->shininess = f;
     one = 1;
     if (aiGetMaterialFloatArray(am, AI_MATKEY_REFRACTI, &f, &one) == aiReturn_SUCCESS) fm->ior = f;
+    /* the diffuse texture, a file beside the model (embedded ones, "*N", are not read) */
+    struct aiString tex;
+    if (aiGetMaterialTexture(am, aiTextureType_DIFFUSE, 0, &tex, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS &&
+        tex.data[0] != '*' && !fr_scene_ref_path(path, tex.data, fm->map_kd, sizeof fm->map_kd))
+      fm->map_kd[0] = 0;
   }
   fr_error e = sc->mRootNode ? add_node(sc, sc->mRootNode, NULL, matmap, m, 0) : FR_OK;
   free(matmap);
@@ -201,13 +213,14 @@ static void send_mesh(int fd, fr_error e, const fr_mesh *m) {
   }
   const uint64_t counts[3] = {m->nverts, m->ntris, m->nmats};
   /* flags: 1 per-triangle materials follow the indices, 2 per-vertex
-   * normals follow the materials */
-  const uint8_t has_mat = m->mat != NULL, has_nrm = m->nverts && m->nnrm == m->nverts;
-  const uint8_t flags = (uint8_t)(has_mat | has_nrm << 1);
+   * normals follow the materials, 4 per-vertex texture coordinates follow */
+  const uint8_t has_mat = m->mat != NULL, has_nrm = m->nverts && m->nrm.n == m->nverts, has_uv = m->nverts && m->uv.n == m->nverts;
+  const uint8_t flags = (uint8_t)(has_mat | has_nrm << 1 | has_uv << 2);
   if (put(fd, counts, sizeof counts) && put(fd, &flags, 1) && put(fd, m->pos, m->nverts * 3 * sizeof(float)) &&
       put(fd, m->idx, m->ntris * 3 * sizeof(uint32_t)) && (!has_mat || put(fd, m->mat, m->ntris * sizeof(uint32_t))) &&
-      put(fd, m->mats, m->nmats * sizeof(fr_material)) && has_nrm)
-    put(fd, m->nrm, m->nnrm * 3 * sizeof(float));
+      put(fd, m->mats, m->nmats * sizeof(fr_material)) && (!has_nrm || put(fd, m->nrm.val, m->nrm.n * 3 * sizeof(float))) &&
+      has_uv)
+    put(fd, m->uv.val, m->uv.n * 2 * sizeof(float));
 }
 
 static void limit_child(size_t file_bytes) {
@@ -238,7 +251,7 @@ static _Noreturn void run_child(int fd, const char *path) {
   fr_mesh_init(&m);
   fr_error e;
   const struct aiScene *sc = import_scene(path, &e);
-  if (sc) e = convert(sc, &m);
+  if (sc) e = convert(sc, path, &m);
   else if (!e) e = fr_fail(FR_ERR_FORMAT, "%s: %s", path, aiGetErrorString());
   send_mesh(fd, e, &m);
   _exit(0);
@@ -246,6 +259,19 @@ static _Noreturn void run_child(int fd, const char *path) {
 
 /* The mesh from the pipe, read as it comes, so that memory follows what the
  * child really sent. *broke: the pipe ended early (the child died). */
+/* A texture the child names must be a file in the model's folder: the
+ * child reads untrusted bytes, so its word is checked again here. */
+static void confine_texture(const char *model, char *tex, size_t cap) {
+  if (!tex[0]) return;
+  const char *slash = strrchr(model, '/');
+  const size_t dir = slash ? (size_t)(slash - model) + 1 : 0;
+  char rel[512], out[512];
+  if (strncmp(tex, model, dir) != 0 || strlen(tex + dir) >= sizeof rel) { tex[0] = 0; return; }
+  snprintf(rel, sizeof rel, "%s", tex + dir);
+  if (!fr_scene_ref_path(model, rel, out, sizeof out)) { tex[0] = 0; return; }
+  snprintf(tex, cap, "%s", out);
+}
+
 static fr_error receive_mesh(int fd, const char *path, fr_mesh *m, int *broke) {
 #define BROKE (*broke = 1, FR_ERR_IO)
   int32_t status;
@@ -259,7 +285,7 @@ static fr_error receive_mesh(int fd, const char *path, fr_mesh *m, int *broke) {
   uint64_t counts[3];
   uint8_t flags;
   if (!get(fd, counts, sizeof counts) || !get(fd, &flags, 1)) return BROKE;
-  const int has_mat = flags & 1, has_nrm = (flags >> 1) & 1;
+  const int has_mat = flags & 1, has_nrm = (flags >> 1) & 1, has_uv = (flags >> 2) & 1;
   if (counts[0] > 0xFFFFFFF0u || counts[1] > 0xFFFFFFF0u || counts[2] > 0xFFFFFFu)
     return fr_fail(FR_ERR_FORMAT, "%s: too large", path);
   for (uint64_t i = 0; i < counts[0]; i++) {
@@ -278,20 +304,27 @@ static fr_error receive_mesh(int fd, const char *path, fr_mesh *m, int *broke) {
     uint32_t k;
     if (!get(fd, &fm, sizeof fm)) { e = BROKE; break; }
     fm.name[sizeof fm.name - 1] = 0;
+    fm.map_kd[sizeof fm.map_kd - 1] = 0;
+    confine_texture(path, fm.map_kd, sizeof fm.map_kd);
     if (!(e = fr_mesh_material(m, fm.name, &k))) m->mats[k] = fm;
   }
   for (uint64_t i = 0; i < counts[0] && has_nrm && !e; i++) {
     float n[3];
     e = get(fd, n, sizeof n) ? fr_mesh_add_normal(m, n[0], n[1], n[2]) : BROKE;
   }
+  for (uint64_t i = 0; i < counts[0] && has_uv && !e; i++) {
+    float st[2];
+    e = get(fd, st, sizeof st) ? fr_mesh_add_uv(m, st[0], st[1]) : BROKE;
+  }
   for (uint64_t t = 0; t < counts[1] && !e; t++) {
     const uint32_t *ix = idx + 3 * t;
     e = fr_mesh_add_triangle(m, ix[0], ix[1], ix[2], mat ? mat[t] : FR_INVALID_ID);
-    if (!e && has_nrm && ix[0] < m->nnrm && ix[1] < m->nnrm && ix[2] < m->nnrm) {
+    if (!e && has_nrm && ix[0] < m->nrm.n && ix[1] < m->nrm.n && ix[2] < m->nrm.n) {
       e = fr_mesh_set_normals(m, m->ntris - 1, ix[0], ix[1], ix[2]);
       if (!e && !fr_mesh_has_normals(m, m->ntris - 1)) /* a mesh without normals among ones with */
         e = fr_mesh_set_normals(m, m->ntris - 1, FR_INVALID_ID, FR_INVALID_ID, FR_INVALID_ID);
     }
+    if (!e && has_uv && ix[0] < m->uv.n && ix[1] < m->uv.n && ix[2] < m->uv.n) e = fr_mesh_set_uvs(m, m->ntris - 1, ix[0], ix[1], ix[2]);
   }
   free(idx);
   free(mat);

@@ -107,7 +107,7 @@ fr_error fr_import_obj(const char *path, const char *data, size_t size, fr_mesh 
   const char *s;
   size_t len;
   uint32_t mat = FR_INVALID_ID;
-  long long poly[MAX_POLY], pnrm[MAX_POLY];
+  long long poly[MAX_POLY], pnrm[MAX_POLY], ptex[MAX_POLY];
   while (next_line(&l, &s, &len)) {
     if (len > MAX_LINE) return fr_fail(FR_ERR_FORMAT, "%s:%zu: line too long", path, l.lineno);
     const char *e = s + len;
@@ -118,13 +118,18 @@ fr_error fr_import_obj(const char *path, const char *data, size_t size, fr_mesh 
       if (parse_floats(s + 1, e, xyz, 3) != 3) return fr_fail(FR_ERR_FORMAT, "%s:%zu: vertex needs three numbers", path, l.lineno);
       fr_error err = fr_mesh_add_vertex(m, xyz[0], xyz[1], xyz[2]);
       if (err) return err;
+    } else if (keyword(s, len, "vt")) {
+      float st[3] = {0, 0, 0};
+      if (parse_floats(s + 2, e, st, 3) < 2) return fr_fail(FR_ERR_FORMAT, "%s:%zu: texture coordinate needs two numbers", path, l.lineno);
+      fr_error err = fr_mesh_add_uv(m, st[0], st[1]);
+      if (err) return err;
     } else if (keyword(s, len, "vn")) {
       float xyz[3];
       if (parse_floats(s + 2, e, xyz, 3) != 3) return fr_fail(FR_ERR_FORMAT, "%s:%zu: normal needs three numbers", path, l.lineno);
       fr_error err = fr_mesh_add_normal(m, xyz[0], xyz[1], xyz[2]);
       if (err) return err;
     } else if (keyword(s, len, "f")) {
-      int n = 0, normals = 1;
+      int n = 0, normals = 1, texcoords = 1;
       const char *p = s + 1;
       for (;;) {
         p = skip_ws(p, e);
@@ -134,17 +139,21 @@ fr_error fr_import_obj(const char *path, const char *data, size_t size, fr_mesh 
         if (!parse_index(&p, e, (long long)m->nverts, &v))
           return fr_fail(FR_ERR_FORMAT, "%s:%zu: bad face index (%zu vertices so far)", path, l.lineno, m->nverts);
         poly[n] = v;
-        /* v/vt/vn or v//vn: the normal's index; a bad one only loses the normals */
-        long long vn = -1;
+        /* v/vt, v/vt/vn or v//vn: the texture coordinate's and the normal's
+         * indices; a bad one only loses them */
+        long long vt = -1, vn = -1;
         if (p < e && *p == '/') {
           p++;
-          while (p < e && *p != '/' && *p != ' ' && *p != '\t' && *p != '\r') p++; /* vt */
+          if (p < e && *p != '/' && !parse_index(&p, e, (long long)m->uv.n, &vt)) vt = -1;
+          while (p < e && *p != '/' && *p != ' ' && *p != '\t' && *p != '\r') p++;
           if (p < e && *p == '/') {
             p++;
-            if (!parse_index(&p, e, (long long)m->nnrm, &vn)) vn = -1;
+            if (!parse_index(&p, e, (long long)m->nrm.n, &vn)) vn = -1;
           }
         }
         while (p < e && *p != ' ' && *p != '\t' && *p != '\r') p++;
+        ptex[n] = vt;
+        texcoords &= vt >= 0;
         pnrm[n++] = vn;
         normals &= vn >= 0;
       }
@@ -152,6 +161,8 @@ fr_error fr_import_obj(const char *path, const char *data, size_t size, fr_mesh 
         fr_error err = fr_mesh_add_triangle(m, (uint32_t)poly[0], (uint32_t)poly[j - 1], (uint32_t)poly[j], mat);
         if (!err && normals)
           err = fr_mesh_set_normals(m, m->ntris - 1, (uint32_t)pnrm[0], (uint32_t)pnrm[j - 1], (uint32_t)pnrm[j]);
+        if (!err && texcoords)
+          err = fr_mesh_set_uvs(m, m->ntris - 1, (uint32_t)ptex[0], (uint32_t)ptex[j - 1], (uint32_t)ptex[j]);
         if (err) return err;
       }
     } else if (keyword(s, len, "usemtl")) {
@@ -164,7 +175,7 @@ fr_error fr_import_obj(const char *path, const char *data, size_t size, fr_mesh 
       parse_name(s + 6, e, name, sizeof name);
       if (name[0]) load_mtllib(path, name, m);
     }
-    /* vt, g, o, s, l and comments: not needed */
+    /* g, o, s, l and comments: not needed */
   }
   return FR_OK;
 }
@@ -174,7 +185,6 @@ fr_error fr_import_mtl(const char *path, const char *data, size_t size, fr_mesh 
   const char *s;
   size_t len;
   fr_material *cur = NULL;
-  (void)path;
   while (next_line(&l, &s, &len)) {
     const char *e = s + len;
     s = skip_ws(s, e);
@@ -198,7 +208,19 @@ fr_error fr_import_mtl(const char *path, const char *data, size_t size, fr_mesh 
       for (int i = 0; i < 3; i++) cur->transmission[i] = f[n == 3 ? i : 0];
     } else if (keyword(s, len, "Ns") && parse_floats(s + 2, e, f, 1) == 1) cur->shininess = f[0];
     else if (keyword(s, len, "Ni") && parse_floats(s + 2, e, f, 1) == 1) cur->ior = f[0];
-    else if (keyword(s, len, "illum") && parse_floats(s + 5, e, f, 1) == 1 && f[0] >= 0.0f && f[0] < 100.0f)
+    else if (keyword(s, len, "map_Kd")) {
+      /* options (-s, -o, -bm ...) come first: the file is the last word */
+      const char *w = e;
+      while (w > s + 6 && (w[-1] == ' ' || w[-1] == '\t' || w[-1] == '\r')) w--;
+      const char *b = w;
+      while (b > s + 6 && b[-1] != ' ' && b[-1] != '\t') b--;
+      char ref[512];
+      if (w > b && (size_t)(w - b) < sizeof ref) {
+        memcpy(ref, b, (size_t)(w - b));
+        ref[w - b] = 0;
+        if (!fr_scene_ref_path(path, ref, cur->map_kd, sizeof cur->map_kd)) cur->map_kd[0] = 0; /* missing or outside */
+      }
+    } else if (keyword(s, len, "illum") && parse_floats(s + 5, e, f, 1) == 1 && f[0] >= 0.0f && f[0] < 100.0f)
       cur->illum = (int)f[0];
     else if (keyword(s, len, "d") && parse_floats(s + 1, e, f, 1) == 1) {
       if (cur->transmission[0] == 0 && cur->transmission[1] == 0 && cur->transmission[2] == 0)

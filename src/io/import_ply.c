@@ -198,7 +198,7 @@ static fr_error read_faces(cursor *c, const elem *e, fr_mesh *m) {
     for (int j = 2; j < npoly; j++) { /* fan: v0 v1 v2, v0 v2 v3, ... */
       fr_error err = fr_mesh_add_triangle(m, poly[0], poly[j - 1], poly[j], FR_INVALID_ID);
       /* per-vertex normals share the vertices' numbers */
-      if (!err && m->nnrm == m->nverts && m->nnrm && poly[0] < m->nnrm && poly[j - 1] < m->nnrm && poly[j] < m->nnrm)
+      if (!err && m->nrm.n == m->nverts && m->nrm.n && poly[0] < m->nrm.n && poly[j - 1] < m->nrm.n && poly[j] < m->nrm.n)
         err = fr_mesh_set_normals(m, m->ntris - 1, poly[0], poly[j - 1], poly[j]);
       if (err) return err;
     }

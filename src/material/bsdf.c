@@ -35,6 +35,7 @@ fr_bsdf fr_bsdf_default(fr_bsdf_kind kind) {
   memset(&m, 0, sizeof m);
   m.kind = kind;
   m.color = v3(0.8f, 0.8f, 0.8f);
+  m.color_tex = -1;
   m.ior = 1.5f;
   fr_bsdf_metal_preset("chrome", &m);
   m.attenuation_color = v3(1, 1, 1);

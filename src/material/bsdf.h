@@ -28,6 +28,7 @@ typedef enum fr_bsdf_kind {
 typedef struct fr_bsdf {
   fr_bsdf_kind kind;
   vec3 color;          /* Lambert, plastic: diffuse reflectance; car paint: the base colour */
+  int color_tex;       /* the texture that gives color instead (path setup's textures), or -1 */
   vec3 emission;       /* radiance the surface emits (MTL Ke) */
   float ior;           /* glass; the coat of plastic and car paint */
   /* metal */

@@ -13,6 +13,7 @@
 #include "base/alloc.h"
 #include "base/error.h"
 #include "base/timer.h"
+#include "material/texture.h"
 #include "render/surfaces.h"
 #include "render/tile.h"
 
@@ -214,6 +215,13 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         }
         const vec3 ng = v3_norm(v3_load(sf.ng));
         const fr_bsdf *m = &P->mats[sf.mat];
+        fr_bsdf textured;
+        float st2[2];
+        if (m->color_tex >= 0 && fr_scene_texcoord(w->scene, h.prim, h.u, h.v, st2)) {
+          textured = *m;
+          textured.color = fr_texture_lookup(&P->textures[m->color_tex], st2[0], st2[1]);
+          m = &textured;
+        }
         const int front = v3_dot(ng, d) < 0.0f;
         if (m->kind == FR_BSDF_GLASS && !front) { /* the segment ran inside: Beer's law */
           const float k = h.t / m->attenuation_distance;

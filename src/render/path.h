@@ -37,6 +37,7 @@ typedef struct fr_path_setup {
   size_t count;                 /* including that last one */
   const struct fr_surface *surf; /* per triangle: normal and material (render/surfaces.h) */
   size_t nsurf;
+  const struct fr_texture *textures; /* the materials' color_tex index these */
   fr_path_lights lights;
   int max_depth;                /* segments per path, 1..FR_PATH_MAX_DEPTH (13 by default) */
   fr_sampler_kind sampler;
@@ -48,8 +49,13 @@ typedef struct fr_path_setup {
 
 /* The materials of a scene for path tracing: MTL rules (material/material_mtl.h),
  * with the named materials made mirrors (chrome) and glass (NULL: the
- * scene's suggestions, views.h). out->mats is malloc'd. */
-fr_error fr_path_mats_build(const fr_scene *s, const char *mirror, const char *glass, fr_bsdf **mats, size_t *count);
+ * scene's suggestions, views.h), and their diffuse textures (map_Kd)
+ * loaded, each file once. *mats and *textures are malloc'd (free the
+ * textures with fr_path_textures_free); a texture that does not load is
+ * an error naming it. */
+fr_error fr_path_mats_build(const fr_scene *s, const char *mirror, const char *glass, fr_bsdf **mats, size_t *count,
+                            struct fr_texture **textures, size_t *ntextures);
+void fr_path_textures_free(struct fr_texture *t, size_t n);
 
 struct fr_workload;
 struct fr_tracer;

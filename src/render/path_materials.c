@@ -4,6 +4,7 @@
 #include "api/scene.h"
 #include "base/error.h"
 #include "material/material_mtl.h"
+#include "material/texture.h"
 #include "render/path.h"
 #include "render/views.h"
 
@@ -36,7 +37,40 @@ static int in_list(const char *list, const char *name) {
   return 0;
 }
 
-fr_error fr_path_mats_build(const fr_scene *s, const char *mirror, const char *glass, fr_bsdf **mats, size_t *count) {
+void fr_path_textures_free(fr_texture *t, size_t n) {
+  for (size_t i = 0; t && i < n; i++) fr_texture_free(&t[i]);
+  free(t);
+}
+
+/* Each material's map_Kd, loaded once per file. */
+static fr_error load_textures(const fr_scene *s, fr_bsdf *m, size_t nm, fr_texture **out, size_t *nout) {
+  fr_texture *tex = NULL;
+  size_t nt = 0;
+  const char **names = calloc(nm + 1, sizeof *names);
+  if (!names) return fr_fail(FR_ERR_NOMEM, "out of memory");
+  fr_error e = FR_OK;
+  for (size_t i = 0; i < nm && !e; i++) {
+    const char *file = fr_scene_material(s, i)->map_kd;
+    if (!file[0] || m[i].kind == FR_BSDF_METAL || m[i].kind == FR_BSDF_GLASS) continue;
+    size_t k = 0;
+    while (k < nt && strcmp(names[k], file)) k++;
+    if (k == nt) {
+      fr_texture *grown = realloc(tex, (nt + 1) * sizeof *tex);
+      if (!grown) { e = fr_fail(FR_ERR_NOMEM, "out of memory"); break; }
+      tex = grown;
+      if ((e = fr_texture_load(&tex[nt], file))) break;
+      names[nt++] = file;
+    }
+    m[i].color_tex = (int)k;
+  }
+  free(names);
+  if (e) { fr_path_textures_free(tex, nt); return e; }
+  *out = tex, *nout = nt;
+  return FR_OK;
+}
+
+fr_error fr_path_mats_build(const fr_scene *s, const char *mirror, const char *glass, fr_bsdf **mats, size_t *count,
+                            fr_texture **textures, size_t *ntextures) {
   if (!mirror && !glass) fr_view_surfaces(s->name, &mirror, &glass);
   float lo[3], hi[3];
   fr_scene_bounds(s, lo, hi);
@@ -58,6 +92,8 @@ fr_error fr_path_mats_build(const fr_scene *s, const char *mirror, const char *g
   if (!strcmp(s->name, "materials"))
     for (size_t i = 0; i < nm; i++) showcase(fr_scene_material(s, i)->name, &m[i]);
   m[nm] = fr_bsdf_default(FR_BSDF_LAMBERT);
+  fr_error e = load_textures(s, m, nm, textures, ntextures);
+  if (e) { free(m); return e; }
   *mats = m;
   *count = nm + 1;
   return FR_OK;

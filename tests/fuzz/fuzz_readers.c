@@ -5,6 +5,7 @@
  *   3 ray file, 4 hit file, 5 occlusion file, 6 zstd-compressed ray file:
  *     through a file, as frusta trace reads them (first bytes 0..251, by
  *     their value modulo 7);
+ *   248 and 249 an 8-bit texture image (PNG, JPEG, TGA, BMP) from memory;
  *   250 and 251 a scene file (JSON), its references resolved against /tmp
  *     and confined there;
  *   252 (and 254) a Radiance HDR, 253 (and 255) an OpenEXR environment map:
@@ -21,6 +22,7 @@
 #include "geom/mesh.h"
 #include "io/import.h"
 #include "io/rayfile.h"
+#include "io/image_read.h"
 #include "io/scene_file.h"
 #include "light/environment.h"
 
@@ -64,6 +66,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   if (size < 1) return 0;
   if (data[0] >= 252) {
     environment_through_file(data[0] & 1, data + 1, size - 1);
+    return 0;
+  }
+  if (data[0] >= 248 && data[0] < 250) {
+    int w, h;
+    float *rgb;
+    if (!fr_image_decode_ldr("fuzz.png", data + 1, size - 1, &w, &h, &rgb)) free(rgb);
     return 0;
   }
   if (data[0] >= 250) {

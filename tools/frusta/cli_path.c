@@ -63,9 +63,10 @@ int cli_path_setup(const cli_path *o, fr_workload *w, cli_path_run *r) {
   if (!(o->lights & CLI_LIGHT_ENV)) { fr_env_free(&r->env); fr_env_constant(&r->env, v3(0, 0, 0)); }
   fr_env_orient(&r->env, v->up, o->env_rotate, o->env_intensity);
   size_t count;
-  if (fr_path_mats_build(w->scene, o->mirror, o->glass, &r->mats, &count)) {
+  fr_error e = fr_path_mats_build(w->scene, o->mirror, o->glass, &r->mats, &count, &r->textures, &r->ntextures);
+  if (e) {
     cli_path_free(r);
-    return cli_error(CLI_USAGE_ERROR, "%s", fr_last_error());
+    return cli_error(e == FR_ERR_ARG ? CLI_USAGE_ERROR : 1, "%s", fr_last_error());
   }
   const fr_scene_file *file = cli_scene_file();
   for (size_t i = 0; file && i + 1 < count; i++) { /* the scene file's materials, by name */
@@ -76,6 +77,7 @@ int cli_path_setup(const cli_path *o, fr_workload *w, cli_path_run *r) {
   P->mats = r->mats, P->count = count;
   if (fr_surfaces_build(w->scene, (int32_t)count - 1, &r->surf, &P->nsurf)) { cli_path_free(r); return cli_error(1, "%s", fr_last_error()); }
   P->surf = r->surf;
+  P->textures = r->textures;
   P->lights.env = &r->env;
   /* the area and point lights bright enough that a white surface where the
    * camera looks, facing them, is as bright as under a white sky (irradiance pi) */
@@ -109,5 +111,6 @@ void cli_path_free(cli_path_run *r) {
   fr_env_free(&r->env);
   free(r->mats);
   free(r->surf);
+  fr_path_textures_free(r->textures, r->ntextures);
   memset(r, 0, sizeof *r);
 }

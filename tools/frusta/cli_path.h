@@ -22,6 +22,8 @@ typedef struct cli_path {
 typedef struct cli_path_run {
   fr_env env;
   fr_bsdf *mats;
+  struct fr_texture *textures;
+  size_t ntextures;
   struct fr_surface *surf;
   fr_path_setup setup;
 } cli_path_run;
