@@ -4,6 +4,16 @@
 #include "base/alloc.h"
 #include "base/error.h"
 
+/* guide[k] = the first i in [0, n) with cdf[i + 1] > k / n (n - 1 if none) */
+static void build_guide(const float *cdf, int n, uint32_t *guide) {
+  int i = 0;
+  for (int k = 0; k < n; k++) {
+    const float u = (float)k / (float)n;
+    while (i < n - 1 && cdf[i + 1] <= u) i++;
+    guide[k] = (uint32_t)i;
+  }
+}
+
 fr_error fr_dist2d_build(fr_dist2d *d, const float *weight, int w, int h) {
   memset(d, 0, sizeof *d);
   const size_t n = (size_t)w * (size_t)h;
@@ -11,7 +21,9 @@ fr_error fr_dist2d_build(fr_dist2d *d, const float *weight, int w, int h) {
   d->weight = malloc(fr_mul_size(n, sizeof(float)));
   d->cdf_row = malloc(fr_mul_size((size_t)h, ((size_t)w + 1) * sizeof(float)));
   d->cdf_marg = malloc(((size_t)h + 1) * sizeof(float));
-  if (!d->weight || !d->cdf_row || !d->cdf_marg) { fr_dist2d_free(d); return fr_fail(FR_ERR_NOMEM, "out of memory for a %dx%d distribution", w, h); }
+  d->guide_row = malloc(fr_mul_size(n, sizeof(uint32_t)));
+  d->guide_marg = malloc((size_t)h * sizeof(uint32_t));
+  if (!d->weight || !d->cdf_row || !d->cdf_marg || !d->guide_row || !d->guide_marg) { fr_dist2d_free(d); return fr_fail(FR_ERR_NOMEM, "out of memory for a %dx%d distribution", w, h); }
   memcpy(d->weight, weight, n * sizeof(float));
   double *rows = calloc((size_t)h, sizeof(double));
   if (!rows) { fr_dist2d_free(d); return fr_fail(FR_ERR_NOMEM, "out of memory"); }
@@ -33,29 +45,31 @@ fr_error fr_dist2d_build(fr_dist2d *d, const float *weight, int w, int h) {
   d->cdf_marg[h] = 1.0f;
   free(rows);
   d->total = total;
+  d->pdf_scale = (float)((double)w * h / total);
+  for (int y = 0; y < h; y++) build_guide(d->cdf_row + (size_t)y * ((size_t)w + 1), w, d->guide_row + (size_t)y * w);
+  build_guide(d->cdf_marg, h, d->guide_marg);
   return FR_OK;
 }
 
 void fr_dist2d_free(fr_dist2d *d) {
-  free(d->weight); free(d->cdf_row); free(d->cdf_marg);
+  free(d->weight); free(d->cdf_row); free(d->cdf_marg); free(d->guide_row); free(d->guide_marg);
   memset(d, 0, sizeof *d);
 }
 
-/* The i with cdf[i] <= u < cdf[i + 1] among n intervals, skipping empty ones. */
-static int find(const float *cdf, int n, float u) {
-  int lo = 0, hi = n; /* cdf[lo] <= u < cdf[hi] */
-  while (hi - lo > 1) {
-    int mid = (lo + hi) / 2;
-    if (cdf[mid] <= u) lo = mid; else hi = mid;
-  }
-  while (lo < n - 1 && cdf[lo + 1] <= cdf[lo]) lo++; /* never an empty interval */
-  return lo;
+/* The i with cdf[i] <= u < cdf[i + 1] among n intervals (never an empty
+ * one), from its guide: a walk of a step or two. */
+static int find(const float *cdf, const uint32_t *guide, int n, float u) {
+  int k = (int)(u * (float)n);
+  if (k >= n) k = n - 1;
+  int i = (int)guide[k < 0 ? 0 : k];
+  while (i < n - 1 && cdf[i + 1] <= u) i++;
+  return i;
 }
 
 float fr_dist2d_sample(const fr_dist2d *d, float u1, float u2, float *u, float *v, int *x, int *y) {
-  const int yy = find(d->cdf_marg, d->h, u2);
+  const int yy = find(d->cdf_marg, d->guide_marg, d->h, u2);
   const float *c = d->cdf_row + (size_t)yy * ((size_t)d->w + 1);
-  const int xx = find(c, d->w, u1);
+  const int xx = find(c, d->guide_row + (size_t)yy * d->w, d->w, u1);
   const float dv = d->cdf_marg[yy + 1] - d->cdf_marg[yy], du = c[xx + 1] - c[xx];
   const float fv = dv > 0.0f ? (u2 - d->cdf_marg[yy]) / dv : 0.5f, fu = du > 0.0f ? (u1 - c[xx]) / du : 0.5f;
   *u = ((float)xx + (fu < 0.0f ? 0.0f : fu)) / (float)d->w;
@@ -67,5 +81,5 @@ float fr_dist2d_sample(const fr_dist2d *d, float u1, float u2, float *u, float *
 }
 
 float fr_dist2d_pdf(const fr_dist2d *d, int x, int y) {
-  return (float)((double)d->weight[(size_t)y * d->w + x] * d->w * d->h / d->total);
+  return d->weight[(size_t)y * d->w + x] * d->pdf_scale;
 }

@@ -5,14 +5,21 @@
  */
 #ifndef FR_LIGHT_DISTRIBUTION2D_H
 #define FR_LIGHT_DISTRIBUTION2D_H
+#include <stdint.h>
 #include "frusta.h"
 
 typedef struct fr_dist2d {
   int w, h;
   float *cdf_row;   /* h x (w + 1): each row's normalized cumulative sum */
   float *cdf_marg;  /* h + 1 */
+  /* guide tables (Chen's): guide[k] is the first interval i whose cdf[i + 1]
+   * exceeds k / n, so that the search for u starts at guide[u n] and
+   * walks a step or two, not log n */
+  uint32_t *guide_row; /* h x w */
+  uint32_t *guide_marg; /* h */
   float *weight;    /* w x h, the weights themselves */
   double total;     /* their sum */
+  float pdf_scale;  /* w h / total */
 } fr_dist2d;
 
 /* FR_ERR_ARG when every weight is 0 (nothing to sample). */

@@ -113,3 +113,16 @@ float fr_env_pdf(const fr_env *e, vec3 dir) {
   if (!(s > 0.0f)) return 0.0f;
   return fr_dist2d_pdf(&e->dist, x, y) / (2.0f * PI_F * PI_F * s);
 }
+
+vec3 fr_env_eval_pdf(const fr_env *e, vec3 dir, float *pdf) {
+  if (!e->rgb) {
+    *pdf = e->black ? 0.0f : 1.0f / (4.0f * PI_F);
+    return v3_scale(e->color, e->intensity);
+  }
+  float u, v, s;
+  int x, y;
+  to_uv(e, dir, &u, &v, &s);
+  const vec3 c = texel(e, u, v, &x, &y);
+  *pdf = e->black || !(s > 0.0f) ? 0.0f : fr_dist2d_pdf(&e->dist, x, y) / (2.0f * PI_F * PI_F * s);
+  return v3_scale(c, e->intensity);
+}
