@@ -185,6 +185,14 @@ expect 0 "$F" render --builtin=materials --shade path --size 48x24 --spp 2 --env
 expect 0 "$F" bench --builtin=materials --size 32x32 --spp 2 --workload path --mode auto,stream --tracer both --repeat 1
 grep -q 'workload=path tracer=frusta mode=auto' "$T/out" && grep -q 'workload=path tracer=embree mode=stream' "$T/out" \
   && grep -q 'stages tracer=frusta mode=auto workload=path .* outside_tracing=' "$T/out" && ok || bad "bench path both tracers"
+expect 0 "$F" render --builtin=materials --shade path --size 32x16 --spp 2 --mode hybrid16 --out "$T/m1.pfm"
+grep -q 'tracer=frusta mode=hybrid16 ' "$T/out" && ok || bad "render path --mode"
+expect 0 "$F" render --builtin=materials --shade path --size 32x16 --spp 2 --mode single --out "$T/m2.pfm"
+cmp -s "$T/m1.pfm" "$T/m2.pfm" && ok || bad "render path: the image depends on the trace mode"
+expect 0 "$F" render --builtin=materials --shade path --size 32x16 --spp 2 --tracer embree --out "$T/m3.pfm"
+grep -q 'tracer=embree mode=stream ' "$T/out" && ok || bad "render path --tracer embree"
+expect 2 "$F" render --builtin --shade eyelight --mode single --out "$T/q.png"
+expect 2 "$F" render --builtin --shade path --mode single --tracer embree --out "$T/q.png"
 expect 1 "$F" render --builtin --shade path --env "$T/missing.exr" --out "$T/q.png"
 printf 'not an exr at all' >"$T/bad.exr"
 expect 1 "$F" render --builtin --shade path --env "$T/bad.exr" --out "$T/q.png"

@@ -10,6 +10,7 @@
 #include "commands.h"
 #include "base/timer.h"
 #include "cli_path.h"
+#include "embree_tracer.h"
 #include "io/image_write.h"
 #include "render/softshadow.h"
 #include "render/whitted.h"
@@ -79,7 +80,8 @@ static void aov_name(const char *out, const char *kind, char *buf, size_t n) {
 /* --shade path: passes of FR_PATH_CHUNK samples (so the sums, and the
  * image, are the same however the work is split), a progress line, the
  * mean written linear (EXR, PFM) or tone-mapped (PNG). */
-static int render_path(fr_scene *s, fr_workload *w, const cli_path *po, const char *out, int threads) {
+static int render_path(fr_scene *s, fr_workload *w, const cli_path *po, const char *out, int threads, int mode,
+                       int embree) {
   const size_t np = (size_t)w->cam.width * (size_t)w->cam.height;
   cli_path_run run;
   int rc = cli_path_setup(po, w, &run);
@@ -93,7 +95,16 @@ static int render_path(fr_scene *s, fr_workload *w, const cli_path *po, const ch
     rc = cli_error(1, "out of memory for a %dx%d image", w->cam.width, w->cam.height);
     goto done;
   }
-  fr_tracer t = fr_tracer_frusta(s);
+  static const char *const mode_names[] = {"auto", "single", "packet8", "packet16", "hybrid16", "raystream"};
+  ebr_scene *e = NULL;
+  if (embree) {
+    ebr_options eo = {.threads = threads, .quality = 2}; /* high quality, not robust: Embree's fastest */
+    if (ebr_create(s, eo, &e)) { rc = cli_error(1, "embree: cannot build the scene"); goto done; }
+  } else if (fr_scene_set_trace_mode(s, (fr_trace_mode)mode)) {
+    rc = cli_error(1, "%s", fr_last_error());
+    goto done;
+  }
+  fr_tracer t = e ? ebr_tracer(e, EBR_STREAM, EBR_FLAG_HINT, EBR_PACK_RAYS) : fr_tracer_frusta(s);
   fr_path_setup *P = &run.setup;
   const int spp = P->spp;
   w->progress = 0;
@@ -127,14 +138,16 @@ static int render_path(fr_scene *s, fr_workload *w, const cli_path *po, const ch
     rc = cli_error(1, "%s", fr_last_error());
     goto done;
   }
-  printf("rendered scene=%s tris=%zu size=%dx%d shade=path spp=%d tracer=frusta isa=%s threads=%d "
+  printf("rendered scene=%s tris=%zu size=%dx%d shade=path spp=%d tracer=%s mode=%s isa=%s threads=%d "
          "build_seconds=%.3f rays=%llu seconds=%.3f mrays=%.2f -> %s%s%s%s%s\n",
-         s->name, fr_scene_triangle_count(s), w->cam.width, w->cam.height, spp,
+         s->name, fr_scene_triangle_count(s), w->cam.width, w->cam.height, spp, e ? "embree" : "frusta",
+         e ? "stream" : mode_names[mode],
          fr_isa_name(fr_get_isa()), threads, s->build_seconds, (unsigned long long)rays, seconds, rays / seconds * 1e-6, out,
          po->aov ? " " : "", po->aov ? albedo_out : "", po->aov ? " " : "", po->aov ? normal_out : "");
 done:
   free(w->image); free(w->gbuf_albedo); free(w->gbuf_normal);
   w->image = w->gbuf_albedo = w->gbuf_normal = NULL;
+  ebr_release(e);
   cli_path_free(&run);
   return rc;
 }
@@ -149,15 +162,21 @@ int cmd_render(int argc, char **argv) {
   fr_softshadow_opts so = {16, 1, FR_LIGHT_SETS_CELLS};
   static const char *const shades[] = {"eyelight", "normals", "shadows", "softshadow", "whitted", "path"};
   static const char *const sets[] = {"cells", "spread"}; /* FR_LIGHT_SETS_CELLS, _SPREAD */
-  int shade = 0, set = 0;
+  int shade = 0, set = 0, mode = 0, embree = 0;
+  static const char *const modes[] = {"auto", "single", "packet8", "packet16", "hybrid16", "raystream"}; /* fr_trace_mode order */
+  static const char *const tracers[] = {"frusta", "embree"};
   cli_view v;
   cli_whitted wo;
   cli_path po;
   if ((rc = cli_view_from_args(&a, &v)) || (rc = cli_whitted_from_args(&a, &wo)) || (rc = cli_path_from_args(&a, &po)) ||
       (rc = cli_common_from_args(&a, &threads)) || (rc = cli_arg_choice(&a, F_SHADE, shades, 6, &shade)) ||
       (rc = cli_arg_choice(&a, F_LIGHT_SETS, sets, 2, &set)) || (rc = cli_arg_onoff(&a, F_FILTER, &so.filter)) ||
-      (rc = cli_arg_onoff(&a, F_MFT, &mft)) || (rc = cli_arg_int(&a, F_LIGHT_SAMPLES, 16, 4096, &so.samples)))
+      (rc = cli_arg_onoff(&a, F_MFT, &mft)) || (rc = cli_arg_int(&a, F_LIGHT_SAMPLES, 16, 4096, &so.samples)) ||
+      (rc = cli_arg_choice(&a, F_MODE, modes, 6, &mode)) || (rc = cli_arg_choice(&a, F_TRACER, tracers, 2, &embree)))
     return rc;
+  if ((a.val[F_MODE] || a.val[F_TRACER]) && shade != 5)
+    return cli_error(CLI_USAGE_ERROR, "--mode and --tracer choose how --shade path traces; other shades take --mft");
+  if (a.val[F_MODE] && embree) return cli_error(CLI_USAGE_ERROR, "--mode is frusta's; --tracer embree traces streams");
   so.sets = set ? FR_LIGHT_SETS_SPREAD : FR_LIGHT_SETS_CELLS;
   if (so.samples % 16)
     return cli_error(CLI_USAGE_ERROR, "--light-samples wants a multiple of 16 (16..4096), got '%s'", a.val[F_LIGHT_SAMPLES]);
@@ -186,7 +205,7 @@ int cmd_render(int argc, char **argv) {
     return rc;
   }
   if (w.kind == FR_WL_PATH) {
-    rc = render_path(s, &w, &po, out, threads);
+    rc = render_path(s, &w, &po, out, threads, mode, embree);
     fr_scene_release(s);
     return rc;
   }

@@ -63,12 +63,13 @@ const cli_flag cli_flags[F_COUNT] = {
     [F_CULL] = {"--cull", "off|ia|planes|corners", R | B, "large packets: whole-packet cull (default off)"},
     [F_WORKLOAD] = {"--workload", "W[,W..]|all", B | S,
                     "primary, shadow, soft16, ao16, diffuse8, specular8, whitted, path (docs/workloads.md; all: but path)"},
-    [F_MODE] = {"--mode", "M[,M..]|all", B | T,
+    [F_MODE] = {"--mode", "M[,M..]|all", R | B | T,
                 "bench: frusta's single single4 packet8 packet16 hybrid16 auto raystream mft packet2x2..packet32x32, "
                 "Embree's single packet4 packet8 packet16 stream; trace: single (default) packet8 packet16 hybrid16 "
-                "auto raystream"},
-    [F_TRACER] = {"--tracer", "frusta|embree|both", B | T,
-                  "who traces (default frusta; trace: embree answers in its watertight mode)"},
+                "auto raystream; render --shade path: auto (default) single packet8 packet16 hybrid16 raystream"},
+    [F_TRACER] = {"--tracer", "frusta|embree|both", R | B | T,
+                  "who traces (default frusta; trace: embree answers in its watertight mode; render --shade path: "
+                  "embree traces the same paths, as streams)"},
     [F_QUERY] = {"--query", "closest|any", T, "closest hits (.hits) or occlusion (.occl)"},
     [F_REPEAT] = {"--repeat", "K", B, "repetitions of every run, interleaved; the line gives best and median (default 3)"},
     [F_EMBREE] = {"--embree", NULL, S, "Embree's build time, memory, SAH and tree beside frusta's"},
