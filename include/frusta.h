@@ -217,10 +217,13 @@ void fr_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occluded
 
 /* How fr_intersect_stream, fr_occluded_stream and fr_intersect16 trace: the
  * choice of Table VIII of the MIC paper. Every mode gives the same answers
- * (t, and the triangle up to which of two a ray exactly through their shared
- * edge reports; u and v to rounding); only speed differs. Within a mode the
- * same ray gets the same bits every time, on every thread. Set it while no
- * thread traces the scene. */
+ * (t, and the triangle up to which of two that meet the ray at one t, at a
+ * shared edge or where two cross, it reports; u and v to rounding); only
+ * speed differs. Within a mode the same ray gets the same t, u and v bits
+ * every time, on every thread, and the same triangle but at such a tie in
+ * FR_TRACE_HYBRID16 and FR_TRACE_AUTO, whose per-thread tuning may trace it
+ * in the packet or the single-ray phase. Set it while no thread traces the
+ * scene. */
 typedef enum fr_trace_mode {
   FR_TRACE_AUTO,      /* default: coherent groups of 16 as hybrid packets, the rest sorted by
                          octant into hybrid packets or ray streams */
