@@ -3,6 +3,7 @@
  *   - white furnace: inside a constant environment of radiance 1, a closed
  *     white Lambert sphere and a clear glass sphere render 1 everywhere
  *     (mean within 0.5% at 256 samples per pixel);
+ *   - Radiance HDR files decode alike flat and run-length encoded;
  *   - the environment's importance sampling (render/light) has the same
  *     mean as uniform sampling, and states the pdf it samples by;
  *   - the samplers stratify: n points of a pixel's pattern fall one per
@@ -14,6 +15,7 @@
  */
 #include "test_util.h"
 #include "embree_tracer.h"
+#include "io/image_read.h"
 #include "light/environment.h"
 #include "render/path.h"
 #include "material/texture.h"
@@ -155,6 +157,34 @@ static void environment_sampling(void **st) {
   fr_env_free(&env);
 }
 
+/* Radiance RGBE: flat and run-length encoded scanlines give the same
+ * values, (m + 0.5) 2^(e - 136); truncated or lying files are refused. */
+static void radiance_hdr(void **st) {
+  (void)st;
+  const char head_flat[] = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 8\n";
+  unsigned char flat[sizeof head_flat - 1 + 32], rle[sizeof head_flat - 1 + 4 + 4 * 2];
+  memcpy(flat, head_flat, sizeof head_flat - 1);
+  memcpy(rle, head_flat, sizeof head_flat - 1);
+  const unsigned char px[4] = {100, 50, 25, 130};
+  for (int x = 0; x < 8; x++) memcpy(flat + sizeof head_flat - 1 + 4 * x, px, 4);
+  unsigned char *r = rle + sizeof head_flat - 1;
+  r[0] = 2, r[1] = 2, r[2] = 0, r[3] = 8; /* new RLE, width 8: each component as a run of 8 */
+  for (int c = 0; c < 4; c++) r[4 + 2 * c] = 128 + 8, r[5 + 2 * c] = px[c];
+  int w, h;
+  float *a, *b;
+  assert_int_equal(fr_hdr_decode("flat", flat, sizeof flat, &w, &h, &a), FR_OK);
+  assert_true(w == 8 && h == 1);
+  assert_int_equal(fr_hdr_decode("rle", rle, sizeof rle, &w, &h, &b), FR_OK);
+  assert_memory_equal(a, b, 24 * sizeof(float));
+  assert_true(fabsf(a[0] - 100.5f / 64.0f) < 1e-6f && fabsf(a[2] - 25.5f / 64.0f) < 1e-6f); /* 2^(130 - 136) */
+  free(a); free(b);
+  assert_int_not_equal(fr_hdr_decode("cut", rle, sizeof rle - 3, &w, &h, &a), FR_OK);
+  assert_int_not_equal(fr_hdr_decode("cut", flat, sizeof flat - 1, &w, &h, &a), FR_OK);
+  const char liar[] = "#?RADIANCE\n\n-Y 60000 +X 60000\n";
+  assert_int_not_equal(fr_hdr_decode("liar", (const unsigned char *)liar, sizeof liar - 1, &w, &h, &a), FR_OK);
+  assert_int_not_equal(fr_hdr_decode("xyze", (const unsigned char *)"#?R\nFORMAT=32-bit_rle_xyze\n\n-Y 1 +X 1\n1234", 40, &w, &h, &a), FR_OK);
+}
+
 static void samplers_stratify(void **st) {
   (void)st;
   for (int k = 0; k < FR_SAMPLER_COUNT; k++)
@@ -245,6 +275,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(white_furnace),
       cmocka_unit_test(environment_sampling),
+      cmocka_unit_test(radiance_hdr),
       cmocka_unit_test(samplers_stratify),
       cmocka_unit_test(same_image_everywhere),
   };
