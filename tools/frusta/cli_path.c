@@ -99,11 +99,15 @@ int cli_path_setup(const cli_path *o, fr_workload *w, cli_path_run *r) {
   P->focus = o->focus > 0.0f ? o->focus : v3_len(v3_sub(v->at, v->eye));
   P->seed = o->seed;
   w->path = P;
-  printf("path spp=%d max_depth=%d sampler=%s lights=%s%s%s env=%s area_radiance=%.4g point_intensity=%.4g "
-         "aperture=%g focus=%g\n",
-         o->spp, o->max_depth, fr_sampler_name(o->sampler), (o->lights & CLI_LIGHT_ENV) ? "env," : "",
-         P->lights.area ? "area," : "", P->lights.point ? "point" : "", o->env_file ? o->env_file : "constant",
-         (double)P->lights.area_radiance.x, (double)P->lights.point_intensity.x, (double)P->aperture, (double)P->focus);
+  char lights[32] = "";
+  if (o->lights & CLI_LIGHT_ENV) strcat(lights, ",env");
+  if (P->lights.area) strcat(lights, ",area");
+  if (P->lights.point) strcat(lights, ",point");
+  printf("path spp=%d max_depth=%d sampler=%s lights=%s env=%s area_radiance=%.4g point_intensity=%.4g aperture=%g "
+         "focus=%g\n",
+         o->spp, o->max_depth, fr_sampler_name(o->sampler), lights[0] ? lights + 1 : "none",
+         o->env_file ? o->env_file : "constant", (double)P->lights.area_radiance.x, (double)P->lights.point_intensity.x,
+         (double)P->aperture, (double)P->focus);
   return 0;
 }
 

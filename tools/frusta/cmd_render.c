@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "api/scene.h"
 #include "cli.h"
 #include "cli_scene_file.h"
@@ -111,19 +112,20 @@ static int render_path(fr_scene *s, fr_workload *w, const cli_path *po, const ch
   uint64_t rays = 0;
   const double t0 = fr_seconds();
   double last = t0;
+  const int tty = isatty(fileno(stderr)); /* the progress line is for a person watching */
   for (int s0 = 0; s0 < spp; s0 += FR_PATH_CHUNK) {
     P->spp_begin = s0;
     P->spp_end = s0 + FR_PATH_CHUNK < spp ? s0 + FR_PATH_CHUNK : spp;
     rays += fr_workload_run(w, &t).rays;
     const double now = fr_seconds();
-    if (now - last > 0.5 || P->spp_end == spp) {
+    if (tty && (now - last > 0.5 || P->spp_end == spp)) {
       last = now;
       const double el = now - t0, left = el / P->spp_end * (spp - P->spp_end);
       fprintf(stderr, "\rpath: %d/%d spp  %.1f Mrays/s  %.1f s, %.1f s left  ", P->spp_end, spp, rays / el * 1e-6, el, left);
       fflush(stderr);
     }
   }
-  fprintf(stderr, "\n");
+  if (tty) fprintf(stderr, "\n");
   const double seconds = fr_seconds() - t0;
   const float inv = 1.0f / (float)spp, gain = exp2f(po->exposure);
   const int png = !strcmp(out + (strlen(out) >= 4 ? strlen(out) - 4 : 0), ".png");
