@@ -252,6 +252,20 @@ bad_scene 'render.size' '{"meshes": [{"file": "sub/floor.ply"}], "render": {"siz
 bad_scene 'environment.file' '{"meshes": [{"file": "sub/floor.ply"}], "environment": {"file": "/etc/passwd"}}'
 bad_scene 'lights.area' '{"meshes": [{"file": "sub/floor.ply"}], "lights": {"area": {"corner": [0, 1, 0]}}}'
 [ ! -e "$T/sb.png" ] && ok || bad "a failed scene file left an output file"
+# the repository's scene files for the shared scenes all load and render
+# (the root is where the shared folder really lies, should it be a link)
+if [ -d "$SHARED/scenes" ]; then
+  root=$(cd "$SHARED/.." && pwd -P)
+  [ -L "$SHARED" ] && root=$(cd "$(dirname "$(readlink -f "$SHARED")")" && pwd -P)
+  for f in "$SRC"/scenes/*.json; do
+    expect 0 "$F" render "$f" --scene-root "$root" --size 16x16 --spp 1 --out "$T/sf.png"
+  done
+else
+  echo "cli: $SHARED/scenes absent: the scene files of scenes/ not rendered"
+fi
+printf '{"meshes": [{"file": "sub/floor.ply"}], "lights": {}}' >"$T/sc/nolamp.json"
+expect 0 "$F" render "$T/sc/nolamp.json" --shade path --size 8x8 --spp 1 --out "$T/nl.png"
+grep -q 'lights=env env=' "$T/out" && ok || bad "an empty lights object: the environment alone"
 # --scene-root widens where a scene file may reach
 printf '{"meshes": [{"file": "../out_of/floor.ply"}]}' >"$T/sc/up.json"
 expect 1 "$F" render "$T/sc/up.json" --out "$T/u.png" --size 16x16

@@ -234,6 +234,7 @@ static fr_error read_all(const ctx *c, const cJSON *root, fr_scene_file *f) {
                            *const point_keys[] = {"position", "intensity", NULL};
   if (lights) {
     if ((e = known_keys(c, lights, "lights", light_keys))) return e;
+    f->has_lights = 1;
     const cJSON *a = cJSON_GetObjectItemCaseSensitive(lights, "area"), *p = cJSON_GetObjectItemCaseSensitive(lights, "point");
     int h[3] = {0, 0, 0};
     if (a && ((e = known_keys(c, a, "lights.area", area_keys)) || (e = triple(c, a, "lights.area", "corner", -1e9, 1e9, &f->area[0], &h[0])) ||

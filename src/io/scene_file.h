@@ -42,6 +42,7 @@ typedef struct fr_scene_file {
   char env_file[PATH_MAX];
   vec3 env_color;
   float env_intensity, env_rotate;
+  int has_lights; /* a "lights" object: exactly its lights (and the environment) shine */
   int has_area, has_area_radiance, has_point, has_point_intensity;
   vec3 area[3], area_radiance, point, point_intensity;
   int has_shade, has_size, has_spp, has_max_depth, has_sampler, has_seed;

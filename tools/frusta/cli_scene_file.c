@@ -49,8 +49,7 @@ int cli_scene_file_defaults(cli_args *a) {
   if (f->has_area)
     set(a, F_AREA, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", V3(f->area[0]), V3(f->area[1]), V3(f->area[2]));
   if (f->has_point) set(a, F_LIGHT, "%.9g,%.9g,%.9g", V3(f->point));
-  if (f->has_area || f->has_point)
-    set(a, F_LIGHTS, "env%s%s", f->has_area ? ",area" : "", f->has_point ? ",point" : "");
+  if (f->has_lights) set(a, F_LIGHTS, "env%s%s", f->has_area ? ",area" : "", f->has_point ? ",point" : "");
   if (f->has_shade) set(a, F_SHADE, "%s", f->shade);
   if (f->has_size) set(a, F_SIZE, "%dx%d", f->width, f->height);
   if (f->has_spp) set(a, F_SPP, "%d", f->spp);
