@@ -38,6 +38,9 @@ vec3 fr_env_eval(const fr_env *e, vec3 dir);
  * it; pdf 0 when the environment is black. */
 vec3 fr_env_sample(const fr_env *e, float u1, float u2, vec3 *dir, float *pdf);
 float fr_env_pdf(const fr_env *e, vec3 dir);
+/* The same, interpolated bilinearly between texels: for the background
+ * seen straight from the camera, where the map's texels would show. */
+vec3 fr_env_eval_smooth(const fr_env *e, vec3 dir);
 /* fr_env_eval and fr_env_pdf at once (one lookup). */
 vec3 fr_env_eval_pdf(const fr_env *e, vec3 dir, float *pdf);
 #endif

@@ -200,7 +200,8 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         }
         if (!hit) {
           float pe = 0.0f;
-          const vec3 le = st.delta ? fr_env_eval(L->env, d) : fr_env_eval_pdf(L->env, d, &pe);
+          const vec3 le = depth == 0 ? fr_env_eval_smooth(L->env, d) /* the background, seen */
+                          : st.delta ? fr_env_eval(L->env, d) : fr_env_eval_pdf(L->env, d, &pe);
           const float w_mis = st.delta ? 1.0f : power_heuristic(st.pdf, pe / (float)nlights);
           S->acc[st.pix] = v3_add(S->acc[st.pix], v3_scale(v3_mul(st.weight, le), w_mis));
           continue;
