@@ -138,16 +138,22 @@ fr_error fr_hdr_decode(const char *what, const unsigned char *data, size_t size,
   return FR_OK;
 }
 
+typedef fr_error (*decoder)(const char *, const unsigned char *, size_t, int *, int *, float **);
+
+/* path, at most max bytes of it, through one of the decoders above or below. */
+static fr_error read_and_decode(const char *path, size_t max, decoder decode, int *width, int *height, float **rgb) {
+  char *data;
+  size_t size;
+  fr_error err = fr_read_file_max(path, max, &data, &size);
+  if (err) return err;
+  err = decode(path, (const unsigned char *)data, size, width, height, rgb);
+  free(data);
+  return err;
+}
+
 fr_error fr_image_read(const char *path, int *width, int *height, float **rgb) {
-  if (fr_has_suffix(path, ".hdr") || fr_has_suffix(path, ".pic")) {
-    char *data;
-    size_t size;
-    fr_error err = fr_read_file_max(path, (size_t)1 << 30, &data, &size);
-    if (err) return err;
-    err = fr_hdr_decode(path, (const unsigned char *)data, size, width, height, rgb);
-    free(data);
-    return err;
-  }
+  if (fr_has_suffix(path, ".hdr") || fr_has_suffix(path, ".pic"))
+    return read_and_decode(path, (size_t)1 << 30, fr_hdr_decode, width, height, rgb);
   if (!fr_has_suffix(path, ".exr")) return fr_fail(FR_ERR_ARG, "%s: unknown image format (use .exr or .hdr)", path);
   FILE *f = fopen(path, "rb");
   if (!f) return fr_fail(FR_ERR_IO, "%s: cannot open", path);
@@ -183,11 +189,5 @@ fr_error fr_image_decode_ldr(const char *what, const unsigned char *data, size_t
 }
 
 fr_error fr_image_read_ldr(const char *path, int *width, int *height, float **rgb) {
-  char *data;
-  size_t size;
-  fr_error err = fr_read_file_max(path, (size_t)256 << 20, &data, &size);
-  if (err) return err;
-  err = fr_image_decode_ldr(path, (const unsigned char *)data, size, width, height, rgb);
-  free(data);
-  return err;
+  return read_and_decode(path, (size_t)256 << 20, fr_image_decode_ldr, width, height, rgb);
 }

@@ -16,6 +16,12 @@ typedef struct ctx {
   const char *what, *dir, *root;
 } ctx;
 
+/* The dotted name of key inside where ("" at the top), as errors show it. */
+static const char *key_of(const char *where, const char *key, char *buf, size_t cap) {
+  snprintf(buf, cap, "%s%s%s", where, *where ? "." : "", key);
+  return buf;
+}
+
 static fr_error bad(const ctx *c, const char *key, const char *expected) {
   return fr_fail(FR_ERR_FORMAT, "%s: %s: expected %s", c->what, key, expected);
 }
@@ -31,7 +37,8 @@ static fr_error known_keys(const ctx *c, const cJSON *o, const char *where, cons
       char list[512] = "";
       for (const char *const *k = keys; *k; k++)
         snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", k == keys ? "" : ", ", *k);
-      return fr_fail(FR_ERR_FORMAT, "%s: %s%s%s: unknown key (known: %s)", c->what, where, *where ? "." : "", it->string, list);
+      char k[256];
+      return fr_fail(FR_ERR_FORMAT, "%s: %s: unknown key (known: %s)", c->what, key_of(where, it->string, k, sizeof k), list);
     }
   }
   return FR_OK;
@@ -42,7 +49,7 @@ static fr_error number(const ctx *c, const cJSON *o, const char *where, const ch
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
   if (!v) return FR_OK;
   char k[256], exp[128];
-  snprintf(k, sizeof k, "%s%s%s", where, *where ? "." : "", key);
+  key_of(where, key, k, sizeof k);
   snprintf(exp, sizeof exp, "a number in [%g, %g]", lo, hi);
   if (!cJSON_IsNumber(v) || !(v->valuedouble >= lo && v->valuedouble <= hi)) return bad(c, k, exp);
   *out = (float)v->valuedouble;
@@ -59,7 +66,7 @@ static fr_error integer(const ctx *c, const cJSON *o, const char *where, const c
   const double v = cJSON_GetObjectItemCaseSensitive(o, key)->valuedouble;
   if (v != floor(v)) {
     char k[256], exp[64];
-    snprintf(k, sizeof k, "%s.%s", where, key);
+    key_of(where, key, k, sizeof k);
     snprintf(exp, sizeof exp, "a whole number in [%d, %d]", lo, hi);
     return bad(c, k, exp);
   }
@@ -74,7 +81,7 @@ static fr_error triple(const ctx *c, const cJSON *o, const char *where, const ch
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
   if (!v) return FR_OK;
   char k[256], exp[128];
-  snprintf(k, sizeof k, "%s%s%s", where, *where ? "." : "", key);
+  key_of(where, key, k, sizeof k);
   snprintf(exp, sizeof exp, "three numbers [x, y, z] in [%g, %g]", lo, hi);
   if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 3) return bad(c, k, exp);
   float xyz[3];
@@ -93,7 +100,7 @@ static fr_error string(const ctx *c, const cJSON *o, const char *where, const ch
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
   if (!v) return FR_OK;
   char k[256], exp[64];
-  snprintf(k, sizeof k, "%s%s%s", where, *where ? "." : "", key);
+  key_of(where, key, k, sizeof k);
   snprintf(exp, sizeof exp, "a string of at most %zu characters", cap - 1);
   if (!cJSON_IsString(v) || !v->valuestring[0] || strlen(v->valuestring) >= cap) return bad(c, k, exp);
   memcpy(out, v->valuestring, strlen(v->valuestring) + 1);
@@ -109,9 +116,10 @@ static fr_error file_ref(const ctx *c, const cJSON *o, const char *where, const 
   if (e || !given) return e;
   char scene[PATH_MAX];
   snprintf(scene, sizeof scene, "%s/scene", c->dir);
+  char k[256];
   if (!fr_scene_ref_path_within(scene, ref, c->root, out, PATH_MAX))
-    return fr_fail(FR_ERR_IO, "%s: %s%s%s: '%s' does not exist within %s (files a scene names stay in its folder, "
-                              "or under --scene-root)", c->what, where, *where ? "." : "", key, ref, c->root ? c->root : c->dir);
+    return fr_fail(FR_ERR_IO, "%s: %s: '%s' does not exist within %s (files a scene names stay in its folder, "
+                              "or under --scene-root)", c->what, key_of(where, key, k, sizeof k), ref, c->root ? c->root : c->dir);
   if (has) *has = 1;
   return FR_OK;
 }

@@ -5,9 +5,12 @@
 #include <string.h>
 #include "io/file_read.h"
 
-/* Whether ref names something below its folder: not absolute, no '..'. */
+/* Whether ref is a relative name: not empty, not absolute, no drive. */
+static int relative(const char *ref) { return ref[0] && ref[0] != '/' && ref[0] != '\\' && !strchr(ref, ':'); }
+
+/* Whether ref names something below its folder: relative, no '..'. */
 static int stays_below(const char *ref) {
-  if (!ref[0] || ref[0] == '/' || ref[0] == '\\' || strchr(ref, ':')) return 0;
+  if (!relative(ref)) return 0;
   for (const char *p = ref; *p;) {
     size_t n = strcspn(p, "/\\");
     if (n == 2 && p[0] == '.' && p[1] == '.') return 0;
@@ -17,32 +20,39 @@ static int stays_below(const char *ref) {
   return 1;
 }
 
-int fr_scene_ref_path(const char *scene, const char *ref, char *out, size_t cap) {
-  if (!stays_below(ref)) return 0;
-  char dir[PATH_MAX];
-  snprintf(dir, sizeof dir, "%s", scene);
+/* The folder of scene, with its '/', in dir. */
+static void folder_of(const char *scene, char *dir, size_t cap) {
+  snprintf(dir, cap, "%s", scene);
   char *slash = strrchr(dir, '/');
   if (slash) slash[1] = 0;
-  else snprintf(dir, sizeof dir, "./");
-  if ((size_t)snprintf(out, cap, "%s%s", dir, ref) >= cap || !fr_file_exists(out)) return 0;
-  /* a symlink, the name's or a folder's on the way, may not lead out */
+  else snprintf(dir, cap, "./");
+}
+
+/* Whether file, symlinks followed, lies under folder, symlinks followed. */
+static int lies_under(const char *file, const char *folder) {
   char real_dir[PATH_MAX], real[PATH_MAX];
-  if (!realpath(dir, real_dir) || !realpath(out, real)) return 0;
+  if (!realpath(folder, real_dir) || !realpath(file, real)) return 0;
   const size_t n = strlen(real_dir);
   return strncmp(real, real_dir, n) == 0 && (real_dir[n - 1] == '/' || real[n] == '/');
 }
 
+/* dir + ref in out, if it fits and exists. */
+static int joined(const char *dir, const char *ref, char *out, size_t cap) {
+  return (size_t)snprintf(out, cap, "%s%s", dir, ref) < cap && fr_file_exists(out);
+}
+
+int fr_scene_ref_path(const char *scene, const char *ref, char *out, size_t cap) {
+  if (!stays_below(ref)) return 0;
+  char dir[PATH_MAX];
+  folder_of(scene, dir, sizeof dir);
+  /* a symlink, the name's or a folder's on the way, may not lead out */
+  return joined(dir, ref, out, cap) && lies_under(out, dir);
+}
+
 int fr_scene_ref_path_within(const char *scene, const char *ref, const char *root, char *out, size_t cap) {
   if (!root) return fr_scene_ref_path(scene, ref, out, cap);
-  if (!ref[0] || ref[0] == '/' || ref[0] == '\\' || strchr(ref, ':')) return 0;
+  if (!relative(ref)) return 0;
   char dir[PATH_MAX];
-  snprintf(dir, sizeof dir, "%s", scene);
-  char *slash = strrchr(dir, '/');
-  if (slash) slash[1] = 0;
-  else snprintf(dir, sizeof dir, "./");
-  if ((size_t)snprintf(out, cap, "%s%s", dir, ref) >= cap || !fr_file_exists(out)) return 0;
-  char real_root[PATH_MAX], real[PATH_MAX];
-  if (!realpath(root, real_root) || !realpath(out, real)) return 0;
-  const size_t n = strlen(real_root);
-  return strncmp(real, real_root, n) == 0 && (real_root[n - 1] == '/' || real[n] == '/');
+  folder_of(scene, dir, sizeof dir);
+  return joined(dir, ref, out, cap) && lies_under(out, root);
 }

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "base/alloc.h"
+#include "base/bilinear.h"
 #include "base/error.h"
 #include "io/image_read.h"
 
@@ -104,14 +105,9 @@ vec3 fr_env_sample(const fr_env *e, float u1, float u2, vec3 *dir, float *pdf) {
 }
 
 float fr_env_pdf(const fr_env *e, vec3 dir) {
-  if (e->black) return 0.0f;
-  if (!e->rgb) return 1.0f / (4.0f * PI_F);
-  float u, v, s;
-  int x, y;
-  to_uv(e, dir, &u, &v, &s);
-  texel(e, u, v, &x, &y);
-  if (!(s > 0.0f)) return 0.0f;
-  return fr_dist2d_pdf(&e->dist, x, y) / (2.0f * PI_F * PI_F * s);
+  float pdf;
+  fr_env_eval_pdf(e, dir, &pdf);
+  return pdf;
 }
 
 vec3 fr_env_eval_pdf(const fr_env *e, vec3 dir, float *pdf) {
@@ -131,16 +127,6 @@ vec3 fr_env_eval_smooth(const fr_env *e, vec3 dir) {
   if (!e->rgb) return v3_scale(e->color, e->intensity);
   float u, v, s;
   to_uv(e, dir, &u, &v, &s);
-  /* texel centres at (i + 0.5) / w: wrap around in u, clamp at the poles in v */
-  const float fx = u * (float)e->w - 0.5f, fy = v * (float)e->h - 0.5f;
-  const float x0f = floorf(fx), y0f = floorf(fy), ax = fx - x0f, ay = fy - y0f;
-  int x0 = (int)x0f, y0 = (int)y0f, x1 = x0 + 1, y1 = y0 + 1;
-  x0 = (x0 % e->w + e->w) % e->w, x1 = x1 % e->w;
-  y0 = y0 < 0 ? 0 : y0, y1 = y1 >= e->h ? e->h - 1 : y1;
-  const float *p00 = e->rgb + 3 * ((size_t)y0 * e->w + x0), *p01 = e->rgb + 3 * ((size_t)y0 * e->w + x1);
-  const float *p10 = e->rgb + 3 * ((size_t)y1 * e->w + x0), *p11 = e->rgb + 3 * ((size_t)y1 * e->w + x1);
-  float c[3];
-  for (int k = 0; k < 3; k++)
-    c[k] = (1.0f - ay) * ((1.0f - ax) * p00[k] + ax * p01[k]) + ay * ((1.0f - ax) * p10[k] + ax * p11[k]);
-  return v3_scale(v3(c[0], c[1], c[2]), e->intensity);
+  /* texel centres at (i + 0.5) / w: around in u, clamped at the poles in v */
+  return v3_scale(fr_rgb_bilinear(e->rgb, e->w, e->h, u * (float)e->w - 0.5f, v * (float)e->h - 0.5f, 1), e->intensity);
 }

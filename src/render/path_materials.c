@@ -24,19 +24,6 @@ static void showcase(const char *name, fr_bsdf *m) {
   }
 }
 
-static int in_list(const char *list, const char *name) {
-  if (!list) return 0;
-  const size_t n = strlen(name);
-  for (const char *p = list; *p;) {
-    const char *e = strchr(p, ',');
-    const size_t len = e ? (size_t)(e - p) : strlen(p);
-    if (len == n && !strncmp(p, name, n)) return 1;
-    if (!e) break;
-    p = e + 1;
-  }
-  return 0;
-}
-
 void fr_path_textures_free(fr_texture *t, size_t n) {
   for (size_t i = 0; t && i < n; i++) fr_texture_free(&t[i]);
   free(t);
@@ -81,10 +68,10 @@ fr_error fr_path_mats_build(const fr_scene *s, const char *mirror, const char *g
   for (size_t i = 0; i < nm; i++) {
     const fr_material *mt = fr_scene_material(s, i);
     m[i] = fr_bsdf_from_mtl(mt, 0.5f * scale);
-    if (in_list(glass, mt->name)) {
+    if (fr_names_contain(glass, mt->name)) {
       m[i] = fr_bsdf_default(FR_BSDF_GLASS);
       m[i].ior = mt->ior > 1.0f && mt->ior < 4.0f ? mt->ior : 1.5f;
-    } else if (in_list(mirror, mt->name)) {
+    } else if (fr_names_contain(mirror, mt->name)) {
       m[i] = fr_bsdf_default(FR_BSDF_METAL);
       fr_bsdf_metal_preset("chrome", &m[i]);
     }

@@ -60,3 +60,14 @@ void fr_view_surfaces(const char *name, const char **mirror, const char **glass)
   if (!strcmp(name, "kitchen")) { *mirror = "shiny_metal,metal"; *glass = "glass,glass_dragon"; }
   else if (!strcmp(name, "museum")) { *mirror = "museum5_0"; *glass = "museum5_1"; }
 }
+
+int fr_names_contain(const char *list, const char *name) {
+  const size_t n = strlen(name);
+  for (const char *p = list; p && *p;) {
+    const char *e = strchr(p, ',');
+    const size_t len = e ? (size_t)(e - p) : strlen(p);
+    if (len == n && !memcmp(p, name, n)) return 1;
+    p = e ? e + 1 : NULL;
+  }
+  return 0;
+}

@@ -16,6 +16,8 @@ int fr_view_lookup(const char *name, fr_view *v);
 /* The scenes README's mirror and glass materials of a shared scene, as
  * comma-separated names (left alone for a scene without suggestions). */
 void fr_view_surfaces(const char *name, const char **mirror, const char **glass);
+/* Whether name is one of the comma-separated names of list (NULL: none). */
+int fr_names_contain(const char *list, const char *name);
 /* A 3/4 view of the box with lights above it. */
 fr_view fr_view_from_bounds(aabb b);
 #endif

@@ -18,17 +18,6 @@
 
 /* ---- materials --------------------------------------------------------------- */
 
-static int in_list(const char *list, const char *name) {
-  size_t n = strlen(name);
-  for (const char *p = list; p && *p;) {
-    const char *e = strchr(p, ',');
-    size_t len = e ? (size_t)(e - p) : strlen(p);
-    if (len == n && !memcmp(p, name, n)) return 1;
-    p = e ? e + 1 : NULL;
-  }
-  return 0;
-}
-
 /* every name of list must be a material of s ("all" aside) */
 static fr_error check_list(const fr_scene *s, const char *list, const char *what) {
   for (const char *p = list; p && *p;) {
@@ -52,7 +41,7 @@ fr_error fr_whitted_mats_build(const fr_scene *s, const char *mirror, const char
   const int defaults = !mirror && !glass;
   if (defaults) fr_view_surfaces(s->name, &mirror, &glass);
   const int by_mtl = defaults && !mirror && !glass;
-  const int all = in_list(mirror, "all");
+  const int all = fr_names_contain(mirror, "all");
   size_t nm = fr_scene_material_count(s);
   out->mat = calloc(nm + 1, sizeof *out->mat);
   if (!out->mat) return fr_fail(FR_ERR_NOMEM, "out of memory for %zu materials", nm + 1);
@@ -68,8 +57,8 @@ fr_error fr_whitted_mats_build(const fr_scene *s, const char *mirror, const char
     w->ns = m ? m->shininess : 0.0f;
     w->ior = m && m->ior > 0.0f ? m->ior : 1.5f;
     float ks = fmaxf(w->ks[0], fmaxf(w->ks[1], w->ks[2])), kt = fmaxf(w->kt[0], fmaxf(w->kt[1], w->kt[2]));
-    int is_glass = m && (by_mtl ? kt > 0.0f : in_list(glass, m->name));
-    int is_mirror = all || (m && (by_mtl ? m->illum == 3 && ks > 0.0f : in_list(mirror, m->name)));
+    int is_glass = m && (by_mtl ? kt > 0.0f : fr_names_contain(glass, m->name));
+    int is_mirror = all || (m && (by_mtl ? m->illum == 3 && ks > 0.0f : fr_names_contain(mirror, m->name)));
     if (is_glass) {
       w->kind = FR_SURF_GLASS;
       /* glass named on the command line without a transmission of its own: clear */
