@@ -7,6 +7,7 @@
 #include <stb_image_write.h>
 #include "base/alloc.h"
 #include "base/error.h"
+#include "film/tonemap.h"
 #include "io/atomic_file.h"
 #include "io/file_read.h"
 
@@ -14,18 +15,11 @@ int fr_image_format_known(const char *path) {
   return fr_has_suffix(path, ".png") || fr_has_suffix(path, ".exr") || fr_has_suffix(path, ".pfm");
 }
 
-static unsigned char to_srgb8(float v) {
-  if (!(v > 0.0f)) return 0;
-  if (v >= 1.0f) return 255;
-  float s = v <= 0.0031308f ? 12.92f * v : 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;
-  return (unsigned char)(s * 255.0f + 0.5f);
-}
-
 static fr_error write_png(const char *tmp, int w, int h, const float *rgb) {
   size_t n = fr_mul_size(fr_mul_size((size_t)w, (size_t)h), 3);
   unsigned char *px = malloc(n);
   if (!px) return fr_fail(FR_ERR_NOMEM, "out of memory for the image");
-  for (size_t i = 0; i < n; i++) px[i] = to_srgb8(rgb[i]);
+  for (size_t i = 0; i < n; i++) px[i] = fr_srgb8(rgb[i]);
   int ok = stbi_write_png(tmp, w, h, 3, px, w * 3);
   free(px);
   return ok ? FR_OK : fr_fail(FR_ERR_IO, "%s: PNG write failed", tmp);

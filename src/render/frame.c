@@ -16,7 +16,7 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
   /* the ray sets of this frame, shared by every tile */
   fr_workload run = *w0, *w = &run;
   fr_mft_sets *sets = fr_alloc_aligned(2 * sizeof(fr_mft_sets), 64);
-  if (!sets) { fr_workload_result none = {0, 0.0, {0}}; return none; }
+  if (!sets) { fr_workload_result none = {0, 0.0, {0}, 0}; return none; }
   float e1[3] = {w->view.area_e1.x, w->view.area_e1.y, w->view.area_e1.z};
   float e2[3] = {w->view.area_e2.x, w->view.area_e2.y, w->view.area_e2.z};
   fr_mft_sets_light(&sets[0], e1, e2, w->seed, w->light_sets_kind);
@@ -28,7 +28,7 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
   const int ntiles = tiles_x * tiles_y;
   uint64_t total = 0;
   double stage[FR_STAGES] = {0};
-  int done = 0, last_pct = -1;
+  int done = 0, last_pct = -1, cancelled = 0;
   double t0 = fr_seconds();
   uint32_t *order = fr_tile_order(tiles_x, tiles_y);
 #pragma omp parallel num_threads(w->threads) reduction(+ : total)
@@ -39,6 +39,10 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
     fr_path_scratch *PS = path ? fr_path_scratch_new() : NULL;
 #pragma omp for schedule(dynamic, 1)
     for (int i = 0; i < ntiles; i++) {
+      if (w->cancel && __atomic_load_n(w->cancel, __ATOMIC_RELAXED)) {
+        __atomic_store_n(&cancelled, 1, __ATOMIC_RELAXED);
+        continue;
+      }
       const int k = order ? (int)order[i] : i;
       const int tx = (k % tiles_x) * tile, ty = (k / tiles_x) * tile;
       if (WS) total += fr_whitted_tile(w, t, WS, tx, ty);
@@ -69,7 +73,7 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
     fr_counters_flush();
 #endif
   }
-  fr_workload_result r = {total, fr_seconds() - t0, {0}};
+  fr_workload_result r = {total, fr_seconds() - t0, {0}, cancelled};
   free(order);
   memcpy(r.stage, stage, sizeof stage);
   if (w->progress && last_pct >= 0) fprintf(stderr, "\n");

@@ -24,7 +24,7 @@ typedef struct path_state {
   float pdf;       /* solid-angle pdf of the BSDF sample that made the ray (for MIS at an emitter it hits) */
   uint32_t sample; /* sample index within the pixel */
   uint32_t key;    /* the pixel's sampler key */
-  uint16_t pix;    /* pixel within the tile */
+  uint16_t slot;   /* (sample - first sample of the wave) * TILE_PIX + pixel within the tile */
   uint8_t delta;   /* the ray left a delta lobe (or the camera): emitters it hits count whole */
   uint8_t depth;   /* segments before this one */
 } path_state;
@@ -37,7 +37,11 @@ struct fr_path_scratch {
   uint8_t occ[WAVE];
   vec3 scontrib[WAVE];
   uint16_t spix[WAVE];
-  vec3 acc[TILE_PIX], alb[TILE_PIX], nrm[TILE_PIX];
+  /* per sample and pixel, so that a pixel's samples are summed in their
+   * order however many a wave holds: the image is the same bits for any
+   * split of the samples into calls */
+  vec3 acc[WAVE], alb[WAVE], nrm[WAVE];
+  float dep[WAVE];
   double stage[FR_STAGES];
 };
 
@@ -127,6 +131,8 @@ static vec3 to_world(vec3 w, vec3 t, vec3 b, vec3 n) {
 static int same_side(vec3 w, vec3 n, vec3 ng) { return (v3_dot(w, n) > 0.0f) == (v3_dot(w, ng) > 0.0f); }
 static int nonzero(vec3 c) { return c.x > 0.0f || c.y > 0.0f || c.z > 0.0f; }
 
+static void add3(float *dst, vec3 v) { dst[0] += v.x, dst[1] += v.y, dst[2] += v.z; }
+
 /* Pixel i of a tile, in blocks of 4x4 (consecutive 16 are coherent). */
 static void tile_pixel(int i, int *x, int *y) {
   const int b = i / 16, k = i % 16;
@@ -143,13 +149,15 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
   const float eps = w->eps;
   const int nlights = light_count(L);
   uint64_t rays = 0;
-  memset(S->acc, 0, sizeof S->acc);
-  memset(S->alb, 0, sizeof S->alb);
-  memset(S->nrm, 0, sizeof S->nrm);
   const vec3 ru = v3_norm(c->right), uu = v3_norm(c->up);
   for (int s0 = P->spp_begin; s0 < P->spp_end; s0 += FR_PATH_CHUNK) {
     const int s1 = s0 + FR_PATH_CHUNK < P->spp_end ? s0 + FR_PATH_CHUNK : P->spp_end;
     double t0 = fr_seconds();
+    const size_t nslot = (size_t)(s1 - s0) * TILE_PIX;
+    memset(S->acc, 0, nslot * sizeof S->acc[0]);
+    memset(S->alb, 0, nslot * sizeof S->alb[0]);
+    memset(S->nrm, 0, nslot * sizeof S->nrm[0]);
+    for (size_t k = 0; k < nslot; k++) S->dep[k] = FR_PATH_DEPTH_MISS;
     size_t n = 0;
     for (int s = s0; s < s1; s++)
       for (int i = 0; i < TILE_PIX; i++) {
@@ -171,7 +179,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
           d = v3_sub(focus, o);
         }
         S->ray[n] = make_ray(o, v3_norm(d), 0.0f, INFINITY);
-        S->st[n] = (path_state){v3(1, 1, 1), 0.0f, (uint32_t)s, key, (uint16_t)i, 1, 0};
+        S->st[n] = (path_state){v3(1, 1, 1), 0.0f, (uint32_t)s, key, (uint16_t)((s - s0) * TILE_PIX + i), 1, 0};
         n++;
       }
     for (int depth = 0; n; depth++) {
@@ -192,9 +200,10 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         /* the area light, which is not in the scene's geometry, in front of the hit */
         const float ta = L->area ? area_hit(L, o, d, r.tnear, tmax) : 0.0f;
         if (ta > 0.0f) { /* the lamp: it emits from its front, its back is dark */
+          if (depth == 0) S->dep[st.slot] = ta;
           if (v3_dot(d, v3_cross(L->area_e1, L->area_e2)) < 0.0f) {
             const float w_mis = st.delta ? 1.0f : power_heuristic(st.pdf, area_pdf(L, d, ta) / (float)nlights);
-            S->acc[st.pix] = v3_add(S->acc[st.pix], v3_scale(v3_mul(st.weight, L->area_radiance), w_mis));
+            S->acc[st.slot] = v3_add(S->acc[st.slot], v3_scale(v3_mul(st.weight, L->area_radiance), w_mis));
           }
           continue;
         }
@@ -203,7 +212,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
           const vec3 le = depth == 0 ? fr_env_eval_smooth(L->env, d) /* the background, seen */
                           : st.delta ? fr_env_eval(L->env, d) : fr_env_eval_pdf(L->env, d, &pe);
           const float w_mis = st.delta ? 1.0f : power_heuristic(st.pdf, pe / (float)nlights);
-          S->acc[st.pix] = v3_add(S->acc[st.pix], v3_scale(v3_mul(st.weight, le), w_mis));
+          S->acc[st.slot] = v3_add(S->acc[st.slot], v3_scale(v3_mul(st.weight, le), w_mis));
           continue;
         }
         const vec3 p = v3_add(o, v3_scale(d, h.t));
@@ -230,7 +239,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
           const vec3 a = m->attenuation_color;
           st.weight = v3_mul(st.weight, v3(powf(a.x, k), powf(a.y, k), powf(a.z, k)));
         }
-        if (front && nonzero(m->emission)) S->acc[st.pix] = v3_add(S->acc[st.pix], v3_mul(st.weight, m->emission));
+        if (front && nonzero(m->emission)) S->acc[st.slot] = v3_add(S->acc[st.slot], v3_mul(st.weight, m->emission));
         /* the shading frame: the outward normal for glass, else the side the
          * ray came from; the interpolated normal where the mesh has one and
          * it sees the ray on the same side as the geometric normal */
@@ -248,9 +257,10 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         const vec3 wo = to_local(v3_scale(d, -1.0f), tb, bb, n);
         fr_shading_point sp;
         fr_bsdf_prepare(m, p, &sp);
+        if (depth == 0) S->dep[st.slot] = h.t;
         if (depth == 0 && (w->gbuf_albedo || w->gbuf_normal)) {
-          S->alb[st.pix] = v3_add(S->alb[st.pix], fr_bsdf_albedo(m));
-          S->nrm[st.pix] = v3_add(S->nrm[st.pix], v3_dot(n, d) < 0.0f ? n : v3_scale(n, -1.0f)); /* facing the camera */
+          S->alb[st.slot] = v3_add(S->alb[st.slot], fr_bsdf_albedo(m));
+          S->nrm[st.slot] = v3_add(S->nrm[st.slot], v3_dot(n, d) < 0.0f ? n : v3_scale(n, -1.0f)); /* facing the camera */
         }
         const uint32_t dim = 2u + 4u * (uint32_t)depth;
         float uc, ul, u1, u2, v1, v2, ur, unused;
@@ -268,7 +278,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
               const float w_mis = delta ? 1.0f : power_heuristic(pl, pb);
               S->scontrib[ns] = v3_scale(v3_mul(v3_mul(st.weight, f), le), w_mis / pl);
               S->sray[ns] = make_ray(p, wi, eps, isinf(dist) ? INFINITY : dist * (1.0f - 1e-4f));
-              S->spix[ns++] = st.pix;
+              S->spix[ns++] = st.slot;
             }
           }
         }
@@ -304,16 +314,20 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
       S->stage[FR_STAGE_SHADOW] += t0 - t3;
       n = nn;
     }
-  }
-  for (int i = 0; i < TILE_PIX; i++) {
-    int x, y;
-    tile_pixel(i, &x, &y);
-    x += tx, y += ty;
-    if (x >= W || y >= H) continue;
-    const size_t o = 3 * ((size_t)y * (size_t)W + (size_t)x);
-    if (w->image) { w->image[o] += S->acc[i].x; w->image[o + 1] += S->acc[i].y; w->image[o + 2] += S->acc[i].z; }
-    if (w->gbuf_albedo) { w->gbuf_albedo[o] += S->alb[i].x; w->gbuf_albedo[o + 1] += S->alb[i].y; w->gbuf_albedo[o + 2] += S->alb[i].z; }
-    if (w->gbuf_normal) { w->gbuf_normal[o] += S->nrm[i].x; w->gbuf_normal[o + 1] += S->nrm[i].y; w->gbuf_normal[o + 2] += S->nrm[i].z; }
+    for (int i = 0; i < TILE_PIX; i++) {
+      int x, y;
+      tile_pixel(i, &x, &y);
+      x += tx, y += ty;
+      if (x >= W || y >= H) continue;
+      const size_t px = (size_t)y * (size_t)W + (size_t)x, o = 3 * px;
+      for (int s = 0; s < s1 - s0; s++) {
+        const size_t k = (size_t)s * TILE_PIX + (size_t)i;
+        if (w->image) add3(w->image + o, S->acc[k]);
+        if (w->gbuf_albedo) add3(w->gbuf_albedo + o, S->alb[k]);
+        if (w->gbuf_normal) add3(w->gbuf_normal + o, S->nrm[k]);
+        if (w->gbuf_depth) w->gbuf_depth[px] += S->dep[k];
+      }
+    }
   }
   return rays;
 }

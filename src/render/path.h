@@ -22,6 +22,7 @@
 #define FR_PATH_CHUNK 8          /* samples per pixel in one wave */
 #define FR_PATH_RR_WEIGHT 0.15f
 #define FR_PATH_MAX_DEPTH 64
+#define FR_PATH_DEPTH_MISS 1e30f /* the depth AOV of a sample that sees the environment */
 
 typedef struct fr_path_lights {
   const fr_env *env;            /* never NULL; a black one is not sampled */
@@ -65,7 +66,9 @@ void fr_path_scratch_free(fr_path_scratch *s);
 /* Adds what s's tiles spent tracing (camera, shadow, bounce rays) and shading to stage[]. */
 void fr_path_scratch_stages(const fr_path_scratch *s, double *stage);
 /* One 16x16 tile: adds the samples' radiance to w->image (sums, not
- * means) and, where set, first-hit albedo and normals to w->gbuf_albedo
- * and w->gbuf_normal; returns the rays traced. */
+ * means) and, where set, first-hit albedo, normal and distance to
+ * w->gbuf_albedo, gbuf_normal and gbuf_depth; returns the rays traced.
+ * Each pixel's samples are added one by one in sample order, so a run of
+ * samples split into calls any way sums to the same bits. */
 uint64_t fr_path_tile(const struct fr_workload *w, const struct fr_tracer *t, fr_path_scratch *s, int tx, int ty);
 #endif

@@ -49,6 +49,9 @@ typedef struct fr_workload {
    * walks the tree from the root and no shaft decides a fall-back, to
    * measure */
   int mft_no_shaft;
+  /* when set, tiles not yet begun are skipped once *cancel is nonzero (read
+   * atomically; another thread sets it): the frame is abandoned */
+  const int *cancel;
   /* path: materials, lights, samples (render/path.h) */
   const struct fr_path_setup *path;
   /* set by fr_workload_run for its tiles */
@@ -67,6 +70,7 @@ typedef struct fr_workload_result {
   uint64_t rays;
   double seconds;
   double stage[FR_STAGES]; /* the Whitted workload only (else 0) */
+  int cancelled;           /* *w->cancel was seen set: some tiles were not rendered */
 } fr_workload_result;
 
 fr_workload_result fr_workload_run(const fr_workload *w, const fr_tracer *t);

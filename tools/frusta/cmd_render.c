@@ -12,7 +12,11 @@
 #include "base/timer.h"
 #include "cli_path.h"
 #include "embree_tracer.h"
+#include "film/denoise.h"
+#include "film/tonemap.h"
+#include "io/file_read.h"
 #include "io/image_write.h"
+#include "render/progressive.h"
 #include "render/softshadow.h"
 #include "render/whitted.h"
 #include "render/workload.h"
@@ -65,12 +69,6 @@ done:
   return rc;
 }
 
-/* A filmic tone curve (Narkowicz's fit of ACES) after the exposure. */
-static float filmic(float x) {
-  x = x > 0.0f ? x : 0.0f;
-  return x * (2.51f * x + 0.03f) / (x * (2.43f * x + 0.59f) + 0.14f);
-}
-
 /* out with ".albedo.exr" for its extension */
 static void aov_name(const char *out, const char *kind, char *buf, size_t n) {
   const char *dot = strrchr(out, '.');
@@ -78,77 +76,103 @@ static void aov_name(const char *out, const char *kind, char *buf, size_t n) {
   snprintf(buf, n, "%.*s.%s.exr", stem, out, kind);
 }
 
-/* --shade path: passes of FR_PATH_CHUNK samples (so the sums, and the
- * image, are the same however the work is split), a progress line, the
- * mean written linear (EXR, PFM) or tone-mapped (PNG). */
-static int render_path(fr_scene *s, fr_workload *w, const cli_path *po, const char *out, int threads, int mode,
-                       int embree) {
+/* --shade path, ao, or softshadow with --denoise: passes summed
+ * (render/progressive.h; path's are of FR_PATH_CHUNK samples), a progress
+ * line, the mean optionally denoised, written linear (EXR, PFM) or
+ * tone-mapped (PNG, path only; the others are in [0, 1] already). */
+static int render_progressive(fr_scene *s, fr_workload *w, fr_shade_mode mode, const cli_path *po,
+                              const fr_softshadow_opts *so, int denoise, const char *out, int threads, int trace_mode,
+                              int embree, int mft) {
   const size_t np = (size_t)w->cam.width * (size_t)w->cam.height;
+  const int path = mode == FR_SM_PATH;
   cli_path_run run;
-  int rc = cli_path_setup(po, w, &run);
+  memset(&run, 0, sizeof run);
+  int rc = path ? cli_path_setup(po, w, &run) : 0;
   if (rc) return rc;
   char albedo_out[4096], normal_out[4096];
   aov_name(out, "albedo", albedo_out, sizeof albedo_out);
   aov_name(out, "normal", normal_out, sizeof normal_out);
-  w->image = calloc(np * 3, sizeof(float));
-  if (po->aov) { w->gbuf_albedo = calloc(np * 3, sizeof(float)); w->gbuf_normal = calloc(np * 3, sizeof(float)); }
-  if (!w->image || (po->aov && (!w->gbuf_albedo || !w->gbuf_normal))) {
+  float *img = malloc(np * 10 * sizeof(float));
+  fr_progressive p;
+  memset(&p, 0, sizeof p);
+  fr_denoiser *dn = NULL;
+  ebr_scene *e = NULL;
+  if (!img || fr_progressive_init(&p, w, mode) || (denoise && fr_denoiser_new(w->cam.width, w->cam.height, &dn))) {
     rc = cli_error(1, "out of memory for a %dx%d image", w->cam.width, w->cam.height);
     goto done;
   }
+  float *albedo = img + 3 * np, *normal = img + 6 * np, *depth = img + 9 * np;
   static const char *const mode_names[] = {"auto", "single", "packet8", "packet16", "hybrid16", "raystream"};
-  ebr_scene *e = NULL;
   if (embree) {
     ebr_options eo = {.threads = threads, .quality = 2}; /* high quality, not robust: Embree's fastest */
     if (ebr_create(s, eo, &e)) { rc = cli_error(1, "embree: cannot build the scene"); goto done; }
-  } else if (fr_scene_set_trace_mode(s, (fr_trace_mode)mode)) {
+  } else if (fr_scene_set_trace_mode(s, (fr_trace_mode)trace_mode)) {
     rc = cli_error(1, "%s", fr_last_error());
     goto done;
   }
-  fr_tracer t = e ? ebr_tracer(e, EBR_STREAM, EBR_FLAG_HINT, EBR_PACK_RAYS) : fr_tracer_frusta(s);
-  fr_path_setup *P = &run.setup;
-  const int spp = P->spp;
-  w->progress = 0;
+  /* camera rays (and soft shadows) as multi-frusta, as the other shades
+   * trace them, unless the scene has spheres; paths trace streams only */
+  fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
+  const int use_mft = !e && mft != 0 && mode != FR_SM_PATH && !fr_scene_sphere_count(s);
+  fr_tracer t = e ? ebr_tracer(e, EBR_STREAM, EBR_FLAG_HINT, EBR_PACK_RAYS) : use_mft ? fr_tracer_mft(&mctx) : fr_tracer_frusta(s);
+  p.w.progress = 0;
+  int passes;
+  if (path) {
+    p.spp_per_pass = FR_PATH_CHUNK;
+    passes = (run.setup.spp + FR_PATH_CHUNK - 1) / FR_PATH_CHUNK;
+  } else if (mode == FR_SM_SOFTSHADOW) {
+    const fr_softshadow_opts used = fr_softshadow_used(so);
+    p.soft = used;
+    passes = used.samples / 16;
+    p.soft_preview = passes == 1;
+  } else {
+    passes = po->spp / 16;
+  }
   uint64_t rays = 0;
   const double t0 = fr_seconds();
   double last = t0;
   const int tty = isatty(fileno(stderr)); /* the progress line is for a person watching */
-  for (int s0 = 0; s0 < spp; s0 += FR_PATH_CHUNK) {
-    P->spp_begin = s0;
-    P->spp_end = s0 + FR_PATH_CHUNK < spp ? s0 + FR_PATH_CHUNK : spp;
-    rays += fr_workload_run(w, &t).rays;
+  for (int k = 0; k < passes; k++) {
+    fr_workload_result r;
+    fr_progressive_pass(&p, &t, NULL, &r);
+    rays += r.rays;
     const double now = fr_seconds();
-    if (tty && (now - last > 0.5 || P->spp_end == spp)) {
+    if (tty && (now - last > 0.5 || k + 1 == passes)) {
       last = now;
-      const double el = now - t0, left = el / P->spp_end * (spp - P->spp_end);
-      fprintf(stderr, "\rpath: %d/%d spp  %.1f Mrays/s  %.1f s, %.1f s left  ", P->spp_end, spp, rays / el * 1e-6, el, left);
+      const double el = now - t0, left = el / (k + 1) * (passes - k - 1);
+      fprintf(stderr, "\r%s: %d/%d passes  %.1f Mrays/s  %.1f s, %.1f s left  ", fr_shade_mode_name(mode), k + 1, passes,
+              rays / el * 1e-6, el, left);
       fflush(stderr);
     }
   }
   if (tty) fprintf(stderr, "\n");
-  const double seconds = fr_seconds() - t0;
-  const float inv = 1.0f / (float)spp, gain = exp2f(po->exposure);
-  const int png = !strcmp(out + (strlen(out) >= 4 ? strlen(out) - 4 : 0), ".png");
-  for (size_t i = 0; i < 3 * np; i++) {
-    w->image[i] *= inv;
-    if (png) w->image[i] = filmic(w->image[i] * gain);
-    if (po->aov) { w->gbuf_albedo[i] *= inv; w->gbuf_normal[i] *= inv; }
+  fr_progressive_resolve(&p, img, albedo, normal, depth);
+  const double render_seconds = fr_seconds() - t0;
+  double denoise_seconds = 0.0;
+  if (dn) {
+    const double t1 = fr_seconds();
+    fr_denoise(dn, img, albedo, normal, depth, fr_progressive_spp(&p), threads, img);
+    denoise_seconds = fr_seconds() - t1;
   }
-  if (fr_image_write(out, w->cam.width, w->cam.height, w->image) ||
-      (po->aov && (fr_image_write(albedo_out, w->cam.width, w->cam.height, w->gbuf_albedo) ||
-                   fr_image_write(normal_out, w->cam.width, w->cam.height, w->gbuf_normal)))) {
+  const int png = fr_has_suffix(out, ".png");
+  if (path && png) fr_tonemap_filmic(img, 3 * np, po->exposure);
+  if (fr_image_write(out, w->cam.width, w->cam.height, img) ||
+      (path && po->aov && (fr_image_write(albedo_out, w->cam.width, w->cam.height, albedo) ||
+                           fr_image_write(normal_out, w->cam.width, w->cam.height, normal)))) {
     rc = cli_error(1, "%s", fr_last_error());
     goto done;
   }
-  printf("rendered scene=%s tris=%zu size=%dx%d shade=path spp=%d tracer=%s mode=%s isa=%s threads=%d "
-         "build_seconds=%.3f rays=%llu seconds=%.3f mrays=%.2f -> %s%s%s%s%s\n",
-         s->name, fr_scene_triangle_count(s), w->cam.width, w->cam.height, spp, e ? "embree" : "frusta",
-         e ? "stream" : mode_names[mode],
-         fr_isa_name(fr_get_isa()), threads, s->build_seconds, (unsigned long long)rays, seconds, rays / seconds * 1e-6, out,
-         po->aov ? " " : "", po->aov ? albedo_out : "", po->aov ? " " : "", po->aov ? normal_out : "");
+  printf("rendered scene=%s tris=%zu size=%dx%d shade=%s spp=%d tracer=%s mode=%s isa=%s threads=%d "
+         "build_seconds=%.3f rays=%llu seconds=%.3f mrays=%.2f denoise_seconds=%.4f -> %s%s%s%s%s\n",
+         s->name, fr_scene_triangle_count(s), w->cam.width, w->cam.height, fr_shade_mode_name(mode), fr_progressive_spp(&p),
+         e ? "embree" : "frusta", e ? "stream" : use_mft ? "mft" : mode_names[trace_mode], fr_isa_name(fr_get_isa()),
+         threads, s->build_seconds, (unsigned long long)rays, render_seconds, rays / render_seconds * 1e-6,
+         denoise_seconds, out, path && po->aov ? " " : "", path && po->aov ? albedo_out : "",
+         path && po->aov ? " " : "", path && po->aov ? normal_out : "");
 done:
-  free(w->image); free(w->gbuf_albedo); free(w->gbuf_normal);
-  w->image = w->gbuf_albedo = w->gbuf_normal = NULL;
+  free(img);
+  fr_progressive_free(&p);
+  fr_denoiser_free(dn);
   ebr_release(e);
   cli_path_free(&run);
   return rc;
@@ -162,23 +186,29 @@ int cmd_render(int argc, char **argv) {
   const char *scene = a.pos[0], *out = a.val[F_OUT], *ref_out = a.val[F_REFERENCE_OUT];
   int threads = omp_get_num_procs(), mft = -1; /* -1: not given */
   fr_softshadow_opts so = {16, 1, FR_LIGHT_SETS_CELLS};
-  static const char *const shades[] = {"eyelight", "normals", "shadows", "softshadow", "whitted", "path"};
+  static const char *const shades[] = {"eyelight", "normals", "shadows", "softshadow", "whitted", "ao", "path"}; /* fr_shade_mode order */
   static const char *const sets[] = {"cells", "spread"}; /* FR_LIGHT_SETS_CELLS, _SPREAD */
-  int shade = 0, set = 0, mode = 0, embree = 0;
+  int shade = 0, set = 0, mode = 0, embree = 0, denoise = 0;
   static const char *const modes[] = {"auto", "single", "packet8", "packet16", "hybrid16", "raystream"}; /* fr_trace_mode order */
   static const char *const tracers[] = {"frusta", "embree"};
   cli_view v;
   cli_whitted wo;
   cli_path po;
   if ((rc = cli_view_from_args(&a, &v)) || (rc = cli_whitted_from_args(&a, &wo)) || (rc = cli_path_from_args(&a, &po)) ||
-      (rc = cli_common_from_args(&a, &threads)) || (rc = cli_arg_choice(&a, F_SHADE, shades, 6, &shade)) ||
+      (rc = cli_common_from_args(&a, &threads)) || (rc = cli_arg_choice(&a, F_SHADE, shades, 7, &shade)) ||
       (rc = cli_arg_choice(&a, F_LIGHT_SETS, sets, 2, &set)) || (rc = cli_arg_onoff(&a, F_FILTER, &so.filter)) ||
       (rc = cli_arg_onoff(&a, F_MFT, &mft)) || (rc = cli_arg_int(&a, F_LIGHT_SAMPLES, 16, 4096, &so.samples)) ||
-      (rc = cli_arg_choice(&a, F_MODE, modes, 6, &mode)) || (rc = cli_arg_choice(&a, F_TRACER, tracers, 2, &embree)))
+      (rc = cli_arg_choice(&a, F_MODE, modes, 6, &mode)) || (rc = cli_arg_choice(&a, F_TRACER, tracers, 2, &embree)) ||
+      (rc = cli_arg_onoff(&a, F_DENOISE, &denoise)))
     return rc;
-  if ((a.val[F_MODE] || a.val[F_TRACER]) && shade != 5)
+  if ((a.val[F_MODE] || a.val[F_TRACER]) && shade != FR_SM_PATH)
     return cli_error(CLI_USAGE_ERROR, "--mode and --tracer choose how --shade path traces; other shades take --mft");
   if (a.val[F_MODE] && embree) return cli_error(CLI_USAGE_ERROR, "--mode is frusta's; --tracer embree traces streams");
+  if (denoise && !fr_shade_mode_progressive((fr_shade_mode)shade))
+    return cli_error(CLI_USAGE_ERROR, "--denoise is for path, ao and softshadow, not %s", shades[shade]);
+  if (denoise && ref_out) return cli_error(CLI_USAGE_ERROR, "--reference-out and --denoise: give one");
+  if (shade == FR_SM_AO && po.spp % 16)
+    return cli_error(CLI_USAGE_ERROR, "ao: --spp wants a multiple of 16 (hemisphere rays per pixel), got '%s'", a.val[F_SPP]);
   so.sets = set ? FR_LIGHT_SETS_SPREAD : FR_LIGHT_SETS_CELLS;
   if (so.samples % 16)
     return cli_error(CLI_USAGE_ERROR, "--light-samples wants a multiple of 16 (16..4096), got '%s'", a.val[F_LIGHT_SAMPLES]);
@@ -188,8 +218,10 @@ int cmd_render(int argc, char **argv) {
   if (!fr_image_format_known(out)) return cli_error(CLI_USAGE_ERROR, "%s: unknown image format (use .png, .exr or .pfm)", out);
   if (ref_out && !fr_image_format_known(ref_out))
     return cli_error(CLI_USAGE_ERROR, "%s: unknown image format (use .png, .exr or .pfm)", ref_out);
-  static const fr_workload_kind kinds[] = {FR_WL_PRIMARY, FR_WL_PRIMARY, FR_WL_SHADOW, FR_WL_SOFT16, FR_WL_WHITTED, FR_WL_PATH};
-  static const fr_shade shading[] = {FR_SHADE_EYELIGHT, FR_SHADE_NORMALS, FR_SHADE_LIGHT, FR_SHADE_LIGHT, FR_SHADE_LIGHT, FR_SHADE_LIGHT};
+  static const fr_workload_kind kinds[] = {FR_WL_PRIMARY, FR_WL_PRIMARY, FR_WL_SHADOW, FR_WL_SOFT16,
+                                           FR_WL_WHITTED, FR_WL_AO16,    FR_WL_PATH};
+  static const fr_shade shading[] = {FR_SHADE_EYELIGHT, FR_SHADE_NORMALS, FR_SHADE_LIGHT, FR_SHADE_LIGHT,
+                                     FR_SHADE_LIGHT,    FR_SHADE_LIGHT,   FR_SHADE_LIGHT};
   fr_workload w;
   memset(&w, 0, sizeof w);
   w.kind = kinds[shade];
@@ -200,14 +232,14 @@ int cmd_render(int argc, char **argv) {
   if (rc) return rc;
   w.seed = 1;
   w.progress = 1;
-  if (w.kind == FR_WL_SOFT16) {
-    /* multi-frusta tracing does not see spheres: such scenes go the packet way */
-    rc = render_soft(s, &w, &so, mft != 0 && !fr_scene_sphere_count(s), out, ref_out, threads);
+  if (shade == FR_SM_PATH || shade == FR_SM_AO || (shade == FR_SM_SOFTSHADOW && denoise)) {
+    rc = render_progressive(s, &w, (fr_shade_mode)shade, &po, &so, denoise, out, threads, mode, embree, mft);
     fr_scene_release(s);
     return rc;
   }
-  if (w.kind == FR_WL_PATH) {
-    rc = render_path(s, &w, &po, out, threads, mode, embree);
+  if (w.kind == FR_WL_SOFT16) {
+    /* multi-frusta tracing does not see spheres: such scenes go the packet way */
+    rc = render_soft(s, &w, &so, mft != 0 && !fr_scene_sphere_count(s), out, ref_out, threads);
     fr_scene_release(s);
     return rc;
   }

@@ -8,7 +8,7 @@
 #include <stdio.h>
 
 /* The subcommands, as bits of cli_flag.cmds. */
-typedef enum cli_cmd { CLI_RENDER = 1, CLI_BENCH = 2, CLI_TRACE = 4, CLI_STATS = 8 } cli_cmd;
+typedef enum cli_cmd { CLI_RENDER = 1, CLI_BENCH = 2, CLI_TRACE = 4, CLI_STATS = 8, CLI_VIEW = 16 } cli_cmd;
 
 typedef enum cli_flag_id {
   /* scene and view */
@@ -17,7 +17,9 @@ typedef enum cli_flag_id {
   F_OUT, F_SHADE, F_LIGHT_SAMPLES, F_FILTER, F_LIGHT_SETS, F_MFT, F_REFERENCE_OUT,
   /* path tracing */
   F_SPP, F_MAX_DEPTH, F_ENV, F_ENV_COLOR, F_ENV_INTENSITY, F_ENV_ROTATE, F_LIGHTS, F_APERTURE, F_FOCUS, F_SAMPLER,
-  F_SEED, F_AOV, F_EXPOSURE,
+  F_SEED, F_AOV, F_EXPOSURE, F_DENOISE,
+  /* view */
+  F_FRAMES, F_CAMERA_PATH, F_TURNTABLE, F_SCREENSHOT, F_RECORD,
   /* Whitted and large packets */
   F_MIRROR, F_GLASS, F_DEPTH, F_PACKET, F_TRAVERSAL, F_CULL,
   /* bench, trace and stats */
