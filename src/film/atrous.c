@@ -4,9 +4,10 @@
  *   kernel  (1/4, 1/2, 1/4) per axis
  *   normal  max(0, n_p . n_q)^16
  *   depth   max(0, 1 - |z_p - z_q| / (sigma_z * zgrad_p * distance + 1e-3 z_p))
- *   colour  max(0, 1 - |l_p - l_q| / (sigma_l * (l_p + l_q) + 1e-4))
- * Polynomial falloffs rather than exponentials keep the loop to adds,
- * multiplies and one division per tap.
+ *   colour  max(0, 1 - |l_p - l_q| / (2 sigma_l l_p + 1e-4))
+ * Polynomial falloffs rather than exponentials, and denominators that
+ * depend on p and the tap's distance only (four divisions per pixel),
+ * keep the taps to adds and multiplies.
  */
 #include "film/atrous.h"
 #include "base/simd.h"
@@ -27,6 +28,10 @@ void FR_ISA_FN(fr_atrous_rows)(const fr_atrous_level *L, int y0, int y1) {
       const vpf npx = vp_load(L->nrm[0] + o), npy = vp_load(L->nrm[1] + o), npz = vp_load(L->nrm[2] + o);
       const vpf cr = vp_load(L->in[0] + o), cg = vp_load(L->in[1] + o), cb = vp_load(L->in[2] + o);
       const vpf lp = luminance(cr, cg, cb);
+      const vpf inv_l = vp_div(one, vp_add(vp_mul(vp(2.0f * L->sigma_l), lp), vp(1e-4f)));
+      vpf inv_z[3]; /* by the tap's distance in steps: 0, 1 or 2 */
+      for (int k = 0; k < 3; k++)
+        inv_z[k] = vp_div(one, vp_add(vp_add(vp_mul(vp(L->sigma_z * (float)(s * k)), gp), vp_mul(vp(1e-3f), zp)), vp(1e-20f)));
       vpf sr = zero, sg = zero, sb = zero, sw = zero;
       for (int j = -1; j <= 1; j++)
         for (int i = -1; i <= 1; i++) {
@@ -37,12 +42,8 @@ void FR_ISA_FN(fr_atrous_rows)(const fr_atrous_level *L, int y0, int y1) {
                           vp_mul(npz, vp_loadu(L->nrm[2] + q)));
           dn = vp_max(zero, dn);
           dn = vp_mul(dn, dn), dn = vp_mul(dn, dn), dn = vp_mul(dn, dn), dn = vp_mul(dn, dn);
-          const float dist = (float)(s * ((i != 0) + (j != 0)));
-          const vpf zs = vp_add(vp_mul(vp(L->sigma_z * dist), gp), vp_mul(vp(1e-3f), zp));
-          const vpf wz = vp_max(zero, vp_sub(one, vp_div(vp_abs(vp_sub(zp, zq)), vp_add(zs, vp(1e-20f)))));
-          const vpf lq = luminance(qr, qg, qb);
-          const vpf ls = vp_add(vp_mul(vp(L->sigma_l), vp_add(lp, lq)), vp(1e-4f));
-          const vpf wl = vp_max(zero, vp_sub(one, vp_div(vp_abs(vp_sub(lp, lq)), ls)));
+          const vpf wz = vp_max(zero, vp_sub(one, vp_mul(vp_abs(vp_sub(zp, zq)), inv_z[(i != 0) + (j != 0)])));
+          const vpf wl = vp_max(zero, vp_sub(one, vp_mul(vp_abs(vp_sub(lp, luminance(qr, qg, qb))), inv_l)));
           const vpf w = vp_mul(vp(kern[i + 1] * kern[j + 1]), vp_mul(dn, vp_mul(wz, wl)));
           sr = vp_add(sr, vp_mul(w, qr)), sg = vp_add(sg, vp_mul(w, qg)), sb = vp_add(sb, vp_mul(w, qb));
           sw = vp_add(sw, w);

@@ -10,6 +10,11 @@
 #define MISS 1e30f /* FR_DEPTH_MISS of render/progressive.h */
 #define ALBEDO_MIN 0.01f /* dividing by less would amplify noise on black surfaces */
 
+/* max and min as compares (fmaxf and fminf are calls at this ISA level) */
+static inline float maxf(float a, float b) { return a > b ? a : b; }
+static inline float minf(float a, float b) { return a < b ? a : b; }
+static inline float absf(float a) { return a < 0.0f ? -a : a; }
+
 enum { P_IN0, P_IN1, P_IN2, P_TMP0, P_TMP1, P_TMP2, P_N0, P_N1, P_N2, P_Z, P_ZG, P_COUNT };
 
 struct fr_denoiser {
@@ -57,24 +62,46 @@ static size_t at(const fr_denoiser *d, int x, int y) {
   return (size_t)(y + FR_ATROUS_PAD) * d->stride + (size_t)(x + FR_ATROUS_PAD);
 }
 
-/* Depth change per pixel step at (x, y): the smaller one-sided difference
- * on each axis (a silhouette on one side does not count), the larger axis. */
-static float depth_gradient(const fr_denoiser *d, const float *depth, int x, int y) {
-  const int W = d->width, H = d->height;
-  const float z = depth[(size_t)y * W + x];
-  float g[2];
-  for (int axis = 0; axis < 2; axis++) {
-    float best = INFINITY;
-    for (int sgn = -1; sgn <= 1; sgn += 2) {
-      const int xx = x + (axis == 0 ? sgn : 0), yy = y + (axis == 1 ? sgn : 0);
-      if (xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
-      const float zq = depth[(size_t)yy * W + xx];
-      if (zq >= 1e29f) continue;
-      best = fminf(best, fabsf(zq - z));
+/* Row y of the image into the planes: illumination (colour over albedo;
+ * non-finite colour as 0), unit normals, depth (MISS for background,
+ * whose colour is kept as it is). */
+static void split_row(const fr_denoiser *d, const float *rgb, const float *albedo, const float *normal, const float *depth,
+                      int y) {
+  const size_t o = at(d, 0, y);
+  float *in0 = d->p[P_IN0] + o, *in1 = d->p[P_IN1] + o, *in2 = d->p[P_IN2] + o;
+  float *n0 = d->p[P_N0] + o, *n1 = d->p[P_N1] + o, *n2 = d->p[P_N2] + o, *z = d->p[P_Z] + o;
+  for (int x = 0; x < d->width; x++) {
+    const float *c = rgb + 3 * x, *a = albedo + 3 * x, *n = normal + 3 * x;
+    const float zz = depth[x];
+    const int hit = zz < 1e29f; /* NaN: background */
+    const float len2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    const float inv = hit && len2 > 0.0f ? 1.0f / sqrtf(len2) : 0.0f;
+    float v[3];
+    for (int k = 0; k < 3; k++) {
+      const float ck = c[k] - c[k] == 0.0f ? c[k] : 0.0f; /* inf and NaN: 0 */
+      v[k] = hit ? ck / maxf(a[k], ALBEDO_MIN) : c[k];
     }
-    g[axis] = isfinite(best) ? best : 0.0f;
+    in0[x] = v[0], in1[x] = v[1], in2[x] = v[2];
+    n0[x] = n[0] * inv, n1[x] = n[1] * inv, n2[x] = n[2] * inv;
+    z[x] = hit ? zz : MISS;
   }
-  return fmaxf(g[0], g[1]);
+}
+
+/* The depth change per pixel step of row y (from the padded depth plane,
+ * background MISS): on each axis the smaller one-sided difference (a
+ * silhouette on one side does not count; background on both: none), the
+ * larger axis. */
+static void depth_gradient_row(const fr_denoiser *d, int y) {
+  const float *z = d->p[P_Z] + at(d, 0, y);
+  float *g = d->p[P_ZG] + at(d, 0, y);
+  const ptrdiff_t st = (ptrdiff_t)d->stride;
+  for (int x = 0; x < d->width; x++) {
+    const float c = z[x];
+    const float gx = minf(absf(z[x - 1] - c), absf(z[x + 1] - c));
+    const float gy = minf(absf(z[x - st] - c), absf(z[x + st] - c));
+    const float ax = gx < 1e28f ? gx : 0.0f, ay = gy < 1e28f ? gy : 0.0f;
+    g[x] = c < 1e29f ? maxf(ax, ay) : 0.0f;
+  }
 }
 
 void fr_denoise(fr_denoiser *d, const float *rgb, const float *albedo, const float *normal, const float *depth, int spp,
@@ -82,23 +109,12 @@ void fr_denoise(fr_denoiser *d, const float *rgb, const float *albedo, const flo
   const int W = d->width, H = d->height;
   float **p = d->p;
 #pragma omp parallel for num_threads(threads) schedule(static)
-  for (int y = 0; y < H; y++)
-    for (int x = 0; x < W; x++) {
-      const size_t i = (size_t)y * W + x, o = at(d, x, y);
-      const float z = depth[i];
-      const int hit = z < 1e29f && isfinite(z);
-      float n[3] = {normal[3 * i], normal[3 * i + 1], normal[3 * i + 2]};
-      const float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-      for (int c = 0; c < 3; c++) {
-        const float v = rgb[3 * i + c];
-        p[P_IN0 + c][o] = hit ? (isfinite(v) ? v : 0.0f) / fmaxf(albedo[3 * i + c], ALBEDO_MIN) : v;
-        p[P_N0 + c][o] = hit && len > 0.0f ? n[c] / len : 0.0f;
-      }
-      p[P_Z][o] = hit ? z : MISS;
-      p[P_ZG][o] = hit ? depth_gradient(d, depth, x, y) : 0.0f;
-    }
+  for (int y = 0; y < H; y++) split_row(d, rgb + 3 * (size_t)y * W, albedo + 3 * (size_t)y * W, normal + 3 * (size_t)y * W,
+                                        depth + (size_t)y * W, y);
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (int y = 0; y < H; y++) depth_gradient_row(d, y);
   /* luminance is trusted more as samples add up: noise falls as 1/sqrt(spp) */
-  const float sigma_l0 = 2.0f / sqrtf((float)(spp > 1 ? spp : 1));
+  const float sigma_l0 = 4.0f / sqrtf((float)(spp > 1 ? spp : 1));
   float *src[3] = {p[P_IN0], p[P_IN1], p[P_IN2]}, *dst[3] = {p[P_TMP0], p[P_TMP1], p[P_TMP2]};
   for (int level = 0; level < FR_DENOISE_LEVELS; level++) {
     fr_atrous_level L = {{src[0], src[1], src[2]}, {dst[0], dst[1], dst[2]}, {p[P_N0], p[P_N1], p[P_N2]}, p[P_Z], p[P_ZG],
@@ -113,6 +129,6 @@ void fr_denoise(fr_denoiser *d, const float *rgb, const float *albedo, const flo
     for (int x = 0; x < W; x++) {
       const size_t i = (size_t)y * W + x, o = at(d, x, y);
       const int hit = p[P_Z][o] < 1e29f;
-      for (int c = 0; c < 3; c++) out[3 * i + c] = hit ? src[c][o] * fmaxf(albedo[3 * i + c], ALBEDO_MIN) : src[c][o];
+      for (int c = 0; c < 3; c++) out[3 * i + c] = hit ? src[c][o] * maxf(albedo[3 * i + c], ALBEDO_MIN) : src[c][o];
     }
 }
