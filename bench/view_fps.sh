@@ -32,7 +32,7 @@ echo "|---|---|---|---|---|---|"
 run() { # LABEL TARGET SCENE [flags]
   local label=$1 target=$2 scene=$3; shift 3
   "$F" view "$scene" --size 1024x768 --threads 2 --frames "$FRAMES" --turntable 0.5 "$@" >"$RAW.tmp"
-  sed "s/^/case=$label /" "$RAW.tmp" | grep -E 'case=[^ ]+ (frame|view)' >>"$RAW"
+  grep -E '^(frame|view) ' "$RAW.tmp" | sed "s/^/case=${label// /} /" >>"$RAW"
   # the first frame builds caches and sets up materials: the rest are timed
   awk -v label="$label" -v target="$target" '
     /^frame / { if ($2 != "0:") { n++; t += $3; r += $6; d += $9 } }

@@ -37,9 +37,24 @@ if [ "${FRUSTA_TSAN_TESTS:-1}" != 0 ]; then
   "$TSAN/frusta" render --builtin=materials --shade path --spp 2 --size 64x32 --threads 4 --out "$out/path.png" >/dev/null
   "$TSAN/frusta" bench --builtin --workload all --mode all --threads 4 --size 64x64 --repeat 1 >/dev/null
   "$TSAN/frusta" bench --builtin=materials --workload path --mode all --threads 4 --size 32x32 --spp 2 --repeat 1 >/dev/null
+  # the viewer: its worker and the main thread, with keys typed into the
+  # window switching modes and abandoning passes
+  D=$((100 + $$ % 800))
+  Xvfb ":$D" -screen 0 800x600x24 -nolisten tcp >/dev/null 2>&1 &
+  XPID=$!
+  for _ in $(seq 100); do [ -e "/tmp/.X11-unix/X$D" ] && break; sleep 0.1; done
+  mkdir -m 700 "$out/xdg"
+  DISPLAY=":$D" XDG_RUNTIME_DIR="$out/xdg" "$TSAN/frusta" view --builtin --size 96x64 --threads 4 --shade path >/dev/null &
+  VP=$!
+  sleep 3
+  for k in 2 w 7 m m 4 6 n 1 5; do DISPLAY=":$D" xdotool search --sync --name frusta key $k >/dev/null 2>&1; sleep 0.3; done
+  kill -TERM $VP
+  vstatus=0; wait $VP || vstatus=$?
+  kill $XPID
+  [ "$vstatus" -eq 0 ] || { echo "ThreadSanitizer: the viewer exited $vstatus"; exit 1; }
   rm -rf "$out"
   unset TSAN_OPTIONS OMP_TOOL_LIBRARIES
-  echo "ThreadSanitizer: threads, hybrid tuning, render and bench on 4 threads: no report"
+  echo "ThreadSanitizer: threads, hybrid tuning, render, bench and view on 4 threads: no report"
 fi
 FUZZ_SECONDS="${FRUSTA_FUZZ_SECONDS:-60}"
 if [ "$FUZZ_SECONDS" != 0 ]; then
