@@ -203,31 +203,52 @@ static void samplers_stratify(void **st) {
         }
 }
 
+/* The built-in materials scene set up for path tracing: a constant sky,
+ * the scene's lamp and point light, 8 samples of the given sampler. */
+typedef struct materials_scene {
+  fr_scene *s;
+  fr_bsdf *mats;
+  fr_texture *tex;
+  size_t count, ntex, nsurf;
+  fr_surface *surf;
+  fr_env env;
+  fr_path_setup P;
+  fr_workload w;
+} materials_scene;
+
+static void materials_scene_setup(materials_scene *m, fr_sampler_kind sampler, uint32_t seed) {
+  memset(m, 0, sizeof *m);
+  assert_int_equal(fr_scene_builtin_materials(&m->s), FR_OK);
+  assert_int_equal(fr_scene_commit(m->s), FR_OK);
+  assert_int_equal(fr_path_mats_build(m->s, NULL, NULL, &m->mats, &m->count, &m->tex, &m->ntex), FR_OK);
+  assert_int_equal(m->ntex, 0);
+  fr_env_constant(&m->env, v3(0.6f, 0.7f, 1.0f));
+  fr_view v;
+  assert_true(fr_view_lookup("materials", &v));
+  assert_int_equal(fr_surfaces_build(m->s, (int32_t)m->count - 1, &m->surf, &m->nsurf), FR_OK);
+  const fr_path_lights L = {&m->env, 1, v.area_c, v.area_e1, v.area_e2, v3(20, 20, 20), 1, v.light, v3(50, 50, 50)};
+  m->P = (fr_path_setup){.mats = m->mats, .count = m->count, .surf = m->surf, .nsurf = m->nsurf, .lights = L,
+                         .max_depth = 13, .sampler = sampler, .seed = seed, .spp = 8, .spp_begin = 0, .spp_end = 8};
+  m->w.kind = FR_WL_PATH, m->w.scene = m->s, m->w.view = v, m->w.eps = 1e-4f * 60.0f, m->w.path = &m->P;
+}
+
+static void materials_scene_free(materials_scene *m) {
+  free(m->mats);
+  free(m->surf);
+  fr_path_textures_free(m->tex, m->ntex);
+  fr_env_free(&m->env);
+  fr_scene_release(m->s);
+}
+
 /* The same image on 1 and 3 threads, in every trace mode, and through Embree. */
 static void same_image_everywhere(void **st) {
   (void)st;
-  fr_scene *s;
-  assert_int_equal(fr_scene_builtin_materials(&s), FR_OK);
-  assert_int_equal(fr_scene_commit(s), FR_OK);
-  fr_bsdf *mats;
-  size_t count;
-  fr_texture *tex;
-  size_t ntex;
-  assert_int_equal(fr_path_mats_build(s, NULL, NULL, &mats, &count, &tex, &ntex), FR_OK);
-  assert_int_equal(ntex, 0);
-  fr_env env;
-  fr_env_constant(&env, v3(0.6f, 0.7f, 1.0f));
-  fr_view v;
-  assert_true(fr_view_lookup("materials", &v));
-  fr_surface *surf;
-  size_t nsurf;
-  assert_int_equal(fr_surfaces_build(s, (int32_t)count - 1, &surf, &nsurf), FR_OK);
-  const fr_path_lights L = {&env, 1, v.area_c, v.area_e1, v.area_e2, v3(20, 20, 20), 1, v.light, v3(50, 50, 50)};
-  fr_path_setup P = {.mats = mats, .count = count, .surf = surf, .nsurf = nsurf, .lights = L, .max_depth = 13,
-                     .sampler = FR_SAMPLER_SOBOL, .seed = 5, .spp = 8, .spp_begin = 0, .spp_end = 8, .aperture = 0.05f, .focus = 9.0f};
-  fr_workload w;
-  memset(&w, 0, sizeof w);
-  w.kind = FR_WL_PATH, w.scene = s, w.view = v, w.eps = 1e-4f * 60.0f, w.path = &P;
+  materials_scene m;
+  materials_scene_setup(&m, FR_SAMPLER_SOBOL, 5);
+  fr_scene *s = m.s;
+  fr_view v = m.w.view;
+  m.P.aperture = 0.05f, m.P.focus = 9.0f;
+  fr_workload w = m.w;
   const int W = FR_TEST_SANITIZED ? 48 : 96, H = W / 2;
   assert_int_equal(fr_camera_setup(&w.cam, v.eye, v.at, v.up, v.fov, W, H), FR_OK);
   const size_t n = (size_t)W * H * 3;
@@ -266,10 +287,8 @@ static void same_image_everywhere(void **st) {
   assert_true(far <= n / 50);
   assert_true(fabs(sa - sb) <= 2e-3 * sa);
   ebr_release(e);
-  free(ref); free(img); free(mats); free(surf);
-  fr_path_textures_free(tex, ntex);
-  fr_env_free(&env);
-  fr_scene_release(s);
+  free(ref); free(img);
+  materials_scene_free(&m);
 }
 
 /* A run of samples split into passes of 1, 3 or 8 sums to the same bits
@@ -277,25 +296,12 @@ static void same_image_everywhere(void **st) {
  * abandoned through the cancel flag restarts the sums. */
 static void passes_split_anyhow(void **st) {
   (void)st;
-  fr_scene *s;
-  assert_int_equal(fr_scene_builtin_materials(&s), FR_OK);
-  assert_int_equal(fr_scene_commit(s), FR_OK);
-  fr_bsdf *mats;
-  size_t count, ntex, nsurf;
-  fr_texture *tex;
-  assert_int_equal(fr_path_mats_build(s, NULL, NULL, &mats, &count, &tex, &ntex), FR_OK);
-  fr_env env;
-  fr_env_constant(&env, v3(0.6f, 0.7f, 1.0f));
-  fr_view v;
-  assert_true(fr_view_lookup("materials", &v));
-  fr_surface *surf;
-  assert_int_equal(fr_surfaces_build(s, (int32_t)count - 1, &surf, &nsurf), FR_OK);
-  const fr_path_lights L = {&env, 1, v.area_c, v.area_e1, v.area_e2, v3(20, 20, 20), 1, v.light, v3(50, 50, 50)};
-  fr_path_setup P = {.mats = mats, .count = count, .surf = surf, .nsurf = nsurf, .lights = L, .max_depth = 13,
-                     .sampler = FR_SAMPLER_SOBOL, .seed = 3, .spp = 8, .spp_begin = 0, .spp_end = 8};
-  fr_workload w;
-  memset(&w, 0, sizeof w);
-  w.kind = FR_WL_PATH, w.scene = s, w.view = v, w.eps = 1e-4f * 60.0f, w.path = &P, w.threads = 2;
+  materials_scene m;
+  materials_scene_setup(&m, FR_SAMPLER_SOBOL, 3);
+  fr_scene *s = m.s;
+  fr_view v = m.w.view;
+  fr_workload w = m.w;
+  w.threads = 2;
   const int W = 40, H = 24;
   assert_int_equal(fr_camera_setup(&w.cam, v.eye, v.at, v.up, v.fov, W, H), FR_OK);
   const size_t n = (size_t)W * H * 3;
@@ -323,10 +329,7 @@ static void passes_split_anyhow(void **st) {
   assert_memory_equal(img[0], img[1], n * sizeof(float));
   assert_memory_equal(img[0], img[2], n * sizeof(float));
   for (int k = 0; k < 3; k++) free(img[k]);
-  free(mats); free(surf);
-  fr_path_textures_free(tex, ntex);
-  fr_env_free(&env);
-  fr_scene_release(s);
+  materials_scene_free(&m);
 }
 
 int main(void) {

@@ -6,15 +6,16 @@
 #include "base/error.h"
 #include "render/shadow_filter.h"
 
-static const char *const mode_names[FR_SM_COUNT] = {"eyelight", "normals", "shadows", "softshadow",
-                                                    "whitted",  "ao",      "path"};
+const char *const fr_shade_mode_names[FR_SM_COUNT] = {"eyelight", "normals", "shadows", "softshadow",
+                                                      "whitted",  "ao",      "path"};
 
-const char *fr_shade_mode_name(fr_shade_mode m) { return m < FR_SM_COUNT ? mode_names[m] : "?"; }
+const char *fr_shade_mode_name(fr_shade_mode m) { return m < FR_SM_COUNT ? fr_shade_mode_names[m] : "?"; }
 
-int fr_shade_mode_parse(const char *name, fr_shade_mode *m) {
-  for (int i = 0; i < FR_SM_COUNT; i++)
-    if (!strcmp(name, mode_names[i])) { *m = (fr_shade_mode)i; return 1; }
-  return 0;
+void fr_shade_mode_workload(fr_shade_mode m, fr_workload_kind *kind, fr_shade *shade) {
+  static const fr_workload_kind kinds[FR_SM_COUNT] = {FR_WL_PRIMARY, FR_WL_PRIMARY, FR_WL_SHADOW, FR_WL_SOFT16,
+                                                       FR_WL_WHITTED, FR_WL_AO16,   FR_WL_PATH};
+  *kind = kinds[m];
+  *shade = m == FR_SM_EYELIGHT ? FR_SHADE_EYELIGHT : m == FR_SM_NORMALS ? FR_SHADE_NORMALS : FR_SHADE_LIGHT;
 }
 
 int fr_shade_mode_progressive(fr_shade_mode m) { return m == FR_SM_SOFTSHADOW || m == FR_SM_AO || m == FR_SM_PATH; }
@@ -78,15 +79,10 @@ int fr_progressive_done(const fr_progressive *p) {
 }
 
 void fr_progressive_pass(fr_progressive *p, const fr_tracer *t, const int *cancel, fr_workload_result *r) {
-  static const fr_workload_kind kinds[FR_SM_COUNT] = {FR_WL_PRIMARY, FR_WL_PRIMARY, FR_WL_SHADOW, FR_WL_SOFT16,
-                                                       FR_WL_WHITTED, FR_WL_AO16,   FR_WL_PATH};
-  static const fr_shade shading[FR_SM_COUNT] = {FR_SHADE_EYELIGHT, FR_SHADE_NORMALS, FR_SHADE_LIGHT, FR_SHADE_LIGHT,
-                                                FR_SHADE_LIGHT,    FR_SHADE_LIGHT,   FR_SHADE_LIGHT};
   memset(r, 0, sizeof *r);
   if (fr_progressive_done(p)) return;
   fr_workload w = p->w;
-  w.kind = kinds[p->mode];
-  w.shade = shading[p->mode];
+  fr_shade_mode_workload(p->mode, &w.kind, &w.shade);
   w.cancel = cancel;
   w.image = NULL;
   w.gbuf_vis = w.gbuf_depth = w.gbuf_normal = w.gbuf_albedo = NULL;

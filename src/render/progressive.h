@@ -27,8 +27,11 @@ typedef enum fr_shade_mode {
   FR_SM_EYELIGHT, FR_SM_NORMALS, FR_SM_SHADOWS, FR_SM_SOFTSHADOW, FR_SM_WHITTED, FR_SM_AO, FR_SM_PATH, FR_SM_COUNT
 } fr_shade_mode;
 
+/* The modes' names as the command spells them, in fr_shade_mode order. */
+extern const char *const fr_shade_mode_names[FR_SM_COUNT];
 const char *fr_shade_mode_name(fr_shade_mode m);
-int fr_shade_mode_parse(const char *name, fr_shade_mode *m);
+/* The workload a mode's passes run, and how it shades the hits. */
+void fr_shade_mode_workload(fr_shade_mode m, fr_workload_kind *kind, fr_shade *shade);
 /* Whether a mode's passes differ (they are summed) or it is done in one. */
 int fr_shade_mode_progressive(fr_shade_mode m);
 

@@ -186,7 +186,7 @@ int cmd_render(int argc, char **argv) {
   const char *scene = a.pos[0], *out = a.val[F_OUT], *ref_out = a.val[F_REFERENCE_OUT];
   int threads = omp_get_num_procs(), mft = -1; /* -1: not given */
   fr_softshadow_opts so = {16, 1, FR_LIGHT_SETS_CELLS};
-  static const char *const shades[] = {"eyelight", "normals", "shadows", "softshadow", "whitted", "ao", "path"}; /* fr_shade_mode order */
+  const char *const *shades = fr_shade_mode_names;
   static const char *const sets[] = {"cells", "spread"}; /* FR_LIGHT_SETS_CELLS, _SPREAD */
   int shade = 0, set = 0, mode = 0, embree = 0, denoise = 0;
   static const char *const modes[] = {"auto", "single", "packet8", "packet16", "hybrid16", "raystream"}; /* fr_trace_mode order */
@@ -195,7 +195,7 @@ int cmd_render(int argc, char **argv) {
   cli_whitted wo;
   cli_path po;
   if ((rc = cli_view_from_args(&a, &v)) || (rc = cli_whitted_from_args(&a, &wo)) || (rc = cli_path_from_args(&a, &po)) ||
-      (rc = cli_common_from_args(&a, &threads)) || (rc = cli_arg_choice(&a, F_SHADE, shades, 7, &shade)) ||
+      (rc = cli_common_from_args(&a, &threads)) || (rc = cli_arg_choice(&a, F_SHADE, shades, FR_SM_COUNT, &shade)) ||
       (rc = cli_arg_choice(&a, F_LIGHT_SETS, sets, 2, &set)) || (rc = cli_arg_onoff(&a, F_FILTER, &so.filter)) ||
       (rc = cli_arg_onoff(&a, F_MFT, &mft)) || (rc = cli_arg_int(&a, F_LIGHT_SAMPLES, 16, 4096, &so.samples)) ||
       (rc = cli_arg_choice(&a, F_MODE, modes, 6, &mode)) || (rc = cli_arg_choice(&a, F_TRACER, tracers, 2, &embree)) ||
@@ -218,14 +218,9 @@ int cmd_render(int argc, char **argv) {
   if (!fr_image_format_known(out)) return cli_error(CLI_USAGE_ERROR, "%s: unknown image format (use .png, .exr or .pfm)", out);
   if (ref_out && !fr_image_format_known(ref_out))
     return cli_error(CLI_USAGE_ERROR, "%s: unknown image format (use .png, .exr or .pfm)", ref_out);
-  static const fr_workload_kind kinds[] = {FR_WL_PRIMARY, FR_WL_PRIMARY, FR_WL_SHADOW, FR_WL_SOFT16,
-                                           FR_WL_WHITTED, FR_WL_AO16,    FR_WL_PATH};
-  static const fr_shade shading[] = {FR_SHADE_EYELIGHT, FR_SHADE_NORMALS, FR_SHADE_LIGHT, FR_SHADE_LIGHT,
-                                     FR_SHADE_LIGHT,    FR_SHADE_LIGHT,   FR_SHADE_LIGHT};
   fr_workload w;
   memset(&w, 0, sizeof w);
-  w.kind = kinds[shade];
-  w.shade = shading[shade];
+  fr_shade_mode_workload((fr_shade_mode)shade, &w.kind, &w.shade);
 
   fr_scene *s;
   rc = cli_workload_setup(scene, &v, threads, &s, &w);

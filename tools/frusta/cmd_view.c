@@ -285,8 +285,7 @@ int cmd_view(int argc, char **argv) {
   cli_path po;
   if ((rc = cli_view_from_args(&a, &v)) || (rc = cli_whitted_from_args(&a, &wo)) || (rc = cli_path_from_args(&a, &po)) ||
       (rc = cli_common_from_args(&a, &threads)) ||
-      (rc = cli_arg_choice(&a, F_SHADE, (const char *const[]){"eyelight", "normals", "shadows", "softshadow", "whitted", "ao", "path"},
-                           FR_SM_COUNT, &shade)) ||
+      (rc = cli_arg_choice(&a, F_SHADE, fr_shade_mode_names, FR_SM_COUNT, &shade)) ||
       (rc = cli_arg_choice(&a, F_LIGHT_SETS, sets, 2, &set)) || (rc = cli_arg_onoff(&a, F_FILTER, &so.filter)) ||
       (rc = cli_arg_choice(&a, F_MODE, view_trace_names, VIEW_TRACE_COUNT, &trace)) ||
       (rc = cli_arg_onoff(&a, F_DENOISE, &denoise)) || (rc = cli_arg_int(&a, F_FRAMES, 1, 1000000, &frames)) ||
