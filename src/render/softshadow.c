@@ -1,7 +1,5 @@
 #include "softshadow.h"
-#include <math.h>
 #include <stdlib.h>
-#include <string.h>
 #include "base/error.h"
 #include "base/timer.h"
 #include "render/progressive.h"
