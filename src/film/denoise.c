@@ -6,8 +6,9 @@
 #include "base/alloc.h"
 #include "base/error.h"
 #include "film/atrous.h"
+#include "render/progressive.h"
 
-#define MISS 1e30f /* FR_DEPTH_MISS of render/progressive.h */
+#define MISS FR_DEPTH_MISS
 #define ALBEDO_MIN 0.01f /* dividing by less would amplify noise on black surfaces */
 
 /* max and min as compares (fmaxf and fminf are calls at this ISA level) */
