@@ -21,6 +21,7 @@ void view_renderer_init(view_renderer *r, fr_scene *s, const fr_workload *base, 
   r->wo = wo;
   r->so = so;
   r->mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
+  for (int i = 0; i <= VIEW_SRGB_STEPS; i++) r->srgb[i] = fr_srgb8((float)i / VIEW_SRGB_STEPS);
 }
 
 static void free_buffers(view_renderer *r) {
@@ -106,18 +107,11 @@ int view_renderer_apply(view_renderer *r, const view_settings *s) {
 int view_renderer_done(const view_renderer *r) { return !r->prog_ready || fr_progressive_done(&r->prog); }
 int view_renderer_spp(const view_renderer *r) { return r->prog_ready ? fr_progressive_spp(&r->prog) : 0; }
 
-/* A display value of v in [0, 1] as 8-bit sRGB, through a table (powf per
- * pixel would cost a frame's budget); screenshots encode exactly. */
-static uint8_t srgb_fast(float v) {
-  enum { N = 4096 };
-  static uint8_t lut[N + 1];
-  static int ready;
-  if (!__atomic_load_n(&ready, __ATOMIC_ACQUIRE)) {
-    for (int i = 0; i <= N; i++) lut[i] = fr_srgb8((float)i / N);
-    __atomic_store_n(&ready, 1, __ATOMIC_RELEASE);
-  }
+/* A display value of v in [0, 1] as 8-bit sRGB, through r's table (powf
+ * per pixel would cost a frame's budget); screenshots encode exactly. */
+static uint8_t srgb_fast(const view_renderer *r, float v) {
   if (!(v > 0.0f)) return 0;
-  return v >= 1.0f ? 255 : lut[(int)(v * N + 0.5f)];
+  return v >= 1.0f ? 255 : r->srgb[(int)(v * VIEW_SRGB_STEPS + 0.5f)];
 }
 
 /* The image as render writes it to PNG: path through the filmic curve. */
@@ -147,9 +141,9 @@ int view_renderer_pass(view_renderer *r, const int *cancel) {
   const float gain = exp2f(r->po->exposure);
 #pragma omp parallel for num_threads(r->base.threads) schedule(static)
   for (size_t i = 0; i < np; i++) {
-    r->bgra[4 * i + 0] = srgb_fast(display_value(r, r->rgb[3 * i + 2], gain));
-    r->bgra[4 * i + 1] = srgb_fast(display_value(r, r->rgb[3 * i + 1], gain));
-    r->bgra[4 * i + 2] = srgb_fast(display_value(r, r->rgb[3 * i + 0], gain));
+    r->bgra[4 * i + 0] = srgb_fast(r, display_value(r, r->rgb[3 * i + 2], gain));
+    r->bgra[4 * i + 1] = srgb_fast(r, display_value(r, r->rgb[3 * i + 1], gain));
+    r->bgra[4 * i + 2] = srgb_fast(r, display_value(r, r->rgb[3 * i + 0], gain));
     r->bgra[4 * i + 3] = 255;
   }
   return 1;

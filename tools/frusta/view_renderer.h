@@ -14,6 +14,8 @@
 typedef enum view_trace { VIEW_TRACE_MFT, VIEW_TRACE_AUTO, VIEW_TRACE_PACKET16, VIEW_TRACE_SINGLE, VIEW_TRACE_COUNT } view_trace;
 extern const char *const view_trace_names[VIEW_TRACE_COUNT];
 
+#define VIEW_SRGB_STEPS 4096 /* the screen's sRGB table: linear values in steps of 1/4096 */
+
 typedef struct view_settings {
   view_camera cam;
   int width, height;
@@ -40,6 +42,7 @@ typedef struct view_renderer {
   fr_mft_tracer mctx;
   float *rgb, *albedo, *normal, *depth; /* the resolved (and denoised) image and its guides */
   uint8_t *bgra;           /* the screen's pixels, 4 bytes each */
+  uint8_t srgb[VIEW_SRGB_STEPS + 1]; /* made before any thread reads it */
   int buf_w, buf_h;
   /* the last pass */
   uint64_t rays;
