@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 
 PKGS="build-essential cmake pkg-config zstd libzstd-dev libassimp-dev libembree-dev \
 libstb-dev libopenexr-dev libcmocka-dev libcjson-dev assimp-testmodels clang libclang-rt-14-dev libomp-dev \
-libsdl2-dev xvfb xauth xdotool"
+libsdl2-dev xvfb xauth xdotool libopenmpi-dev openmpi-bin"
 
 missing=""
 for p in $PKGS; do

@@ -43,7 +43,6 @@ export DISPLAY=:$D
 i=0; while [ ! -e /tmp/.X11-unix/X$D ] && [ $i -lt 100 ]; do sleep 0.1; i=$((i+1)); done
 
 # interactive: the window opens and renders on its worker until asked to
-# close (SDL turns SIGTERM into a quit event)
 # close (SDL turns SIGTERM into a quit event); keys typed into it switch
 # the mode while a path frame renders and print the camera
 "$F" view --builtin --size 128x96 --threads 2 --shade path >"$T/live.out" 2>"$T/live.err" &

@@ -31,6 +31,10 @@ fr_error fr_render_softshadow(const fr_workload *w0, const fr_tracer *t, const f
     fr_workload_result r;
     fr_progressive_pass(&p, t, NULL, &r);
     rays += r.rays;
+    if (r.failed) {
+      fr_progressive_free(&p);
+      return FR_ERR_ARG;
+    }
   }
   fr_progressive_resolve(&p, image, NULL, NULL, NULL);
   if (vis_out) fr_progressive_visibility(&p, vis_out);

@@ -22,6 +22,33 @@ int fr_workload_parse(const char *name, fr_workload_kind *k);
 
 typedef enum fr_shade { FR_SHADE_NONE, FR_SHADE_EYELIGHT, FR_SHADE_NORMALS, FR_SHADE_LIGHT } fr_shade;
 
+struct fr_workload;
+
+/* A frame's tiles: tile k of the order (k in 0..count-1) is the tile at
+ * x = (order[k] % tiles_x) * size, y = (order[k] / tiles_x) * size,
+ * clipped to the image. */
+typedef struct fr_tile_grid {
+  int size, tiles_x, tiles_y, count;
+  const uint32_t *order;
+} fr_tile_grid;
+
+/* Where a frame's tiles come from when they are not all this process's:
+ * another process's share of the frame (src/cluster). fr_workload_run
+ * calls begin once, then next whenever its threads want tiles, done when
+ * every tile of a range next gave is rendered (its pixels are in the
+ * workload's buffers), and end once the threads are finished. next, done
+ * and end are called by one thread at a time, not always the same one.
+ * next returns 0 when the frame has no more tiles for this process; end
+ * returns the rays of the whole frame, given this process's, and 0 for
+ * success (1: the frame failed; fr_last_error says why). */
+typedef struct fr_tile_feed {
+  void *ctx;
+  int (*begin)(void *ctx, const struct fr_workload *w, const fr_tile_grid *g);
+  int (*next)(void *ctx, int *first, int *count);
+  void (*done)(void *ctx, int first, int count);
+  int (*end)(void *ctx, uint64_t rays, uint64_t *all_rays);
+} fr_tile_feed;
+
 typedef struct fr_workload {
   fr_workload_kind kind;
   const fr_scene *scene;   /* for normals and materials (the same for every tracer) */
@@ -52,6 +79,8 @@ typedef struct fr_workload {
   /* when set, tiles not yet begun are skipped once *cancel is nonzero (read
    * atomically; another thread sets it): the frame is abandoned */
   const int *cancel;
+  /* when set, the tiles this process renders (else all of them) */
+  const fr_tile_feed *feed;
   /* path: materials, lights, samples (render/path.h) */
   const struct fr_path_setup *path;
   /* set by fr_workload_run for its tiles */
@@ -71,6 +100,7 @@ typedef struct fr_workload_result {
   double seconds;
   double stage[FR_STAGES]; /* the Whitted workload only (else 0) */
   int cancelled;           /* *w->cancel was seen set: some tiles were not rendered */
+  int failed;              /* the feed failed: the frame is incomplete (fr_last_error says why) */
 } fr_workload_result;
 
 fr_workload_result fr_workload_run(const fr_workload *w, const fr_tracer *t);

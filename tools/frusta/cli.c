@@ -11,17 +11,24 @@
 #include "render/whitted.h"
 #include "render/workload.h"
 
+static char last_msg[1024];
+static int quiet;
+
 int cli_error(int code, const char *fmt, ...) {
-  char msg[1024];
+  char msg[sizeof last_msg];
   va_list ap;
   va_start(ap, fmt);
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
   for (char *p = msg; *p; p++)
     if (*p == '\n') *p = ' ';
-  fprintf(stderr, "frusta: %s\n", msg);
+  memcpy(last_msg, msg, sizeof msg);
+  if (!quiet) fprintf(stderr, "frusta: %s\n", msg);
   return code;
 }
+
+const char *cli_last_error(void) { return last_msg; }
+void cli_set_quiet(int q) { quiet = q; }
 
 int cli_parse_float(const char *s, float *out) {
   char *e;

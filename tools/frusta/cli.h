@@ -10,6 +10,10 @@
 
 /* Prints "frusta: <message>" on one line to stderr; returns 1 (or 2 for usage). */
 int cli_error(int code, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* The last message cli_error gave; with quiet set it prints nothing (the
+ * ranks of a cluster but rank 0, whose messages rank 0 tells). */
+const char *cli_last_error(void);
+void cli_set_quiet(int quiet);
 
 int cli_parse_vec3(const char *s, vec3 *out);
 int cli_parse_int(const char *s, int lo, int hi, int *out);

@@ -13,6 +13,7 @@
 #include <string.h>
 #include "api/scene.h"
 #include "cli.h"
+#include "cli_cluster.h"
 #include "cli_scene_file.h"
 #include "commands.h"
 #include "cli_path.h"
@@ -60,7 +61,22 @@ typedef struct bench_run {
   fr_counters c;      /* summed over the repetitions */
   ebr_flag flag;      /* Embree: the context flag and packing traced */
   ebr_packing packing;
+  fr_cluster_share *shares; /* a cluster's ranks' shares of the last repetition (NULL: one process) */
 } bench_run;
+
+/* A cluster run: each rank's share of the rays and tiles, and the pixel
+ * bytes the others sent rank 0. */
+static void report_shares(const fr_workload *w, const bench_run *r) {
+  const int n = fr_cluster_size();
+  uint64_t rays = 0, bytes = 0;
+  for (int k = 0; k < n; k++) rays += r->shares[k].rays, bytes += r->shares[k].bytes;
+  printf("cluster tracer=%s mode=%s workload=%s ranks=%d threads_per_rank=%d bytes_sent=%llu rank_rays=", r->tracer,
+         r->name, fr_workload_name(w->kind), n, w->threads, (unsigned long long)bytes);
+  for (int k = 0; k < n; k++) printf("%s%.1f%%", k ? "," : "", rays ? 100.0 * (double)r->shares[k].rays / (double)rays : 0.0);
+  printf(" rank_tiles=");
+  for (int k = 0; k < n; k++) printf("%s%d", k ? "," : "", r->shares[k].tiles);
+  printf("\n");
+}
 
 static void report(const fr_workload *w0, const bench_run *r, const char *scene, size_t tris, int repeat) {
   double secs[64];
@@ -72,6 +88,7 @@ static void report(const fr_workload *w0, const bench_run *r, const char *scene,
   char embree[64] = "";
   if (r->tracer[0] == 'e')
     snprintf(embree, sizeof embree, " flag=%s packing=%s", ebr_flag_name(r->flag), ebr_packing_name(r->packing));
+  if (r->shares) report_shares(w0, r);
   printf("scene=%s tris=%zu workload=%s tracer=%s mode=%s threads=%d rays=%llu seconds=%.4f mrays=%.2f median_seconds=%.4f median_mrays=%.2f%s\n",
          scene, tris, fr_workload_name(w0->kind), tracer, mode, w0->threads, (unsigned long long)rays, best,
          (double)rays / best * 1e-6, med, (double)rays / med * 1e-6, embree);
@@ -289,9 +306,11 @@ typedef struct bench_setup {
   cli_path_run path;
   ebr_scene *e;
   int width;              /* the single-ray BVH width */
+  fr_cluster_feed *feed;  /* a cluster's frames */
 } bench_setup;
 
 static void setup_free(bench_setup *b) {
+  fr_cluster_feed_free(b->feed);
   ebr_release(b->e);
   fr_bvh2_free(&b->shallow);
   fr_whitted_mats_free(&b->mats);
@@ -369,7 +388,7 @@ static int bench_prepare(const bench_opts *o, bench_setup *b) {
 
 /* One workload: every selected run, their repetitions interleaved, then one
  * line each. */
-static void bench_workload(const bench_opts *o, bench_setup *b, fr_workload_kind k) {
+static int bench_workload(const bench_opts *o, bench_setup *b, fr_workload_kind k) {
   fr_scene *s = b->s;
   fr_workload *w = &b->w;
   w->kind = k;
@@ -405,6 +424,12 @@ static void bench_workload(const bench_opts *o, bench_setup *b, fr_workload_kind
       if (r->tracer[0] == 'f') set_frusta_mode(s, r->mode, &o->tuning, b->width);
       fr_counters_reset();
       fr_workload_result res = fr_workload_run(w, &r->t);
+      if (res.failed) {
+        for (int j = 0; j < nruns; j++) free(runs[j].shares);
+        return cli_error(1, "%s", fr_last_error());
+      }
+      if (b->feed && (r->shares || (r->shares = calloc((size_t)fr_cluster_size(), sizeof *r->shares))))
+        for (int k = 0; k < fr_cluster_size(); k++) r->shares[k] = fr_cluster_feed_share(b->feed, k);
       fr_counters c = fr_counters_read();
       fr_counters_add(&r->c, &c);
       r->secs[rep] = res.seconds;
@@ -414,6 +439,8 @@ static void bench_workload(const bench_opts *o, bench_setup *b, fr_workload_kind
   fr_scene_set_bvh_width(s, b->width);
   fr_scene_set_tuning(s, &o->tuning);
   for (int i = 0; i < nruns; i++) report(w, &runs[i], s->name, fr_scene_triangle_count(s), o->repeat);
+  for (int i = 0; i < nruns; i++) free(runs[i].shares);
+  return 0;
 }
 
 int cmd_bench(int argc, char **argv) {
@@ -424,9 +451,9 @@ int cmd_bench(int argc, char **argv) {
   bench_opts o;
   if ((rc = bench_options(&a, &o))) return rc;
   bench_setup b;
-  if (!(rc = bench_prepare(&o, &b)))
-    for (int k = 0; k < FR_WL_COUNT; k++)
-      if ((o.workloads >> k) & 1) bench_workload(&o, &b, (fr_workload_kind)k);
+  rc = cli_cluster_join(bench_prepare(&o, &b), &b.w, &b.feed);
+  for (int k = 0; !rc && k < FR_WL_COUNT; k++)
+    if ((o.workloads >> k) & 1) rc = bench_workload(&o, &b, (fr_workload_kind)k);
   setup_free(&b);
   return rc;
 }

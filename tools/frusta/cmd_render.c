@@ -7,6 +7,7 @@
 #include <unistd.h>
 #include "api/scene.h"
 #include "cli.h"
+#include "cli_cluster.h"
 #include "cli_scene_file.h"
 #include "commands.h"
 #include "base/timer.h"
@@ -47,7 +48,10 @@ static int render_soft(fr_scene *s, fr_workload *w, const fr_softshadow_opts *so
   fr_tracer t = mft ? fr_tracer_mft(&ctx) : fr_tracer_frusta(s);
   fr_workload_result r;
   if (fr_render_softshadow(w, &t, so, img, vis, &r)) { rc = cli_error(1, "%s", fr_last_error()); goto done; }
-  if (fr_image_write(out, w->cam.width, w->cam.height, img)) { rc = cli_error(1, "%s", fr_last_error()); goto done; }
+  if (cli_cluster_leader() && fr_image_write(out, w->cam.width, w->cam.height, img)) {
+    rc = cli_error(1, "%s", fr_last_error());
+    goto done;
+  }
   const fr_softshadow_opts used = fr_softshadow_used(so);
   printf("rendered scene=%s tris=%zu size=%dx%d shade=softshadow light_samples=%d filter=%s light_sets=%s tracer=%s "
          "isa=%s threads=%d rays=%llu seconds=%.3f mrays=%.2f -> %s\n",
@@ -60,7 +64,10 @@ static int render_soft(fr_scene *s, fr_workload *w, const fr_softshadow_opts *so
     rw.seed = w->seed + 1000;
     rw.progress = 0;
     if (fr_render_softshadow(&rw, &t, &ro, rimg, rvis, &r)) { rc = cli_error(1, "%s", fr_last_error()); goto done; }
-    if (fr_image_write(ref_out, w->cam.width, w->cam.height, rimg)) { rc = cli_error(1, "%s", fr_last_error()); goto done; }
+    if (cli_cluster_leader() && fr_image_write(ref_out, w->cam.width, w->cam.height, rimg)) {
+      rc = cli_error(1, "%s", fr_last_error());
+      goto done;
+    }
     printf("reference light_samples=256 filter=off -> %s\nmae_visibility=%.4f mae_rgb=%.4f\n", ref_out,
            mae(vis, rvis, 1, rimg, np), mae(img, rimg, 3, rimg, np));
   }
@@ -117,7 +124,13 @@ static int render_progressive(fr_scene *s, fr_workload *w, fr_shade_mode mode, c
   fr_tracer t = e ? ebr_tracer(e, EBR_STREAM, EBR_FLAG_HINT, EBR_PACK_RAYS) : use_mft ? fr_tracer_mft(&mctx) : fr_tracer_frusta(s);
   p.w.progress = 0;
   int passes;
-  if (path) {
+  if (path && w->feed) {
+    /* a cluster's tile takes all its samples at once: a worker's pixels
+     * are then whole sums, the same bits as passes summed here */
+    p.spp_per_pass = run.setup.spp;
+    p.w.progress = 1;
+    passes = 1;
+  } else if (path) {
     p.spp_per_pass = FR_PATH_CHUNK;
     passes = (run.setup.spp + FR_PATH_CHUNK - 1) / FR_PATH_CHUNK;
   } else if (mode == FR_SM_SOFTSHADOW) {
@@ -131,10 +144,12 @@ static int render_progressive(fr_scene *s, fr_workload *w, fr_shade_mode mode, c
   uint64_t rays = 0;
   const double t0 = fr_seconds();
   double last = t0;
-  const int tty = isatty(fileno(stderr)); /* the progress line is for a person watching */
+  /* the progress line is for a person watching */
+  const int tty = isatty(fileno(stderr)) && cli_cluster_leader() && passes > 1;
   for (int k = 0; k < passes; k++) {
     fr_workload_result r;
     fr_progressive_pass(&p, &t, NULL, &r);
+    if (r.failed) { rc = cli_error(1, "%s", fr_last_error()); goto done; }
     rays += r.rays;
     const double now = fr_seconds();
     if (tty && (now - last > 0.5 || k + 1 == passes)) {
@@ -149,6 +164,7 @@ static int render_progressive(fr_scene *s, fr_workload *w, fr_shade_mode mode, c
   fr_progressive_resolve(&p, img, albedo, normal, depth);
   const double render_seconds = fr_seconds() - t0;
   double denoise_seconds = 0.0;
+  if (!cli_cluster_leader()) goto done; /* rank 0 has the image */
   if (dn) {
     const double t1 = fr_seconds();
     fr_denoise(dn, img, albedo, normal, depth, fr_progressive_spp(&p), threads, img);
@@ -175,6 +191,63 @@ done:
   fr_denoiser_free(dn);
   ebr_release(e);
   cli_path_free(&run);
+  return rc;
+}
+
+/* The image of the scene in shade, as the flags ask. */
+static int render_scene(fr_scene *s, fr_workload *wp, const char *const *val, int shade, const cli_view *vp,
+                        const cli_whitted *wop, const cli_path *pop, const fr_softshadow_opts *sop, int mft, int mode,
+                        int embree, int denoise, int threads) {
+  fr_workload w = *wp;
+  const cli_view v = *vp;
+  const cli_whitted wo = *wop;
+  const cli_path po = *pop;
+  const fr_softshadow_opts so = *sop;
+  const char *out = val[F_OUT], *ref_out = val[F_REFERENCE_OUT];
+  const char *const *shades = fr_shade_mode_names;
+  int rc = 0;
+  w.seed = 1;
+  w.progress = 1;
+  if (shade == FR_SM_PATH || shade == FR_SM_AO || (shade == FR_SM_SOFTSHADOW && denoise))
+    return render_progressive(s, &w, (fr_shade_mode)shade, &po, &so, denoise, out, threads, mode, embree, mft);
+  if (w.kind == FR_WL_SOFT16) /* multi-frusta tracing does not see spheres: such scenes go the packet way */
+    return render_soft(s, &w, &so, mft != 0 && !fr_scene_sphere_count(s), out, ref_out, threads);
+  fr_whitted_mats mats = {0};
+  if (w.kind == FR_WL_WHITTED && (rc = cli_whitted_setup(s, &wo, &mats, &w))) return rc;
+  w.image = calloc((size_t)v.width * (size_t)v.height * 3, sizeof(float));
+  if (!w.image) { fr_whitted_mats_free(&mats); return cli_error(1, "out of memory for a %dx%d image", v.width, v.height); }
+  /* Whitted: camera rays by multi-frusta tracing and the rest as streams
+   * (the fastest), or with --mft off or any of --packet, --traversal,
+   * --cull: large packets of --packet x --packet */
+  fr_lp_tracer lpc = {s, cli_lp_scene(s), wo.lp, wo.packet};
+  fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
+  if (w.kind == FR_WL_WHITTED && mft == 1 && wo.large_flags) {
+    fr_whitted_mats_free(&mats); free(w.image);
+    return cli_error(CLI_USAGE_ERROR, "--mft on and --packet/--traversal/--cull: large packets need --mft off");
+  }
+  /* multi-frusta tracing does not see spheres: such scenes go the packet
+   * way. Camera rays are traced as frusta by default for every shade, the
+   * rest as streams (auto). */
+  const int use_mft = mft != 0 && !fr_scene_sphere_count(s) && !(w.kind == FR_WL_WHITTED && wo.large_flags);
+  fr_tracer t = use_mft ? fr_tracer_mft(&mctx) : w.kind != FR_WL_WHITTED ? fr_tracer_frusta(s) : fr_tracer_lp(&lpc);
+  const int whitted_mft = w.kind == FR_WL_WHITTED && use_mft;
+  if (w.kind == FR_WL_WHITTED && cli_cluster_leader()) {
+    if (whitted_mft) printf("whitted tracer=mft\n");
+    else printf("whitted tracer=packet%dx%d/%s/%s\n", wo.packet, wo.packet, fr_lp_traversal_name(wo.lp.traversal),
+                fr_cull_name(wo.lp.cull));
+  }
+  fr_workload_result r = fr_workload_run(&w, &t);
+  if (r.failed) rc = cli_error(1, "%s", fr_last_error());
+  else if (!cli_cluster_leader()) rc = 0;
+  else if (fr_image_write(out, v.width, v.height, w.image)) rc = cli_error(1, "%s", fr_last_error());
+  else
+    printf("rendered scene=%s tris=%zu size=%dx%d shade=%s tracer=%s isa=%s threads=%d build_seconds=%.3f rays=%llu "
+           "seconds=%.3f mrays=%.2f -> %s\n",
+           s->name, fr_scene_triangle_count(s), v.width, v.height, shades[shade],
+           use_mft ? "mft" : w.kind == FR_WL_WHITTED ? "packets" : "auto", fr_isa_name(fr_get_isa()), threads,
+           s->build_seconds, (unsigned long long)r.rays, r.seconds, (double)r.rays / r.seconds * 1e-6, out);
+  free(w.image);
+  fr_whitted_mats_free(&mats);
   return rc;
 }
 
@@ -222,56 +295,15 @@ int cmd_render(int argc, char **argv) {
   memset(&w, 0, sizeof w);
   fr_shade_mode_workload((fr_shade_mode)shade, &w.kind, &w.shade);
 
-  fr_scene *s;
-  rc = cli_workload_setup(scene, &v, threads, &s, &w);
-  if (rc) return rc;
-  w.seed = 1;
-  w.progress = 1;
-  if (shade == FR_SM_PATH || shade == FR_SM_AO || (shade == FR_SM_SOFTSHADOW && denoise)) {
-    rc = render_progressive(s, &w, (fr_shade_mode)shade, &po, &so, denoise, out, threads, mode, embree, mft);
-    fr_scene_release(s);
+  fr_scene *s = NULL;
+  fr_cluster_feed *feed = NULL;
+  const int set_up = cli_workload_setup(scene, &v, threads, &s, &w);
+  if ((rc = cli_cluster_join(set_up, &w, &feed))) {
+    if (!set_up) fr_scene_release(s);
     return rc;
   }
-  if (w.kind == FR_WL_SOFT16) {
-    /* multi-frusta tracing does not see spheres: such scenes go the packet way */
-    rc = render_soft(s, &w, &so, mft != 0 && !fr_scene_sphere_count(s), out, ref_out, threads);
-    fr_scene_release(s);
-    return rc;
-  }
-  fr_whitted_mats mats = {0};
-  if (w.kind == FR_WL_WHITTED && (rc = cli_whitted_setup(s, &wo, &mats, &w))) { fr_scene_release(s); return rc; }
-  w.image = calloc((size_t)v.width * (size_t)v.height * 3, sizeof(float));
-  if (!w.image) { fr_whitted_mats_free(&mats); fr_scene_release(s); return cli_error(1, "out of memory for a %dx%d image", v.width, v.height); }
-  /* Whitted: camera rays by multi-frusta tracing and the rest as streams
-   * (the fastest), or with --mft off or any of --packet, --traversal,
-   * --cull: large packets of --packet x --packet */
-  fr_lp_tracer lpc = {s, cli_lp_scene(s), wo.lp, wo.packet};
-  fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
-  if (w.kind == FR_WL_WHITTED && mft == 1 && wo.large_flags) {
-    fr_whitted_mats_free(&mats); fr_scene_release(s); free(w.image);
-    return cli_error(CLI_USAGE_ERROR, "--mft on and --packet/--traversal/--cull: large packets need --mft off");
-  }
-  /* multi-frusta tracing does not see spheres: such scenes go the packet
-   * way. Camera rays are traced as frusta by default for every shade, the
-   * rest as streams (auto). */
-  const int use_mft = mft != 0 && !fr_scene_sphere_count(s) && !(w.kind == FR_WL_WHITTED && wo.large_flags);
-  fr_tracer t = use_mft ? fr_tracer_mft(&mctx) : w.kind != FR_WL_WHITTED ? fr_tracer_frusta(s) : fr_tracer_lp(&lpc);
-  const int whitted_mft = w.kind == FR_WL_WHITTED && use_mft;
-  if (w.kind == FR_WL_WHITTED) {
-    if (whitted_mft) printf("whitted tracer=mft\n");
-    else printf("whitted tracer=packet%dx%d/%s/%s\n", wo.packet, wo.packet, fr_lp_traversal_name(wo.lp.traversal),
-                fr_cull_name(wo.lp.cull));
-  }
-  fr_workload_result r = fr_workload_run(&w, &t);
-  if (fr_image_write(out, v.width, v.height, w.image)) rc = cli_error(1, "%s", fr_last_error());
-  else
-    printf("rendered scene=%s tris=%zu size=%dx%d shade=%s tracer=%s isa=%s threads=%d build_seconds=%.3f rays=%llu "
-           "seconds=%.3f mrays=%.2f -> %s\n",
-           s->name, fr_scene_triangle_count(s), v.width, v.height, shades[shade],
-           use_mft ? "mft" : w.kind == FR_WL_WHITTED ? "packets" : "auto", fr_isa_name(fr_get_isa()), threads,
-           s->build_seconds, (unsigned long long)r.rays, r.seconds, (double)r.rays / r.seconds * 1e-6, out);
-  free(w.image);
-  fr_whitted_mats_free(&mats);
+  rc = render_scene(s, &w, a.val, shade, &v, &wo, &po, &so, mft, mode, embree, denoise, threads);
+  fr_cluster_feed_free(feed);
   fr_scene_release(s);
   return rc;
 }
