@@ -83,6 +83,7 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
   const int progress = w->progress && !w->feed; /* a feed's frame is shared: the feed tells its progress */
   double t0 = fr_seconds();
   uint32_t *order = fr_tile_order(tiles_x, tiles_y);
+  if (w->tile_seconds) memset(w->tile_seconds, 0, (size_t)ntiles * sizeof *w->tile_seconds);
   tile_queue q;
   memset(&q, 0, sizeof q);
   q.feed = w->feed, q.end = ntiles;
@@ -115,9 +116,11 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
       if (i < 0) break;
       const int k = order ? (int)order[i] : i;
       const int tx = (k % tiles_x) * tile, ty = (k / tiles_x) * tile;
+      const double tile_t0 = w->tile_seconds ? fr_seconds() : 0.0;
       if (WS) total += fr_whitted_tile(w, t, WS, tx, ty);
       else if (PS) total += fr_path_tile(w, t, PS, tx, ty);
       else if (B) total += fr_tile_run(w, t, B, tx, ty);
+      if (w->tile_seconds) w->tile_seconds[i] = fr_seconds() - tile_t0;
       finish_tile(&q, slot);
       if (progress) {
         int d, pct;

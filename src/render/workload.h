@@ -81,6 +81,10 @@ typedef struct fr_workload {
   const int *cancel;
   /* when set, the tiles this process renders (else all of them) */
   const fr_tile_feed *feed;
+  /* when set, tile_seconds[k] gets the seconds the k-th tile of the order
+   * took to render (0 for those another process rendered); room for
+   * ceil(width / 16) x ceil(height / 16) tiles */
+  double *tile_seconds;
   /* path: materials, lights, samples (render/path.h) */
   const struct fr_path_setup *path;
   /* set by fr_workload_run for its tiles */

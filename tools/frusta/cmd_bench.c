@@ -18,6 +18,7 @@
 #include "commands.h"
 #include "cli_path.h"
 #include "embree_tracer.h"
+#include "render/whitted.h"
 #include "render/workload.h"
 #include "trace/counters.h"
 
@@ -62,7 +63,27 @@ typedef struct bench_run {
   ebr_flag flag;      /* Embree: the context flag and packing traced */
   ebr_packing packing;
   fr_cluster_share *shares; /* a cluster's ranks' shares of the last repetition (NULL: one process) */
+  double tile_ms[6];  /* the fastest repetition's tiles rendered here: count, mean, sd, median, p99, max (ms) */
 } bench_run;
+
+/* The tiles' render times of a frame (ms): count, mean, standard
+ * deviation, median, 99th percentile and maximum over those rendered here. */
+static void tile_stats(const double *secs, int n, double out[6]) {
+  double *v = malloc((size_t)(n > 0 ? n : 1) * sizeof *v), sum = 0.0, sq = 0.0;
+  int k = 0;
+  memset(out, 0, 6 * sizeof *out);
+  if (!v) return;
+  for (int i = 0; i < n; i++)
+    if (secs[i] > 0.0) v[k++] = secs[i] * 1e3;
+  if (k) {
+    qsort(v, (size_t)k, sizeof *v, cmp_double);
+    for (int i = 0; i < k; i++) sum += v[i], sq += v[i] * v[i];
+    const double mean = sum / k;
+    out[0] = k, out[1] = mean, out[2] = sqrt(fmax(0.0, sq / k - mean * mean));
+    out[3] = v[k / 2], out[4] = v[(int)(0.99 * (k - 1))], out[5] = v[k - 1];
+  }
+  free(v);
+}
 
 /* A cluster run: each rank's share of the rays and tiles, and the pixel
  * bytes the others sent rank 0. */
@@ -89,6 +110,11 @@ static void report(const fr_workload *w0, const bench_run *r, const char *scene,
   if (r->tracer[0] == 'e')
     snprintf(embree, sizeof embree, " flag=%s packing=%s", ebr_flag_name(r->flag), ebr_packing_name(r->packing));
   if (r->shares) report_shares(w0, r);
+  if (r->tile_ms[0] > 0)
+    printf("tiles tracer=%s mode=%s workload=%s tile=%d count=%.0f mean_ms=%.4f sd_ms=%.4f median_ms=%.4f p99_ms=%.4f "
+           "max_ms=%.4f\n",
+           r->tracer, r->name, fr_workload_name(w0->kind), w0->kind == FR_WL_WHITTED ? FR_WHITTED_TILE : 16,
+           r->tile_ms[0], r->tile_ms[1], r->tile_ms[2], r->tile_ms[3], r->tile_ms[4], r->tile_ms[5]);
   printf("scene=%s tris=%zu workload=%s tracer=%s mode=%s threads=%d rays=%llu seconds=%.4f mrays=%.2f median_seconds=%.4f median_mrays=%.2f%s\n",
          scene, tris, fr_workload_name(w0->kind), tracer, mode, w0->threads, (unsigned long long)rays, best,
          (double)rays / best * 1e-6, med, (double)rays / med * 1e-6, embree);
@@ -311,6 +337,7 @@ typedef struct bench_setup {
 
 static void setup_free(bench_setup *b) {
   fr_cluster_feed_free(b->feed);
+  free(b->w.tile_seconds);
   ebr_release(b->e);
   fr_bvh2_free(&b->shallow);
   fr_whitted_mats_free(&b->mats);
@@ -347,6 +374,8 @@ static int bench_prepare(const bench_opts *o, bench_setup *b) {
   if (rc) return rc;
   fr_scene *s = b->s;
   b->w.seed = 7;
+  b->w.tile_seconds = calloc(((size_t)view.width + 15) / 16 * (((size_t)view.height + 15) / 16), sizeof(double));
+  if (!b->w.tile_seconds) return cli_error(1, "out of memory");
   b->w.light_sets_kind = o->light_sets;
   b->w.mft_no_fallback = o->mft_no_fallback;
   b->w.mft_no_shaft = o->mft_no_shaft;
@@ -432,7 +461,13 @@ static int bench_workload(const bench_opts *o, bench_setup *b, fr_workload_kind 
         for (int k = 0; k < fr_cluster_size(); k++) r->shares[k] = fr_cluster_feed_share(b->feed, k);
       fr_counters c = fr_counters_read();
       fr_counters_add(&r->c, &c);
+      int fastest = 1;
+      for (int j = 0; j < rep; j++) fastest &= res.seconds < r->secs[j];
       r->secs[rep] = res.seconds;
+      if (w->tile_seconds && fastest) {
+        const int tile = k == FR_WL_WHITTED ? FR_WHITTED_TILE : 16;
+        tile_stats(w->tile_seconds, ((w->cam.width + tile - 1) / tile) * ((w->cam.height + tile - 1) / tile), r->tile_ms);
+      }
       memcpy(r->stage[rep], res.stage, sizeof res.stage);
       r->rays = res.rays;
     }

@@ -303,6 +303,16 @@ int cmd_render(int argc, char **argv) {
     return rc;
   }
   rc = render_scene(s, &w, a.val, shade, &v, &wo, &po, &so, mft, mode, embree, denoise, threads);
+  if (!rc && feed) { /* the last frame's deal: what each rank rendered, what came to rank 0 */
+    uint64_t bytes = 0;
+    printf("cluster ranks=%d threads_per_rank=%d rank_tiles=", fr_cluster_size(), threads);
+    for (int k = 0; k < fr_cluster_size(); k++) {
+      const fr_cluster_share sh = fr_cluster_feed_share(feed, k);
+      printf("%s%d", k ? "," : "", sh.tiles);
+      bytes += sh.bytes;
+    }
+    printf(" bytes_sent=%llu\n", (unsigned long long)bytes);
+  }
   fr_cluster_feed_free(feed);
   fr_scene_release(s);
   return rc;
