@@ -1,8 +1,22 @@
 /* The cluster of a frusta built without MPI: this one process. */
 #include <stdio.h>
+#include <stdlib.h>
+#include "base/error.h"
 #include "cluster/cluster.h"
 
-int fr_cluster_start(int *argc, char ***argv) { return 0; }
+/* Started by an MPI launcher with other ranks, each would render the
+ * whole frame and write the same file: refuse. */
+int fr_cluster_start(int *argc, char ***argv) {
+  const char *n = getenv("OMPI_COMM_WORLD_SIZE");
+  if (!n) n = getenv("PMI_SIZE");
+  if (n && atoi(n) > 1) {
+    fr_fail(FR_ERR_ARG, "this frusta was built without MPI and cannot share a frame over %s processes "
+                        "(build it where CMake finds MPI: Debian's libopenmpi-dev)", n);
+    return 1;
+  }
+  return 0;
+}
+
 void fr_cluster_stop(int rc) {}
 int fr_cluster_rank(void) { return 0; }
 int fr_cluster_size(void) { return 1; }

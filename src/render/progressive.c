@@ -137,14 +137,11 @@ void fr_progressive_visibility(const fr_progressive *p, float *vis) {
   }
 }
 
-/* Soft shadows' image: the visibility shaded by the light's centre. */
-static void resolve_soft(const fr_progressive *p, float *image) {
+void fr_progressive_shade_soft(const fr_progressive *p, const float *vis, float *image) {
   const fr_workload *w = &p->w;
   const int W = w->cam.width, H = w->cam.height;
-  float *vis = malloc(p->np * sizeof(float));
-  if (!vis) { memset(image, 0, 3 * p->np * sizeof(float)); return; }
-  fr_progressive_visibility(p, vis);
   const vec3 centre = v3_add(w->view.area_c, v3_scale(v3_add(w->view.area_e1, w->view.area_e2), 0.5f));
+#pragma omp parallel for schedule(static) num_threads(w->threads > 0 ? w->threads : 1)
   for (int y = 0; y < H; y++)
     for (int x = 0; x < W; x++) {
       const size_t i = (size_t)y * (size_t)W + (size_t)x;
@@ -156,6 +153,14 @@ static void resolve_soft(const fr_progressive *p, float *image) {
       const float k = 0.15f * fabsf(v3_dot(n, d)) + 0.85f * vis[i] * fmaxf(0.0f, v3_dot(n, L));
       for (int c = 0; c < 3; c++) px[c] = p->albedo[3 * i + c] * k;
     }
+}
+
+/* Soft shadows' image when the caller wants no visibility of its own. */
+static void resolve_soft(const fr_progressive *p, float *image) {
+  float *vis = malloc(p->np * sizeof(float));
+  if (!vis) { memset(image, 0, 3 * p->np * sizeof(float)); return; }
+  fr_progressive_visibility(p, vis);
+  fr_progressive_shade_soft(p, vis, image);
   free(vis);
 }
 

@@ -75,4 +75,8 @@ void fr_progressive_pass(fr_progressive *p, const fr_tracer *t, const int *cance
 void fr_progressive_resolve(const fr_progressive *p, float *rgb, float *albedo, float *normal, float *depth);
 /* softshadow: the visibility the image shows (W*H). */
 void fr_progressive_visibility(const fr_progressive *p, float *vis);
+/* softshadow: the image (W*H*3) of that visibility, shaded by the light's
+ * centre; what fr_progressive_resolve gives, for a caller that wants the
+ * visibility too without filtering twice. */
+void fr_progressive_shade_soft(const fr_progressive *p, const float *vis, float *image);
 #endif

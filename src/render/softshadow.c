@@ -36,8 +36,12 @@ fr_error fr_render_softshadow(const fr_workload *w0, const fr_tracer *t, const f
       return FR_ERR_ARG;
     }
   }
-  fr_progressive_resolve(&p, image, NULL, NULL, NULL);
-  if (vis_out) fr_progressive_visibility(&p, vis_out);
+  if (vis_out) {
+    fr_progressive_visibility(&p, vis_out);
+    fr_progressive_shade_soft(&p, vis_out, image);
+  } else {
+    fr_progressive_resolve(&p, image, NULL, NULL, NULL);
+  }
   res->rays = rays;
   res->seconds = fr_seconds() - t0;
   fr_progressive_free(&p);
