@@ -92,6 +92,18 @@ expect 0 "$F" render --builtin $S --shade normals --eye "$1" --at "$2" --up "$3"
 same "$T/v_cam_0003.png" "$T/r_cam.png" "the camera path's last view"
 grep -q '^frame 3: ' "$T/out" 2>/dev/null || true
 
+# temporal blending along a turntable: without it the last frame is
+# render's of the last view; with it the frames blend and reuse most pixels
+expect 0 "$F" view --builtin $S --shade path --frames 5 --turntable 1 --denoise off --temporal off --record "$T/tt.path" \
+  --screenshot "$T/v_t0.png"
+last=$(tail -1 "$T/tt.path")
+set -- $last
+expect 0 "$F" render --builtin $S --shade path --sampler sobol --spp 1 --eye "$1" --at "$2" --up "$3" --fov "$4" --out "$T/r_t.png"
+same "$T/v_t0.png" "$T/r_t.png" "a moving path view without temporal blending"
+expect 0 "$F" view --builtin $S --shade path --frames 5 --turntable 1 --denoise off --screenshot "$T/v_t1.png"
+grep -q '^frame 4: .* reused=[5-9][0-9]%' "$T/out" && ok || { bad "temporal blending reused little"; grep '^frame' "$T/out"; }
+cmp -s "$T/v_t1.png" "$T/v_t0.png" && bad "temporal blending changed nothing" || ok
+
 # a shared scene, its own view
 K="$SHARED/scenes/kitchen/kitchen.ply.zst"
 if [ -e "$K" ]; then

@@ -76,7 +76,7 @@ struct fr_cluster_feed {
   int failed;
   /* rank 0: every call comes with frame.c's lock held, or after its threads */
   int next, tiles_done, progress, shown_pct, workers_left;
-  int *finished;
+  int *last_tiles; /* per worker: the tiles its last message counts, -1 before it came */
   double t0, polled;
   fr_cluster_share *shares;
   void *rbuf;
@@ -206,14 +206,17 @@ static void serve(fr_cluster_feed *f, int kind, const MPI_Status *st) {
     if (bytes != (int)sizeof m) { fail(f, "a malformed last message", src); return; }
     if (mpi_failed(f, MPI_Recv(&m, (int)sizeof m, MPI_BYTE, src, t, MPI_COMM_WORLD, MPI_STATUS_IGNORE), "receive"))
       return;
-    if (m.frame != f->frame || m.tiles != f->shares[src].tiles || f->finished[src]) {
-      fail(f, "a last message out of step", src);
-      return;
-    }
+    if (m.frame != f->frame || m.tiles < 0 || f->last_tiles[src] >= 0) { fail(f, "a last message out of step", src); return; }
     f->shares[src].rays = m.rays;
-    f->finished[src] = 1;
-    f->workers_left--;
+    f->last_tiles[src] = m.tiles;
   }
+  /* A worker is done when its last message and all the pixels it counts
+   * are in. The pixels may come after it: each kind is probed by its own
+   * tag, and MPI keeps a sender's order only among messages one probe
+   * could match. */
+  const int last = f->last_tiles[src];
+  if (last >= 0 && f->shares[src].tiles > last) fail(f, "more pixels than its last message counts", src);
+  else if (last >= 0 && f->shares[src].tiles == last) f->last_tiles[src] = INT32_MAX, f->workers_left--;
 }
 
 /* Rank 0: answers every message that has come; whether there was one. */
@@ -251,7 +254,7 @@ static int feed_begin(void *ctx, const fr_workload *w, const fr_tile_grid *g) {
     f->next = f->tiles_done = 0;
     f->workers_left = f->size - 1;
     memset(f->shares, 0, (size_t)f->size * sizeof *f->shares);
-    memset(f->finished, 0, (size_t)f->size * sizeof *f->finished);
+    for (int r = 0; r < f->size; r++) f->last_tiles[r] = -1;
     f->progress = w->progress;
     f->shown_pct = -1;
     f->t0 = fr_seconds();
@@ -383,8 +386,8 @@ fr_cluster_feed *fr_cluster_feed_new(void) {
   if (!f) return NULL;
   f->rank = fr_cluster_rank(), f->size = fr_cluster_size();
   f->shares = calloc((size_t)f->size, sizeof *f->shares);
-  f->finished = calloc((size_t)f->size, sizeof *f->finished);
-  if (!f->shares || !f->finished) {
+  f->last_tiles = calloc((size_t)f->size, sizeof *f->last_tiles);
+  if (!f->shares || !f->last_tiles) {
     fr_cluster_feed_free(f);
     return NULL;
   }
@@ -395,7 +398,7 @@ fr_cluster_feed *fr_cluster_feed_new(void) {
 void fr_cluster_feed_free(fr_cluster_feed *f) {
   if (!f) return;
   free(f->shares);
-  free(f->finished);
+  free(f->last_tiles);
   free(f->rbuf);
   free(f->sends);
   free(f);

@@ -26,8 +26,8 @@
 
 static const char *const keys_help =
     "keys: drag to orbit (left), pan (right or middle); wheel zooms; W A S D Q E fly (shift: faster);\n"
-    "1-7 eyelight normals shadows softshadow whitted ao path; M trace mode; N denoiser; P prints the camera;\n"
-    "K screenshot (frusta-NNNN.png); H this help; Esc quits\n";
+    "1-7 eyelight normals shadows softshadow whitted ao path; M trace mode; N denoiser; T temporal blending;\n"
+    "P prints the camera; K screenshot (frusta-NNNN.png); H this help; Esc quits\n";
 
 typedef struct view_shared {
   pthread_mutex_t lock;
@@ -173,6 +173,7 @@ static int run_interactive(view_app *app, view_settings init, float speed) {
         else if (k >= SDLK_1 && k <= SDLK_7) w.mode = (fr_shade_mode)(k - SDLK_1);
         else if (k == SDLK_m) w.trace = (view_trace)((w.trace + 1) % VIEW_TRACE_COUNT);
         else if (k == SDLK_n) w.denoise = !w.denoise;
+        else if (k == SDLK_t) w.temporal = !w.temporal;
         else if (k == SDLK_p) { view_camera_print(stdout, &w.cam); fflush(stdout); }
         else if (k == SDLK_h) { fputs(keys_help, stdout); fflush(stdout); }
         else if (k == SDLK_k) {
@@ -249,8 +250,9 @@ static int run_frames(view_app *app, view_settings s, int frames, const view_cam
     if ((rc = show(app, app->r.bgra, s.width, s.height))) return rc;
     const double dt = fr_seconds() - t0;
     total += dt;
-    printf("frame %d: %.2f ms render %.2f ms denoise %.2f ms spp=%d mrays=%.2f\n", i, dt * 1e3, app->r.seconds * 1e3,
-           app->r.denoise_seconds * 1e3, view_renderer_spp(&app->r), app->r.rays / fmax(app->r.seconds, 1e-9) * 1e-6);
+    printf("frame %d: %.2f ms render %.2f ms denoise %.2f ms spp=%d mrays=%.2f reused=%.0f%%\n", i, dt * 1e3,
+           app->r.seconds * 1e3, app->r.denoise_seconds * 1e3, view_renderer_spp(&app->r),
+           app->r.rays / fmax(app->r.seconds, 1e-9) * 1e-6, 100.0 * view_renderer_reused(&app->r));
     set_title(app, &s, 1.0 / dt, app->r.rays / fmax(app->r.seconds, 1e-9) * 1e-6, view_renderer_spp(&app->r));
     if (screenshot && (strchr(screenshot, '#') || i == frames - 1)) {
       char name[4096];
@@ -276,7 +278,7 @@ int cmd_view(int argc, char **argv) {
   }
   if ((rc = cli_scene_file_defaults(&a))) return rc;
   const char *scene = a.pos[0];
-  int threads = omp_get_num_procs(), shade = 0, set = 0, trace = 0, denoise = 1, frames = 0;
+  int threads = omp_get_num_procs(), shade = 0, set = 0, trace = 0, denoise = 1, temporal = 1, frames = 0;
   float turntable = 0.0f;
   fr_softshadow_opts so = {16, 1, FR_LIGHT_SETS_CELLS};
   static const char *const sets[] = {"cells", "spread"};
@@ -288,7 +290,8 @@ int cmd_view(int argc, char **argv) {
       (rc = cli_arg_choice(&a, F_SHADE, fr_shade_mode_names, FR_SM_COUNT, &shade)) ||
       (rc = cli_arg_choice(&a, F_LIGHT_SETS, sets, 2, &set)) || (rc = cli_arg_onoff(&a, F_FILTER, &so.filter)) ||
       (rc = cli_arg_choice(&a, F_MODE, view_trace_names, VIEW_TRACE_COUNT, &trace)) ||
-      (rc = cli_arg_onoff(&a, F_DENOISE, &denoise)) || (rc = cli_arg_int(&a, F_FRAMES, 1, 1000000, &frames)) ||
+      (rc = cli_arg_onoff(&a, F_DENOISE, &denoise)) || (rc = cli_arg_onoff(&a, F_TEMPORAL, &temporal)) ||
+      (rc = cli_arg_int(&a, F_FRAMES, 1, 1000000, &frames)) ||
       (rc = cli_arg_float(&a, F_TURNTABLE, -180.0f, 180.0f, &turntable)))
     return rc;
   if (!scene) return cli_error(CLI_USAGE_ERROR, "usage: frusta view SCENE|--builtin [flags] (see frusta view --help)");
@@ -342,7 +345,7 @@ int cmd_view(int argc, char **argv) {
   if (app.win) app.ren = SDL_CreateRenderer(app.win, -1, 0);
   if (!app.win || !app.ren) { rc = cli_error(1, "view: cannot open a window: %s", SDL_GetError()); goto done; }
   view_settings init = {{w.view.eye, w.view.at, w.view.up, w.view.fov}, v.width, v.height, (fr_shade_mode)shade,
-                        (view_trace)trace, denoise};
+                        (view_trace)trace, denoise, temporal};
   if (frames) rc = run_frames(&app, init, frames, path, npath, turntable, screenshot);
   else rc = run_interactive(&app, init, 0.25f * v3_len(v3_sub(s->bounds.hi, s->bounds.lo)));
 done:

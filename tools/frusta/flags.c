@@ -59,6 +59,9 @@ const cli_flag cli_flags[F_COUNT] = {
     [F_EXPOSURE] = {"--exposure", "EV", R | V, "path: PNG exposure in stops before the filmic tone curve (default 0)"},
     [F_DENOISE] = {"--denoise", "on|off", R | V,
                    "path, ao, softshadow: the edge-aware denoiser guided by albedo, normal and depth (render: off; view: on)"},
+    [F_TEMPORAL] = {"--temporal", "on|off", V,
+                    "path, ao: while the camera moves, blend each frame with the last one carried to the new view "
+                    "through its first hits (default on)"},
     [F_FRAMES] = {"--frames", "N", V, "render N frames, print each one's time and exit (default: until the window closes)"},
     [F_CAMERA_PATH] = {"--camera-path", "FILE", V,
                        "frames along a camera path: lines of eye, at, up (x,y,z each) and fov, as --record writes"},

@@ -31,6 +31,8 @@ static void free_buffers(view_renderer *r) {
   r->bgra = NULL;
   fr_denoiser_free(r->dn);
   r->dn = NULL;
+  fr_temporal_free(r->tp);
+  r->tp = NULL;
 }
 
 void view_renderer_free(view_renderer *r) {
@@ -50,11 +52,13 @@ static int camera_of(const view_settings *s, fr_camera *c) {
 int view_renderer_apply(view_renderer *r, const view_settings *s) {
   const int fresh = !r->have_cur || s->mode != r->cur.mode || s->width != r->cur.width || s->height != r->cur.height ||
                     s->trace != r->cur.trace;
-  if (!fresh && view_camera_equal(&s->cam, &r->cur.cam) && s->denoise == r->cur.denoise) return 0;
+  if (!fresh && view_camera_equal(&s->cam, &r->cur.cam) && s->denoise == r->cur.denoise && s->temporal == r->cur.temporal)
+    return 0;
   fr_camera cam;
   int rc = camera_of(s, &cam);
   if (rc) return rc;
-  if (!fresh && view_camera_equal(&s->cam, &r->cur.cam)) { /* the denoiser alone: the sums stay */
+  if (!fresh && view_camera_equal(&s->cam, &r->cur.cam)) { /* the denoiser or the blending: the sums stay */
+    if (s->temporal != r->cur.temporal || s->denoise != r->cur.denoise) fr_temporal_reset(r->tp);
     r->cur = *s;
     return 0;
   }
@@ -69,7 +73,8 @@ int view_renderer_apply(view_renderer *r, const view_settings *s) {
     const size_t np = (size_t)s->width * (size_t)s->height;
     r->rgb = malloc(np * 10 * sizeof(float));
     r->bgra = malloc(np * 4);
-    if (!r->rgb || !r->bgra || fr_denoiser_new(s->width, s->height, &r->dn)) {
+    if (!r->rgb || !r->bgra || fr_denoiser_new(s->width, s->height, &r->dn) ||
+        fr_temporal_new(s->width, s->height, &r->tp)) {
       free_buffers(r);
       r->buf_w = r->buf_h = 0;
       return cli_error(1, "out of memory for a %dx%d frame", s->width, s->height);
@@ -92,6 +97,7 @@ int view_renderer_apply(view_renderer *r, const view_settings *s) {
   w.max_depth = r->wo->depth;
   if (r->prog_ready) fr_progressive_free(&r->prog);
   r->prog_ready = 0;
+  fr_temporal_reset(r->tp); /* another image: nothing to carry over */
   if (fr_progressive_init(&r->prog, &w, s->mode)) return cli_error(1, "%s", fr_last_error());
   r->prog_ready = 1;
   r->prog.soft = r->so;
@@ -104,7 +110,15 @@ int view_renderer_apply(view_renderer *r, const view_settings *s) {
   return 0;
 }
 
+/* Temporal blending is for the noisy modes, path and ao: softshadow's
+ * first pass is filtered already, and its frame rate has no room for the
+ * blend's cost (about 20 ms at 1024x768 on 2 threads). */
+static int temporal_applies(const view_renderer *r) {
+  return r->tp && r->cur.temporal && (r->cur.mode == FR_SM_PATH || r->cur.mode == FR_SM_AO);
+}
+
 int view_renderer_done(const view_renderer *r) { return !r->prog_ready || fr_progressive_done(&r->prog); }
+float view_renderer_reused(const view_renderer *r) { return temporal_applies(r) ? fr_temporal_reused(r->tp) : 0.0f; }
 int view_renderer_spp(const view_renderer *r) { return r->prog_ready ? fr_progressive_spp(&r->prog) : 0; }
 
 /* A display value of v in [0, 1] as 8-bit sRGB, through r's table (powf
@@ -132,9 +146,14 @@ int view_renderer_pass(view_renderer *r, const int *cancel) {
   r->seconds = res.seconds;
   fr_progressive_resolve(&r->prog, r->rgb, r->albedo, r->normal, r->depth);
   r->denoise_seconds = 0.0;
+  int spp = fr_progressive_spp(&r->prog);
+  if (temporal_applies(r)) {
+    fr_temporal_apply(r->tp, &r->prog.w.cam, r->prog.passes, r->depth, r->normal, r->rgb, r->base.threads);
+    spp = (int)(spp * (1.0f + fr_temporal_worth(r->tp)));
+  }
   if (r->cur.denoise && fr_shade_mode_progressive(r->cur.mode)) {
     const double t0 = fr_seconds();
-    fr_denoise(r->dn, r->rgb, r->albedo, r->normal, r->depth, fr_progressive_spp(&r->prog), r->base.threads, r->rgb);
+    fr_denoise(r->dn, r->rgb, r->albedo, r->normal, r->depth, spp, r->base.threads, r->rgb);
     r->denoise_seconds = fr_seconds() - t0;
   }
   const size_t np = (size_t)r->cur.width * (size_t)r->cur.height;

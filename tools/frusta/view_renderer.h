@@ -7,6 +7,7 @@
 #include "cli.h"
 #include "cli_path.h"
 #include "film/denoise.h"
+#include "film/temporal.h"
 #include "render/progressive.h"
 #include "render/whitted.h"
 #include "view_camera.h"
@@ -22,6 +23,7 @@ typedef struct view_settings {
   fr_shade_mode mode;
   view_trace trace;
   int denoise;      /* progressive modes only */
+  int temporal;     /* path and ao: temporal reprojection while the camera moves */
 } view_settings;
 
 typedef struct view_renderer {
@@ -39,6 +41,7 @@ typedef struct view_renderer {
   fr_progressive prog;
   int prog_ready;
   fr_denoiser *dn;
+  fr_temporal *tp;
   fr_mft_tracer mctx;
   float *rgb, *albedo, *normal, *depth; /* the resolved (and denoised) image and its guides */
   uint8_t *bgra;           /* the screen's pixels, 4 bytes each */
@@ -54,7 +57,8 @@ void view_renderer_init(view_renderer *r, fr_scene *s, const fr_workload *base, 
                         fr_softshadow_opts so);
 void view_renderer_free(view_renderer *r);
 /* Makes the next pass render s: a new mode, trace mode or size starts
- * afresh, a new camera restarts the sums. 0, or the exit code after
+ * afresh, a new camera restarts the sums (and, with temporal set, the
+ * next frame blends in the last one carried to the new view). 0, or the exit code after
  * reporting. */
 int view_renderer_apply(view_renderer *r, const view_settings *s);
 /* Whether another pass would change the image. */
@@ -62,6 +66,8 @@ int view_renderer_done(const view_renderer *r);
 /* One pass; 1 when the image changed (rgb and bgra hold it), 0 when it was
  * abandoned (*cancel set) or nothing was left to do. */
 int view_renderer_pass(view_renderer *r, const int *cancel);
+/* The share of the last frame's pixels blended with the one before (0..1). */
+float view_renderer_reused(const view_renderer *r);
 /* Samples per pixel of the image (render/progressive.h). */
 int view_renderer_spp(const view_renderer *r);
 /* Writes the image as `frusta render` would (PNG of a path image through
