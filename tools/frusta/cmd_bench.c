@@ -458,7 +458,7 @@ static int bench_workload(const bench_opts *o, bench_setup *b, fr_workload_kind 
         return cli_error(1, "%s", fr_last_error());
       }
       if (b->feed && (r->shares || (r->shares = calloc((size_t)fr_cluster_size(), sizeof *r->shares))))
-        for (int k = 0; k < fr_cluster_size(); k++) r->shares[k] = fr_cluster_feed_share(b->feed, k);
+        for (int rk = 0; rk < fr_cluster_size(); rk++) r->shares[rk] = fr_cluster_feed_share(b->feed, rk);
       fr_counters c = fr_counters_read();
       fr_counters_add(&r->c, &c);
       int fastest = 1;

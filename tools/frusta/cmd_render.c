@@ -221,10 +221,6 @@ static int render_scene(fr_scene *s, fr_workload *wp, const char *const *val, in
    * --cull: large packets of --packet x --packet */
   fr_lp_tracer lpc = {s, cli_lp_scene(s), wo.lp, wo.packet};
   fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
-  if (w.kind == FR_WL_WHITTED && mft == 1 && wo.large_flags) {
-    fr_whitted_mats_free(&mats); free(w.image);
-    return cli_error(CLI_USAGE_ERROR, "--mft on and --packet/--traversal/--cull: large packets need --mft off");
-  }
   /* multi-frusta tracing does not see spheres: such scenes go the packet
    * way. Camera rays are traced as frusta by default for every shade, the
    * rest as streams (auto). */
@@ -295,6 +291,8 @@ int cmd_render(int argc, char **argv) {
   memset(&w, 0, sizeof w);
   fr_shade_mode_workload((fr_shade_mode)shade, &w.kind, &w.shade);
 
+  if (w.kind == FR_WL_WHITTED && mft == 1 && wo.large_flags)
+    return cli_error(CLI_USAGE_ERROR, "--mft on and --packet/--traversal/--cull: large packets need --mft off");
   fr_scene *s = NULL;
   fr_cluster_feed *feed = NULL;
   const int set_up = cli_workload_setup(scene, &v, threads, &s, &w);
