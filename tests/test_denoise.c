@@ -1,7 +1,8 @@
 /* The denoiser (film/denoise.h): every ISA gives the same bits; noise on a
  * flat lit plane falls tenfold in squared error; an edge between two
  * normals is not blurred across; background pixels pass through; albedo
- * detail survives. */
+ * detail survives; black specks at 1 spp take their neighbours' light,
+ * the same bits on any number of threads. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -104,6 +105,25 @@ static void edges_kept(void **st) {
   fr_denoiser_free(d);
 }
 
+/* At 1 spp a pixel whose path found no light is black: it takes its
+ * neighbours' light, and the image is the same bits on 1 and 3 threads. */
+static void black_specks_filled(void **st) {
+  (void)st;
+  static image im;
+  static float out[2][3 * NP];
+  plane(&im, 0.1f, 0);
+  for (size_t i = 3 * W + 3; i < NP; i += 37)
+    for (int c = 0; c < 3; c++) im.rgb[3 * i + c] = 0.0f;
+  fr_denoiser *d;
+  assert_int_equal(fr_denoiser_new(W, H, &d), FR_OK);
+  fr_denoise(d, im.rgb, im.albedo, im.normal, im.depth, 1, 1, out[0]);
+  fr_denoise(d, im.rgb, im.albedo, im.normal, im.depth, 1, 3, out[1]);
+  assert_memory_equal(out[0], out[1], sizeof out[0]);
+  for (size_t i = 3 * W + 3; i < NP; i += 37)
+    for (int c = 0; c < 3; c++) assert_true(out[0][3 * i + c] > 0.5f * im.truth[3 * i + c]);
+  fr_denoiser_free(d);
+}
+
 static void bad_sizes(void **st) {
   (void)st;
   fr_denoiser *d = (fr_denoiser *)1;
@@ -118,6 +138,7 @@ int main(void) {
       cmocka_unit_test(every_isa_alike),
       cmocka_unit_test(flat_plane_smoothed),
       cmocka_unit_test(edges_kept),
+      cmocka_unit_test(black_specks_filled),
       cmocka_unit_test(bad_sizes),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

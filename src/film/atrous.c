@@ -4,7 +4,9 @@
  *   kernel  (1/4, 1/2, 1/4) per axis
  *   normal  max(0, n_p . n_q)^16
  *   depth   max(0, 1 - |z_p - z_q| / (sigma_z * zgrad_p * distance + 1e-3 z_p))
- *   colour  max(0, 1 - |l_p - l_q| / (2 sigma_l l_p + 1e-4))
+ *   colour  max(0, 1 - |l_p - l_q| / (2 sigma_l (l_p + l_floor) + 1e-4))
+ * (l_floor, the frame's mean over spp, lets a pixel whose samples found
+ * no light, l_p = 0, take its neighbours' light instead of staying black)
  * Polynomial falloffs rather than exponentials, and denominators that
  * depend on p and the tap's distance only (four divisions per pixel),
  * keep the taps to adds and multiplies.
@@ -28,7 +30,7 @@ void FR_ISA_FN(fr_atrous_rows)(const fr_atrous_level *L, int y0, int y1) {
       const vpf npx = vp_load(L->nrm[0] + o), npy = vp_load(L->nrm[1] + o), npz = vp_load(L->nrm[2] + o);
       const vpf cr = vp_load(L->in[0] + o), cg = vp_load(L->in[1] + o), cb = vp_load(L->in[2] + o);
       const vpf lp = luminance(cr, cg, cb);
-      const vpf inv_l = vp_div(one, vp_add(vp_mul(vp(2.0f * L->sigma_l), lp), vp(1e-4f)));
+      const vpf inv_l = vp_div(one, vp_add(vp_mul(vp(2.0f * L->sigma_l), vp_add(lp, vp(L->lum_floor))), vp(1e-4f)));
       vpf inv_z[3]; /* by the tap's distance in steps: 0, 1 or 2 */
       for (int k = 0; k < 3; k++)
         inv_z[k] = vp_div(one, vp_add(vp_add(vp_mul(vp(L->sigma_z * (float)(s * k)), gp), vp_mul(vp(1e-3f), zp)), vp(1e-20f)));

@@ -23,6 +23,7 @@ typedef struct fr_atrous_level {
   int step;            /* 1, 2, 4, ...: the distance between taps */
   float sigma_l;       /* relative luminance difference that stops blending */
   float sigma_z;       /* depth difference, in units of the expected change, that stops blending */
+  float lum_floor;     /* added to each pixel's luminance where sigma_l scales it: a black pixel may blend */
 } fr_atrous_level;
 
 /* Rows [y0, y1) of one level: each pixel that sees geometry becomes the

@@ -23,6 +23,8 @@ struct fr_denoiser {
   size_t stride, plane;   /* floats per padded row and per plane */
   float *mem;
   float *p[P_COUNT];
+  double *row_lum;        /* per row: the summed luminance of the illumination where it sees geometry */
+  int *row_hits;          /* ... and how many pixels that is */
 };
 
 static void atrous_rows(const fr_atrous_level *L, int y0, int y1) {
@@ -44,7 +46,12 @@ fr_error fr_denoiser_new(int width, int height, fr_denoiser **out) {
   d->stride = (size_t)d->row + 2 * FR_ATROUS_PAD;
   d->plane = d->stride * ((size_t)height + 2 * FR_ATROUS_PAD);
   d->mem = fr_alloc_aligned(d->plane * P_COUNT * sizeof(float), 64);
-  if (!d->mem) { free(d); return fr_fail(FR_ERR_NOMEM, "out of memory for the denoiser"); }
+  d->row_lum = malloc((size_t)height * sizeof *d->row_lum);
+  d->row_hits = malloc((size_t)height * sizeof *d->row_hits);
+  if (!d->mem || !d->row_lum || !d->row_hits) {
+    fr_denoiser_free(d);
+    return fr_fail(FR_ERR_NOMEM, "out of memory for the denoiser");
+  }
   for (int k = 0; k < P_COUNT; k++) d->p[k] = d->mem + (size_t)k * d->plane;
   /* the border: background, which no pixel blends with */
   memset(d->mem, 0, d->plane * P_COUNT * sizeof(float));
@@ -56,6 +63,8 @@ fr_error fr_denoiser_new(int width, int height, fr_denoiser **out) {
 void fr_denoiser_free(fr_denoiser *d) {
   if (!d) return;
   fr_free_aligned(d->mem);
+  free(d->row_lum);
+  free(d->row_hits);
   free(d);
 }
 
@@ -66,8 +75,10 @@ static size_t at(const fr_denoiser *d, int x, int y) {
 /* Row y of the image into the planes: illumination (colour over albedo;
  * non-finite colour as 0), unit normals, depth (MISS for background,
  * whose colour is kept as it is). */
-static void split_row(const fr_denoiser *d, const float *rgb, const float *albedo, const float *normal, const float *depth,
+static void split_row(fr_denoiser *d, const float *rgb, const float *albedo, const float *normal, const float *depth,
                       int y) {
+  double lum = 0.0;
+  int hits = 0;
   const size_t o = at(d, 0, y);
   float *in0 = d->p[P_IN0] + o, *in1 = d->p[P_IN1] + o, *in2 = d->p[P_IN2] + o;
   float *n0 = d->p[P_N0] + o, *n1 = d->p[P_N1] + o, *n2 = d->p[P_N2] + o, *z = d->p[P_Z] + o;
@@ -83,9 +94,11 @@ static void split_row(const fr_denoiser *d, const float *rgb, const float *albed
       v[k] = hit ? ck / maxf(a[k], ALBEDO_MIN) : c[k];
     }
     in0[x] = v[0], in1[x] = v[1], in2[x] = v[2];
+    if (hit) lum += 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2], hits++;
     n0[x] = n[0] * inv, n1[x] = n[1] * inv, n2[x] = n[2] * inv;
     z[x] = hit ? zz : MISS;
   }
+  d->row_lum[y] = lum, d->row_hits[y] = hits;
 }
 
 /* The depth change per pixel step of row y (from the padded depth plane,
@@ -116,10 +129,18 @@ void fr_denoise(fr_denoiser *d, const float *rgb, const float *albedo, const flo
   for (int y = 0; y < H; y++) depth_gradient_row(d, y);
   /* luminance is trusted more as samples add up: noise falls as 1/sqrt(spp) */
   const float sigma_l0 = 4.0f / sqrtf((float)(spp > 1 ? spp : 1));
+  /* the frame's mean illumination (rows summed in order: the same bits on
+   * any number of threads) */
+  double lum = 0.0, hits = 0.0;
+  for (int y = 0; y < H; y++) lum += d->row_lum[y], hits += d->row_hits[y];
+  const float mean = hits > 0.0 ? (float)(lum / hits) : 0.0f;
+  /* a pixel with no light at all is likely at one sample and rare at many:
+   * the mean's help falls as 1/spp */
+  const float lum_floor = mean / (float)(spp > 1 ? spp : 1);
   float *src[3] = {p[P_IN0], p[P_IN1], p[P_IN2]}, *dst[3] = {p[P_TMP0], p[P_TMP1], p[P_TMP2]};
   for (int level = 0; level < FR_DENOISE_LEVELS; level++) {
     fr_atrous_level L = {{src[0], src[1], src[2]}, {dst[0], dst[1], dst[2]}, {p[P_N0], p[P_N1], p[P_N2]}, p[P_Z], p[P_ZG],
-                         d->stride, d->row, 1 << level, sigma_l0 / (float)(1 << level), 2.0f};
+                         d->stride, d->row, 1 << level, sigma_l0 / (float)(1 << level), 2.0f, lum_floor};
     const int chunk = 8;
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
     for (int y0 = 0; y0 < H; y0 += chunk) atrous_rows(&L, y0, y0 + chunk < H ? y0 + chunk : H);
