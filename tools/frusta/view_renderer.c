@@ -144,7 +144,9 @@ int view_renderer_pass(view_renderer *r, const int *cancel) {
   if (res.cancelled) return 0;
   r->rays = res.rays;
   r->seconds = res.seconds;
-  fr_progressive_resolve(&r->prog, r->rgb, r->albedo, r->normal, r->depth);
+  /* the guides are for the denoiser and the temporal blend only */
+  const int guides = fr_shade_mode_progressive(r->cur.mode) && (r->cur.denoise || temporal_applies(r));
+  fr_progressive_resolve(&r->prog, r->rgb, guides ? r->albedo : NULL, guides ? r->normal : NULL, guides ? r->depth : NULL);
   r->denoise_seconds = 0.0;
   int spp = fr_progressive_spp(&r->prog);
   if (temporal_applies(r)) {
