@@ -8,7 +8,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SIZE=${1:-256x192}
-REF=${2:-1024}
+REF=${2:-4096}
 F=${FRUSTA:-./build/frusta}
 K=../shared/scenes/kitchen/kitchen.ply.zst
 RAW=bench/results/denoise.txt

@@ -11,7 +11,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 FRAMES=${1:-8}
 SIZE=${2:-256x192}
-REF=${3:-1024}
+REF=${3:-4096}
 F=${FRUSTA:-./build/frusta}
 K=../shared/scenes/kitchen/kitchen.ply.zst
 RAW=bench/results/temporal.txt

@@ -55,6 +55,7 @@ wait $VP; code=$?
 [ "$code" -eq 0 ] && grep -q '^keys:' "$T/live.out" && ok || { bad "interactive view exited $code"; cat "$T/live.err"; }
 grep -q '^whitted depth=' "$T/live.out" && ok || bad "key 5 did not switch the live view to whitted"
 grep -q '^--eye .* --fov ' "$T/live.out" && ok || bad "key p did not print the camera"
+grep -q '^view: [0-9]* changes answered in [0-9.]* ms median' "$T/live.out" && ok || bad "the live view did not say how soon it answered"
 
 S="--size 96x64 --threads 2"
 # every deterministic mode: one frame equals render

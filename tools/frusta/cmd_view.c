@@ -43,6 +43,11 @@ typedef struct view_shared {
   uint64_t rays;
   int shot;             /* a screenshot is asked for */
   char shot_name[64];
+  /* how soon a change is answered: from the first change the worker has
+   * not picked up (0: none) to the start of the new view's pass */
+  double changed_at;
+  float answer_ms[4096];
+  int answers;
 } view_shared;
 
 typedef struct view_app {
@@ -83,6 +88,11 @@ static void *worker(void *arg) {
     if (!have || applied != gen) {
       rc = view_renderer_apply(&app->r, &want);
       applied = gen, have = 1;
+      pthread_mutex_lock(&sh->lock);
+      if (sh->changed_at > 0.0 && sh->answers < (int)(sizeof sh->answer_ms / sizeof sh->answer_ms[0]))
+        sh->answer_ms[sh->answers++] = (float)((fr_seconds() - sh->changed_at) * 1e3);
+      sh->changed_at = 0.0;
+      pthread_mutex_unlock(&sh->lock);
     }
     if (!rc) fresh = view_renderer_pass(&app->r, &sh->cancel);
     pthread_mutex_lock(&sh->lock);
@@ -126,6 +136,11 @@ static void set_title(view_app *app, const view_settings *s, double fps, double 
            fr_shade_mode_name(s->mode), view_trace_names[s->trace], fps, mrays, spp,
            s->denoise && fr_shade_mode_progressive(s->mode) ? " - denoised" : "");
   SDL_SetWindowTitle(app->win, t);
+}
+
+static int cmp_float(const void *a, const void *b) {
+  const float x = *(const float *)a, y = *(const float *)b;
+  return x < y ? -1 : x > y;
 }
 
 /* Interactive: returns the exit code. */
@@ -202,6 +217,7 @@ static int run_interactive(view_app *app, view_settings init, float speed) {
       pthread_mutex_lock(&sh->lock);
       sh->want = w;
       sh->gen++;
+      if (sh->changed_at == 0.0) sh->changed_at = fr_seconds();
       __atomic_store_n(&sh->cancel, 1, __ATOMIC_RELAXED);
       pthread_cond_signal(&sh->wake);
       pthread_mutex_unlock(&sh->lock);
@@ -224,6 +240,11 @@ static int run_interactive(view_app *app, view_settings init, float speed) {
   pthread_cond_signal(&sh->wake);
   pthread_mutex_unlock(&sh->lock);
   pthread_join(th, NULL);
+  if (sh->answers) { /* how responsive it was */
+    qsort(sh->answer_ms, (size_t)sh->answers, sizeof sh->answer_ms[0], cmp_float);
+    printf("view: %d changes answered in %.1f ms median, %.1f ms at most (the pass under way abandoned, the new "
+           "view begun)\n", sh->answers, (double)sh->answer_ms[sh->answers / 2], (double)sh->answer_ms[sh->answers - 1]);
+  }
   return rc ? rc : sh->error;
 }
 
