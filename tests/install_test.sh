@@ -1,0 +1,50 @@
+#!/bin/sh
+# frusta installed as a user installs it: `cmake --install` into a fresh
+# prefix puts the shared library (with its SONAME), the static one,
+# frusta.h alone, the command, its manual page, frusta.pc and the CMake
+# package there; an example program builds against it from outside the
+# build tree through pkg-config (shared and static) and through
+# find_package(frusta), and runs.
+# usage: install_test.sh BUILD_DIR SOURCE_DIR
+set -u
+B="$1"; SRC="$2"
+T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
+fails=0; passes=0
+ok() { passes=$((passes+1)); }
+bad() { echo "FAIL: $*"; fails=$((fails+1)); }
+P="$T/prefix"
+cmake --install "$B" --prefix "$P" >"$T/install.log" 2>&1 || { bad "cmake --install failed"; cat "$T/install.log"; }
+LIB=$(dirname "$(find "$P" -name libfrusta.a | head -1)")
+for f in "$P/include/frusta.h" "$P/bin/frusta" "$LIB/libfrusta.a" "$LIB/libfrusta.so" "$LIB/pkgconfig/frusta.pc" \
+         "$LIB/cmake/frusta/frustaConfig.cmake" "$P/share/man/man1/frusta.1"; do
+  [ -e "$f" ] && ok || bad "not installed: $f"
+done
+[ "$(ls "$P/include")" = "frusta.h" ] && ok || bad "the include folder holds more than frusta.h: $(ls "$P/include")"
+readelf -d "$LIB/libfrusta.so" | grep -q 'SONAME.*libfrusta\.so\.0' && ok || bad "libfrusta.so has no SONAME libfrusta.so.0"
+"$P/bin/frusta" --version >/dev/null && ok || bad "the installed command does not run"
+
+# pkg-config, shared and static; the example checks its own answer
+EX="$(cd "$SRC" && pwd)/examples/trace_one_ray.c"
+export PKG_CONFIG_PATH="$LIB/pkgconfig"
+if cc "$EX" $(pkg-config --cflags --libs frusta) -lm -o "$T/one_shared" 2>"$T/cc.log"; then
+  LD_LIBRARY_PATH="$LIB" "$T/one_shared" >/dev/null && ok || bad "the example built through pkg-config does not run"
+else
+  bad "the example does not build through pkg-config"; cat "$T/cc.log"
+fi
+if cc "$EX" $(pkg-config --cflags frusta) "$LIB/libfrusta.a" $(pkg-config --static --libs-only-l frusta | sed 's/-lfrusta //') \
+     -o "$T/one_static" 2>"$T/cc.log"; then
+  "$T/one_static" >/dev/null && ok || bad "the example linked statically does not run"
+  ldd "$T/one_static" | grep -q libfrusta && bad "the static build still needs libfrusta.so" || ok
+else
+  bad "the example does not link statically through pkg-config --static"; cat "$T/cc.log"
+fi
+
+# CMake: find_package(frusta) and frusta::frusta
+if cmake -S "$SRC/tests/install_consumer" -B "$T/consumer" -DCMAKE_PREFIX_PATH="$P" -DEXAMPLE="$EX" >"$T/cm.log" 2>&1 &&
+   cmake --build "$T/consumer" >>"$T/cm.log" 2>&1; then
+  LD_LIBRARY_PATH="$LIB" "$T/consumer/trace_one_ray" >/dev/null && ok || bad "the example built through CMake does not run"
+else
+  bad "the example does not build through find_package(frusta)"; tail -20 "$T/cm.log"
+fi
+echo "install: $passes passed, $fails failed"
+[ "$fails" -eq 0 ]
