@@ -22,6 +22,9 @@
 int fr_cluster_start(int *argc, char ***argv);
 /* Leaves the job (MPI_Finalize); rc is the process's exit code. */
 void fr_cluster_stop(int rc);
+/* This process has told the user why it fails (exit code rc): when the
+ * launcher stops the job because other ranks ended, it ends quietly. */
+void fr_cluster_told(int rc);
 int fr_cluster_rank(void);
 int fr_cluster_size(void);
 /* Whether this frusta was built with MPI. */

@@ -9,6 +9,7 @@
 #include "cluster/cluster.h"
 
 static int started, rank, size = 1;
+static volatile sig_atomic_t told; /* the exit code of a failure already told, or 0 */
 /* set once the ranks agreed to go on together (fr_cluster_agree): from
  * then on a rank that fails alone leaves the others waiting on it */
 static int lockstep;
@@ -22,11 +23,14 @@ static int launched(void) {
 /* A launcher stops the job when a rank dies or fails: rank 0, the one
  * whose output a user reads, says so in one line before it goes. */
 static void on_stop(int sig) {
+  if (told) _exit(told);
   static const char msg[] = "frusta: stopped by the MPI launcher: another rank failed or the job was interrupted\n";
   ssize_t w = write(2, msg, sizeof msg - 1);
   (void)w;
   _exit(1);
 }
+
+void fr_cluster_told(int rc) { told = rc ? rc : 1; }
 
 int fr_cluster_start(int *argc, char ***argv) {
   if (!launched()) return 0;

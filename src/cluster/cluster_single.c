@@ -18,6 +18,7 @@ int fr_cluster_start(int *argc, char ***argv) {
 }
 
 void fr_cluster_stop(int rc) {}
+void fr_cluster_told(int rc) {}
 int fr_cluster_rank(void) { return 0; }
 int fr_cluster_size(void) { return 1; }
 int fr_cluster_built(void) { return 0; }

@@ -7,6 +7,7 @@
 #include <string.h>
 #include "api/scene.h"
 #include "cli_scene_file.h"
+#include "cluster/cluster.h"
 #include "io/file_read.h"
 #include "render/whitted.h"
 #include "render/workload.h"
@@ -24,6 +25,7 @@ int cli_error(int code, const char *fmt, ...) {
     if (*p == '\n') *p = ' ';
   memcpy(last_msg, msg, sizeof msg);
   if (!quiet) fprintf(stderr, "frusta: %s\n", msg);
+  fr_cluster_told(code); /* rank 0 has said why: a stop by the launcher adds nothing */
   return code;
 }
 
