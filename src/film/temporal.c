@@ -113,9 +113,9 @@ static void reproject(fr_temporal *t, const fr_camera *cam, const float *depth, 
          * neighbouring pixel of another surface can be as far away) */
         if (!miss) {
           const vec3 nq = v3_load(t->normal + 3 * q);
-          const float c = v3_dot(nq, n); /* n is unit, nq need not be */
+          const float cn = v3_dot(nq, n); /* n is unit, nq need not be */
           if (!(fabsf(t->depth[q] - dist) <= FR_TEMPORAL_DEPTH_TOL * dist) ||
-              !(c > 0.0f && c * c >= FR_TEMPORAL_NORMAL_COS * FR_TEMPORAL_NORMAL_COS * v3_dot(nq, nq)) ||
+              !(cn > 0.0f && cn * cn >= FR_TEMPORAL_NORMAL_COS * FR_TEMPORAL_NORMAL_COS * v3_dot(nq, nq)) ||
               !(fabsf(v3_dot(v3_sub(v3_load(t->pos + 3 * q), p), n)) <= FR_TEMPORAL_PLANE_TOL * dist))
             continue;
         }
