@@ -24,55 +24,23 @@ done
   echo "# commit $(git rev-parse --short HEAD)$(git diff --quiet HEAD -- src tools include || echo '+changes')"
   echo "# bench/denoise_quality.sh $SIZE $REF"
   python3 - "$T" <<'PY'
-import struct, sys, math
+import sys
+sys.path.insert(0, "bench")
+from pfm_images import pfm, rel_rmse
 T = sys.argv[1]
-def pfm(path):
-    with open(path, 'rb') as f:
-        assert f.readline().strip() == b'PF'
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        data = f.read()
-    return struct.unpack(('<' if scale < 0 else '>') + 'f' * (w * h * 3), data)
-ref = pfm(f'{T}/ref.pfm')
-def rel_rmse(img):  # per value, relative to the reference's value (+0.01)
-    s = sum(((a - b) / (b + 0.01)) ** 2 for a, b in zip(img, ref))
-    return math.sqrt(s / len(ref))
+ref = pfm(f'{T}/ref.pfm')[2]
 for spp in (1, 4, 16):
-    print(f"spp={spp} rel_rmse_noisy={rel_rmse(pfm(f'{T}/n{spp}.pfm')):.4f} rel_rmse_denoised={rel_rmse(pfm(f'{T}/d{spp}.pfm')):.4f}")
+    print(f"spp={spp} rel_rmse_noisy={rel_rmse(pfm(f'{T}/n{spp}.pfm')[2], ref):.4f} "
+          f"rel_rmse_denoised={rel_rmse(pfm(f'{T}/d{spp}.pfm')[2], ref):.4f}")
 PY
 } | tee "$RAW"
 # the picture: 1 spp, 1 spp denoised / 16 spp denoised, the reference,
 # through the same filmic curve and sRGB as the command's PNGs
 python3 - "$T" docs/denoise_kitchen.png <<'PY'
-import struct, sys, zlib
+import sys
+sys.path.insert(0, "bench")
+from pfm_images import pfm, write_png
 T, out = sys.argv[1:3]
-def pfm(path):
-    with open(path, 'rb') as f:
-        assert f.readline().strip() == b'PF'
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        v = struct.unpack(('<' if scale < 0 else '>') + 'f' * (w * h * 3), f.read())
-    return w, h, v
-def code(x):
-    x = max(x, 0.0)
-    x = x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14)
-    if x >= 1.0: return 255
-    s = 12.92 * x if x <= 0.0031308 else 1.055 * x ** (1 / 2.4) - 0.055
-    return int(s * 255 + 0.5)
-panels = [pfm(f"{T}/{n}.pfm") for n in ("n1", "d1", "d16", "ref")]
-w, h = panels[0][0], panels[0][1]
-rows = []
-for gy in range(2):
-    for y in range(h):  # PFM rows run bottom to top
-        row = bytearray([0])
-        for gx in range(2):
-            v = panels[2 * gy + gx][2]
-            base = (h - 1 - y) * w * 3
-            row += bytes(code(c) for c in v[base:base + 3 * w])
-        rows.append(bytes(row))
-def chunk(t, d): return struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
-png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 2 * w, 2 * h, 8, 2, 0, 0, 0))
-png += chunk(b"IDAT", zlib.compress(b"".join(rows), 9)) + chunk(b"IEND", b"")
-open(out, "wb").write(png)
+write_png(out, [pfm(f"{T}/{n}.pfm") for n in ("n1", "d1", "d16", "ref")], 2)
 PY
 echo "-> docs/denoise_kitchen.png"

@@ -42,20 +42,13 @@ set -- $(tail -1 "$T/cam.path")
   echo "# bench/temporal_quality.sh $FRAMES $SIZE $REF"
   for f in "$T"/v_*.log; do echo "## $(basename "$f" .log)"; tail -2 "$f"; done
   python3 - "$T" <<'PY'
-import struct, sys, math
+import sys
+sys.path.insert(0, "bench")
+from pfm_images import pfm, rel_rmse
 T = sys.argv[1]
-def pfm(path):
-    with open(path, 'rb') as f:
-        assert f.readline().strip() == b'PF'
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        data = f.read()
-    return struct.unpack(('<' if scale < 0 else '>') + 'f' * (w * h * 3), data)
-ref = pfm(f'{T}/ref.pfm')
-def rel_rmse(img):  # per value, relative to the reference's value (+0.01)
-    return math.sqrt(sum(((a - b) / (b + 0.01)) ** 2 for a, b in zip(img, ref)) / len(ref))
+ref = pfm(f'{T}/ref.pfm')[2]
 for dn in ('off', 'on'):
-    print(f"denoise={dn} rel_rmse_temporal_off={rel_rmse(pfm(f'{T}/v_{dn}_off.pfm')):.4f} "
-          f"rel_rmse_temporal_on={rel_rmse(pfm(f'{T}/v_{dn}_on.pfm')):.4f}")
+    print(f"denoise={dn} rel_rmse_temporal_off={rel_rmse(pfm(f'{T}/v_{dn}_off.pfm')[2], ref):.4f} "
+          f"rel_rmse_temporal_on={rel_rmse(pfm(f'{T}/v_{dn}_on.pfm')[2], ref):.4f}")
 PY
 } | tee "$RAW"
