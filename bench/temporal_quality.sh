@@ -16,17 +16,8 @@ F=${FRUSTA:-./build/frusta}
 K=../shared/scenes/kitchen/kitchen.ply.zst
 RAW=bench/results/temporal.txt
 T=$(mktemp -d)
-if [ -z "${DISPLAY:-}" ]; then
-  D=$((100 + $$ % 800))
-  Xvfb ":$D" -screen 0 1280x1024x24 -nolisten tcp >/dev/null 2>&1 &
-  XPID=$!
-  trap 'kill $XPID; rm -rf "$T"' EXIT
-  export DISPLAY=":$D"
-  for _ in $(seq 100); do [ -e "/tmp/.X11-unix/X$D" ] && break; sleep 0.1; done
-else
-  trap 'rm -rf "$T"' EXIT
-fi
-export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-$T}
+. bench/display.sh
+with_display "$T"
 mkdir -p bench/results
 V="--shade path --size $SIZE --threads 2 --frames $FRAMES --turntable 0.5"
 for dn in off on; do

@@ -13,15 +13,8 @@ FRAMES=${1:-30}
 RAW=bench/results/view_fps.txt
 F=${FRUSTA:-./build/frusta}
 S=../shared/scenes
-if [ -z "${DISPLAY:-}" ]; then
-  D=$((100 + $$ % 800))
-  Xvfb ":$D" -screen 0 1280x1024x24 -nolisten tcp >/dev/null 2>&1 &
-  XPID=$!
-  trap 'kill $XPID' EXIT
-  export DISPLAY=":$D"
-  for _ in $(seq 100); do [ -e "/tmp/.X11-unix/X$D" ] && break; sleep 0.1; done
-fi
-export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-$(mktemp -d)}
+. bench/display.sh
+with_display "$(mktemp -d)"
 mkdir -p bench/results
 {
   echo "# commit $(git rev-parse --short HEAD)$(git diff --quiet HEAD -- src tools include || echo '+changes')"

@@ -14,12 +14,8 @@ RAW=bench/results/view_latency.txt
 F=${FRUSTA:-./build/frusta}
 S=../shared/scenes
 T=$(mktemp -d)
-D=$((100 + $$ % 800))
-Xvfb ":$D" -screen 0 1280x1024x24 -nolisten tcp >/dev/null 2>&1 &
-XPID=$!
-trap 'kill $XPID; rm -rf "$T"' EXIT
-export DISPLAY=":$D" XDG_RUNTIME_DIR="$T"
-for _ in $(seq 100); do [ -e "/tmp/.X11-unix/X$D" ] && break; sleep 0.1; done
+. bench/display.sh
+with_display "$T" always
 mkdir -p bench/results
 {
   echo "# commit $(git rev-parse --short HEAD)$(git diff --quiet HEAD -- src tools include || echo '+changes')"

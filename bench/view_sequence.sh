@@ -13,12 +13,8 @@ SIZE=${2:-320x240}
 F=${FRUSTA:-./build/frusta}
 K=../shared/scenes/kitchen/kitchen.ply.zst
 T=$(mktemp -d)
-D=$((100 + $$ % 800))
-Xvfb ":$D" -screen 0 1280x1024x24 -nolisten tcp >/dev/null 2>&1 &
-XPID=$!
-trap 'kill $XPID; rm -rf "$T"' EXIT
-export DISPLAY=":$D" XDG_RUNTIME_DIR="$T"
-for _ in $(seq 100); do [ -e "/tmp/.X11-unix/X$D" ] && break; sleep 0.1; done
+. bench/display.sh
+with_display "$T" always
 "$F" view "$K" --shade path --size "$SIZE" --threads 2 --frames "$FRAMES" --turntable 1 --screenshot "$T/f#.pfm" >/dev/null
 python3 - "$T" "$FRAMES" docs/view_turntable.png <<'PY'
 import sys
