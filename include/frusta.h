@@ -239,6 +239,23 @@ typedef enum fr_trace_mode {
 fr_error fr_scene_set_trace_mode(fr_scene *s, fr_trace_mode mode);
 fr_trace_mode fr_scene_get_trace_mode(const fr_scene *s);
 
+/* ---- every hit along a ray ------------------------------------------------------
+ * For each of the n rays, every triangle it crosses in (tnear, tfar), in
+ * order of t (ties by triangle number), each triangle once: a ray through
+ * an edge or vertex shared by consistently oriented triangles crosses
+ * exactly one of them, so counts[i] is the number of times ray i passes
+ * through a closed surface (odd from inside, even from outside). The first
+ * min(counts[i], max_hits) crossings go to hits[i * max_hits ...], t being
+ * the plane's distance in double rounded once; the rest of ray i's
+ * max_hits slots read as misses. max_hits may be 0 (hits may then be NULL)
+ * to count only. The answers are the same in every trace mode and on every
+ * thread. Caller-owned arrays; may be called from several threads at once.
+ * Errors: FR_ERR_ARG (NULL arrays, n * max_hits overflowing), FR_ERR_STATE
+ * (not committed), FR_ERR_UNSUPPORTED (the scene has spheres),
+ * FR_ERR_NOMEM. */
+fr_error fr_intersect_all(const fr_scene *s, const fr_ray *rays, size_t n, fr_hit *hits, size_t max_hits,
+                          uint32_t *counts);
+
 #ifdef __cplusplus
 }
 #endif

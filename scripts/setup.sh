@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 
 PKGS="build-essential cmake pkg-config zstd libzstd-dev libassimp-dev libembree-dev \
 libstb-dev libopenexr-dev libcmocka-dev libcjson-dev assimp-testmodels clang libclang-rt-14-dev libomp-dev \
-libsdl2-dev xvfb xauth xdotool libopenmpi-dev openmpi-bin"
+libsdl2-dev xvfb xauth xdotool libopenmpi-dev openmpi-bin python3-dev python3-numpy python3-pytest"
 
 missing=""
 for p in $PKGS; do
