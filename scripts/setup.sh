@@ -22,3 +22,6 @@ fi
 BUILD_DIR="${FRUSTA_BUILD_DIR:-build}"
 cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$BUILD_DIR" -j "$(nproc)"
+# The Python module into /usr/local, where Debian's python3 finds it.
+SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+$SUDO cmake --install "$BUILD_DIR" --component python >/dev/null

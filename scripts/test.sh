@@ -9,6 +9,15 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 (cd "${FRUSTA_BUILD_DIR:-build}" && ctest --output-on-failure -j "$(nproc)" --timeout 900)
+# The Python module: pytest on the build's copy (checked against the C
+# library's own answers through FRUSTA_LIB), then Debian's python3 importing
+# the installed one from anywhere.
+B="$(cd "${FRUSTA_BUILD_DIR:-build}" && pwd)"
+[ -e "$B/python/frusta/__init__.py" ] || { echo "the Python module was not built (python3-numpy missing?)"; exit 1; }
+SH="${FRUSTA_SHARED:-../shared}"; case "$SH" in /*) ;; *) SH="$(pwd)/$SH" ;; esac
+FRUSTA_LIB="$B/libfrusta.so" FRUSTA_SHARED="$SH" PYTHONPATH="$B/python" \
+  /usr/bin/python3 -m pytest -q -p no:cacheprovider tests/python
+(cd / && /usr/bin/python3 -c "import frusta; print('python3: frusta', frusta.__version__, 'from', frusta.__file__)")
 if [ "${FRUSTA_SANITIZE_TESTS:-1}" != 0 ]; then
   SAN="${FRUSTA_SANITIZE_DIR:-build-sanitize}"
   cmake -S . -B "$SAN" -DCMAKE_BUILD_TYPE=Release -DFRUSTA_SANITIZE=ON >/dev/null

@@ -46,5 +46,21 @@ if cmake -S "$SRC/tests/install_consumer" -B "$T/consumer" -DCMAKE_PREFIX_PATH="
 else
   bad "the example does not build through find_package(frusta)"; tail -20 "$T/cm.log"
 fi
+
+# the Python module, where it was built: installed under the prefix, it
+# imports in Debian's python3 and traces
+if [ -d "$B/python/frusta" ]; then
+  PY=$(find "$P" -name __init__.py -path '*frusta*' | head -1)
+  if [ -n "$PY" ]; then
+    (cd "$T" && PYTHONPATH="$(dirname "$(dirname "$PY")")" /usr/bin/python3 -c "
+import numpy as np, frusta
+s = frusta.Scene(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32), np.array([[0, 1, 2]]))
+h = s.intersect(np.array([[0.2, 0.2, 1]], np.float32), np.array([[0, 0, -1]], np.float32))
+assert h.prim[0] == 0 and abs(h.t[0] - 1) < 1e-6
+") && ok || bad "the installed Python module does not import or trace"
+  else
+    bad "the Python module was built but not installed"
+  fi
+fi
 echo "install: $passes passed, $fails failed"
 [ "$fails" -eq 0 ]

@@ -1,0 +1,84 @@
+"""frusta: exact, fast ray queries on triangle meshes, from numpy.
+
+    import numpy as np, frusta
+    scene = frusta.Scene(vertices, triangles)        # (n, 3) floats, (m, 3) ints
+    hits = scene.intersect(origins, directions)       # arrays of shape origins.shape[:-1]
+    hits.t, hits.prim, hits.u, hits.v, hits.normal    # t = inf, prim = INVALID_ID on a miss
+
+Rays are given as origins and directions of shape (..., 3), any float dtype
+(C-contiguous float32 is read in place, anything else converted once);
+t is in units of the direction, which need not be normalized. tnear and
+tfar are numbers or one value per ray. A NaN or infinite origin or
+direction raises ValueError. Calls release the GIL and trace on all cores
+(set_threads). A scene may be traced from several Python threads at once.
+"""
+from collections import namedtuple
+
+from ._frusta import INVALID_ID, VERSION_MAJOR, VERSION_MINOR, get_threads, isa, set_threads
+from ._frusta import Scene as _Scene
+
+__version__ = f"{VERSION_MAJOR}.{VERSION_MINOR}"
+__all__ = ["Scene", "Hits", "AllHits", "INVALID_ID", "set_threads", "get_threads", "isa"]
+
+Hits = namedtuple("Hits", "t prim u v normal")
+Hits.__doc__ = """Closest hits: t (float32, inf on a miss), prim (uint32 triangle number,
+INVALID_ID on a miss), barycentrics u, v of the 2nd and 3rd vertex, and the
+unnormalized geometric normal (v1 - v0) x (v2 - v0) (zero on a miss)."""
+
+AllHits = namedtuple("AllHits", "ray prim t u v count")
+AllHits.__doc__ = """Every crossing, flat and grouped by ray in order of t: ray (int64 index
+into the rays, flattened), prim, t, u, v; count (shape of the rays) is the
+number of all crossings of each ray, also those beyond max_hits."""
+
+INF = float("inf")
+
+
+class Scene(_Scene):
+    """Scene(vertices, triangles): a triangle mesh, ready to trace.
+
+    vertices: (n, 3) floats (copied); triangles: (m, 3) integer vertex
+    indices. Degenerate triangles are kept in the numbering but never hit.
+    Scene.load(path) reads PLY, OBJ and the formats Assimp reads (also
+    .zst-compressed); Scene.builtin() is frusta's built-in scene.
+    """
+
+    def intersect(self, origins, directions, tnear=0.0, tfar=INF):
+        """The closest hit of each ray in (tnear, tfar), as Hits."""
+        return Hits(*self._intersect(origins, directions, tnear, tfar))
+
+    def occluded(self, origins, directions, tnear=0.0, tfar=INF):
+        """Whether anything lies on each ray in (tnear, tfar): a bool array."""
+        return self._occluded(origins, directions, tnear, tfar)
+
+    def intersect_all(self, origins, directions, max_hits=16, tnear=0.0, tfar=INF):
+        """Every triangle each ray crosses in (tnear, tfar), each once (also
+        through shared edges and vertices), the first max_hits per ray in
+        order of t, as AllHits."""
+        return AllHits(*self._intersect_all(origins, directions, max_hits, tnear, tfar))
+
+    def count_intersections(self, origins, directions, tnear=0.0, tfar=INF):
+        """How many times each ray crosses the surface in (tnear, tfar)
+        (odd: it starts inside a closed, consistently wound mesh)."""
+        return self._intersect_all(origins, directions, 0, tnear, tfar)[5]
+
+    def contains(self, points):
+        """Whether each point lies inside the closed mesh: an odd count of
+        crossings along a fixed, irrational-ish direction."""
+        import numpy as np
+
+        p = np.asarray(points, dtype=np.float32)
+        d = np.broadcast_to(np.array([0.5773503, 0.5773491, 0.5773517], dtype=np.float32), p.shape)
+        return self.count_intersections(p, np.ascontiguousarray(d)) % 2 == 1
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def __repr__(self):
+        try:
+            return f"<frusta.Scene {self.triangle_count} triangles>"
+        except ValueError:
+            return "<frusta.Scene closed>"

@@ -1,0 +1,587 @@
+/*
+ * frusta._frusta: the CPython extension under the frusta package, over the
+ * public C API alone (frusta.h).
+ *
+ * Arrays in: any float dtype of shape (..., 3); a C-contiguous float32 one is
+ * read in place, others are converted once. Arrays out: new numpy arrays of
+ * the rays' leading shape. Tracing runs without the GIL on OpenMP threads,
+ * in chunks of CHUNK rays packed into fr_ray records on the thread's stack.
+ * A scene counts the calls tracing it, so that close() cannot free it under
+ * them.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
+#include <numpy/arrayobject.h>
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+#include "frusta.h"
+
+#define CHUNK 1024
+
+static int n_threads; /* 0: OpenMP's default */
+
+/* ---- errors ------------------------------------------------------------------ */
+
+static PyObject *raise_fr(fr_error e, const char *msg) {
+  PyObject *type = PyExc_RuntimeError;
+  switch (e) {
+  case FR_ERR_ARG: case FR_ERR_FORMAT: type = PyExc_ValueError; break;
+  case FR_ERR_IO: type = PyExc_OSError; break;
+  case FR_ERR_NOMEM: type = PyExc_MemoryError; break;
+  case FR_ERR_UNSUPPORTED: type = PyExc_NotImplementedError; break;
+  default: break;
+  }
+  PyErr_SetString(type, msg && *msg ? msg : fr_error_name(e));
+  return NULL;
+}
+
+/* ---- the Scene type ------------------------------------------------------------ */
+
+typedef struct {
+  PyObject_HEAD
+  fr_scene *scene;
+  int busy; /* calls tracing it now (changed with the GIL held) */
+} SceneObject;
+
+static PyTypeObject SceneType;
+
+static int scene_open(SceneObject *s) {
+  if (s->scene) return 1;
+  PyErr_SetString(PyExc_ValueError, "the scene is closed");
+  return 0;
+}
+
+static PyObject *wrap_scene(PyTypeObject *type, fr_scene *sc) {
+  fr_error e = fr_scene_commit(sc);
+  if (e != FR_OK) {
+    raise_fr(e, fr_last_error());
+    fr_scene_release(sc);
+    return NULL;
+  }
+  SceneObject *o = (SceneObject *)type->tp_alloc(type, 0);
+  if (!o) { fr_scene_release(sc); return NULL; }
+  o->scene = sc;
+  return (PyObject *)o;
+}
+
+/* A float array of shape (..., 3) as C-contiguous float32 (in place if it
+ * is one). */
+static PyArrayObject *vec3_array(PyObject *obj, const char *name) {
+  PyArrayObject *a = (PyArrayObject *)PyArray_FROM_O(obj);
+  if (!a) return NULL;
+  if (!PyArray_ISFLOAT(a)) {
+    PyObject *d = PyObject_Str((PyObject *)PyArray_DESCR(a));
+    if (d) {
+      PyErr_Format(PyExc_TypeError, "%s: expected a float array, got dtype %U", name, d);
+      Py_DECREF(d);
+    }
+    Py_DECREF(a);
+    return NULL;
+  }
+  if (PyArray_NDIM(a) < 1 || PyArray_DIM(a, PyArray_NDIM(a) - 1) != 3) {
+    PyErr_Format(PyExc_ValueError, "%s: expected shape (..., 3), got %d dimensions ending in %zd", name,
+                 PyArray_NDIM(a), PyArray_NDIM(a) ? (Py_ssize_t)PyArray_DIM(a, PyArray_NDIM(a) - 1) : (Py_ssize_t)0);
+    Py_DECREF(a);
+    return NULL;
+  }
+  PyArrayObject *f = (PyArrayObject *)PyArray_FROM_OTF((PyObject *)a, NPY_FLOAT32, NPY_ARRAY_IN_ARRAY | NPY_ARRAY_FORCECAST);
+  Py_DECREF(a);
+  return f;
+}
+
+static PyObject *scene_new(PyTypeObject *type, PyObject *args, PyObject *kw) {
+  static char *names[] = {"vertices", "triangles", NULL};
+  PyObject *vo, *to;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "OO", names, &vo, &to)) return NULL;
+  PyArrayObject *v = vec3_array(vo, "vertices");
+  if (!v) return NULL;
+  PyArrayObject *ta = (PyArrayObject *)PyArray_FROM_O(to);
+  if (!ta) { Py_DECREF(v); return NULL; }
+  if (!PyArray_ISINTEGER(ta) || PyArray_NDIM(ta) != 2 || PyArray_DIM(ta, 1) != 3) {
+    PyErr_SetString(PyExc_ValueError, "triangles: expected an integer array of shape (n, 3)");
+    Py_DECREF(v); Py_DECREF(ta);
+    return NULL;
+  }
+  PyArrayObject *t = (PyArrayObject *)PyArray_FROM_OTF((PyObject *)ta, NPY_INT64, NPY_ARRAY_IN_ARRAY);
+  Py_DECREF(ta);
+  if (!t) { Py_DECREF(v); return NULL; }
+  size_t nv = (size_t)(PyArray_SIZE(v) / 3), nt = (size_t)PyArray_DIM(t, 0);
+  const float *pos = PyArray_DATA(v);
+  const int64_t *ti = PyArray_DATA(t);
+  PyObject *result = NULL;
+  uint32_t *idx = NULL;
+  for (size_t i = 0; i < 3 * nv; i++)
+    if (!isfinite(pos[i])) {
+      PyErr_Format(PyExc_ValueError, "vertices: vertex %zu is not finite", i / 3);
+      goto done;
+    }
+  idx = malloc((nt ? 3 * nt : 1) * sizeof *idx);
+  if (!idx) { PyErr_NoMemory(); goto done; }
+  for (size_t i = 0; i < 3 * nt; i++) {
+    if (ti[i] < 0 || (uint64_t)ti[i] >= nv) {
+      PyErr_Format(PyExc_ValueError, "triangles: triangle %zu names vertex %lld of %zu", i / 3, (long long)ti[i], nv);
+      goto done;
+    }
+    idx[i] = (uint32_t)ti[i];
+  }
+  fr_scene *sc;
+  fr_error e = fr_scene_from_arrays(pos, nv, idx, nt, &sc);
+  if (e != FR_OK) { raise_fr(e, fr_last_error()); goto done; }
+  result = wrap_scene(type, sc);
+done:
+  free(idx);
+  Py_DECREF(v);
+  Py_DECREF(t);
+  return result;
+}
+
+static PyObject *scene_load(PyObject *cls, PyObject *args) {
+  PyObject *path;
+  if (!PyArg_ParseTuple(args, "O&", PyUnicode_FSConverter, &path)) return NULL;
+  fr_scene *sc;
+  fr_error e;
+  Py_BEGIN_ALLOW_THREADS
+  e = fr_scene_load(PyBytes_AS_STRING(path), &sc);
+  Py_END_ALLOW_THREADS
+  Py_DECREF(path);
+  if (e != FR_OK) return raise_fr(e, fr_last_error());
+  return wrap_scene((PyTypeObject *)cls, sc);
+}
+
+static PyObject *scene_builtin(PyObject *cls, PyObject *args) {
+  const char *name = "default";
+  if (!PyArg_ParseTuple(args, "|s", &name)) return NULL;
+  fr_scene *sc;
+  fr_error e;
+  if (!strcmp(name, "default")) e = fr_scene_builtin(&sc);
+  else if (!strcmp(name, "materials")) e = fr_scene_builtin_materials(&sc);
+  else return PyErr_Format(PyExc_ValueError, "builtin: no scene named '%s' (default, materials)", name);
+  if (e != FR_OK) return raise_fr(e, fr_last_error());
+  return wrap_scene((PyTypeObject *)cls, sc);
+}
+
+static void scene_dealloc(SceneObject *s) {
+  if (s->scene) fr_scene_release(s->scene);
+  Py_TYPE(s)->tp_free((PyObject *)s);
+}
+
+static PyObject *scene_close(SceneObject *s, PyObject *unused) {
+  (void)unused;
+  if (s->busy) {
+    PyErr_SetString(PyExc_RuntimeError, "close: the scene is being traced by another thread");
+    return NULL;
+  }
+  if (s->scene) fr_scene_release(s->scene);
+  s->scene = NULL;
+  Py_RETURN_NONE;
+}
+
+/* ---- rays in ----------------------------------------------------------------- */
+
+typedef struct rays_in {
+  PyArrayObject *org, *dir, *tnear_a, *tfar_a; /* tnear_a, tfar_a: NULL for a scalar */
+  float tnear, tfar;
+  size_t n;
+  int ndim;            /* of the leading shape */
+  npy_intp shape[NPY_MAXDIMS];
+} rays_in;
+
+static void rays_free(rays_in *r) {
+  Py_XDECREF(r->org); Py_XDECREF(r->dir); Py_XDECREF(r->tnear_a); Py_XDECREF(r->tfar_a);
+}
+
+/* A range bound: a number, or a float array of one value per ray. */
+static int range_arg(PyObject *o, const char *name, size_t n, float *value, PyArrayObject **arr) {
+  *arr = NULL;
+  if (PyFloat_Check(o) || PyLong_Check(o) || PyArray_IsScalar(o, Number)) {
+    double d = PyFloat_AsDouble(o);
+    if (d == -1.0 && PyErr_Occurred()) return 0;
+    if (isnan(d)) { PyErr_Format(PyExc_ValueError, "%s is NaN", name); return 0; }
+    *value = (float)d;
+    return 1;
+  }
+  PyArrayObject *a = (PyArrayObject *)PyArray_FROM_OTF(o, NPY_FLOAT32, NPY_ARRAY_IN_ARRAY | NPY_ARRAY_FORCECAST);
+  if (!a) return 0;
+  if ((size_t)PyArray_SIZE(a) != n) {
+    PyErr_Format(PyExc_ValueError, "%s: expected a number or one value per ray (%zu), got %zd values", name, n,
+                 (Py_ssize_t)PyArray_SIZE(a));
+    Py_DECREF(a);
+    return 0;
+  }
+  *arr = a;
+  return 1;
+}
+
+static int rays_parse(PyObject *o, PyObject *d, PyObject *tnear, PyObject *tfar, rays_in *r) {
+  memset(r, 0, sizeof *r);
+  r->tfar = INFINITY;
+  if (!(r->org = vec3_array(o, "origins")) || !(r->dir = vec3_array(d, "directions"))) goto fail;
+  if (!PyArray_SAMESHAPE(r->org, r->dir)) {
+    PyErr_SetString(PyExc_ValueError, "origins and directions must have the same shape");
+    goto fail;
+  }
+  r->ndim = PyArray_NDIM(r->org) - 1;
+  for (int i = 0; i < r->ndim; i++) r->shape[i] = PyArray_DIM(r->org, i);
+  r->n = (size_t)(PyArray_SIZE(r->org) / 3);
+  if (tnear && !range_arg(tnear, "tnear", r->n, &r->tnear, &r->tnear_a)) goto fail;
+  if (tfar && !range_arg(tfar, "tfar", r->n, &r->tfar, &r->tfar_a)) goto fail;
+  return 1;
+fail:
+  rays_free(r);
+  return 0;
+}
+
+/* Rays [i0, i0 + k) packed; 0 and the first bad ray's index in *bad where
+ * an origin or direction is not finite or a tnear is NaN. */
+static int rays_pack(const rays_in *r, size_t i0, size_t k, fr_ray *out, size_t *bad) {
+  const float *o = (const float *)PyArray_DATA(r->org) + 3 * i0, *d = (const float *)PyArray_DATA(r->dir) + 3 * i0;
+  const float *tn = r->tnear_a ? (const float *)PyArray_DATA(r->tnear_a) + i0 : NULL;
+  const float *tf = r->tfar_a ? (const float *)PyArray_DATA(r->tfar_a) + i0 : NULL;
+  int ok = 1;
+  for (size_t j = 0; j < k; j++) {
+    fr_ray *x = &out[j];
+    for (int a = 0; a < 3; a++) { x->org[a] = o[3 * j + a]; x->dir[a] = d[3 * j + a]; }
+    x->tnear = tn ? tn[j] : r->tnear;
+    x->tfar = tf ? tf[j] : r->tfar;
+    float s = x->org[0] + x->org[1] + x->org[2] + x->dir[0] + x->dir[1] + x->dir[2];
+    if (ok && (!isfinite(s) || isnan(x->tnear) || isnan(x->tfar))) {
+      int fine = 1;
+      for (int a = 0; a < 3; a++) fine &= isfinite(x->org[a]) && isfinite(x->dir[a]);
+      if (!fine || isnan(x->tnear) || isnan(x->tfar)) { ok = 0; *bad = i0 + j; }
+    }
+  }
+  return ok;
+}
+
+static PyObject *bad_ray(size_t i) {
+  return PyErr_Format(PyExc_ValueError, "ray %zu: an origin or direction is NaN or infinite, or a range is NaN", i);
+}
+
+static PyArrayObject *out_array(const rays_in *r, int extra, int type) {
+  npy_intp shape[NPY_MAXDIMS];
+  int nd = r->ndim;
+  memcpy(shape, r->shape, sizeof(npy_intp) * (size_t)nd);
+  if (extra) shape[nd++] = extra;
+  return (PyArrayObject *)PyArray_SimpleNew(nd, shape, type);
+}
+
+/* Parses (origins, directions, tnear=0, tfar=inf) and marks the scene busy. */
+static int begin_trace(SceneObject *s, PyObject *args, PyObject *kw, rays_in *r, Py_ssize_t *max_hits) {
+  static char *names[] = {"origins", "directions", "tnear", "tfar", NULL};
+  static char *names_all[] = {"origins", "directions", "max_hits", "tnear", "tfar", NULL};
+  PyObject *o, *d, *tn = NULL, *tf = NULL;
+  if (max_hits) {
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|nOO", names_all, &o, &d, max_hits, &tn, &tf)) return 0;
+    if (*max_hits < 0) { PyErr_SetString(PyExc_ValueError, "max_hits must be at least 0"); return 0; }
+  } else if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|OO", names, &o, &d, &tn, &tf))
+    return 0;
+  if (!scene_open(s) || !rays_parse(o, d, tn, tf, r)) return 0;
+  s->busy++;
+  return 1;
+}
+
+/* ---- intersect and occluded ------------------------------------------------------ */
+
+static PyObject *scene_intersect(SceneObject *s, PyObject *args, PyObject *kw) {
+  rays_in r;
+  if (!begin_trace(s, args, kw, &r, NULL)) return NULL;
+  PyArrayObject *t = out_array(&r, 0, NPY_FLOAT32), *prim = out_array(&r, 0, NPY_UINT32);
+  PyArrayObject *u = out_array(&r, 0, NPY_FLOAT32), *v = out_array(&r, 0, NPY_FLOAT32);
+  PyArrayObject *ng = out_array(&r, 3, NPY_FLOAT32);
+  PyObject *result = NULL;
+  if (!t || !prim || !u || !v || !ng) goto done;
+  size_t bad = (size_t)-1, n = r.n, chunks = (n + CHUNK - 1) / CHUNK;
+  const fr_scene *sc = s->scene;
+  float *tp = PyArray_DATA(t), *up = PyArray_DATA(u), *vp = PyArray_DATA(v), *np = PyArray_DATA(ng);
+  uint32_t *pp = PyArray_DATA(prim);
+  Py_BEGIN_ALLOW_THREADS
+#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads ? n_threads : omp_get_max_threads())
+  for (size_t c = 0; c < chunks; c++) {
+    fr_ray rays[CHUNK];
+    fr_hit hits[CHUNK];
+    size_t i0 = c * CHUNK, k = n - i0 < CHUNK ? n - i0 : CHUNK, b;
+    if (!rays_pack(&r, i0, k, rays, &b)) {
+#pragma omp critical(frusta_bad_ray)
+      if (b < bad) bad = b;
+      continue;
+    }
+    fr_intersect_stream(sc, rays, hits, k);
+    for (size_t j = 0; j < k; j++) {
+      size_t i = i0 + j;
+      tp[i] = hits[j].t; up[i] = hits[j].u; vp[i] = hits[j].v; pp[i] = hits[j].prim;
+      np[3 * i] = hits[j].ng[0]; np[3 * i + 1] = hits[j].ng[1]; np[3 * i + 2] = hits[j].ng[2];
+    }
+  }
+  Py_END_ALLOW_THREADS
+  if (bad != (size_t)-1) { bad_ray(bad); goto done; }
+  result = Py_BuildValue("(OOOOO)", t, prim, u, v, ng);
+done:
+  s->busy--;
+  Py_XDECREF(t); Py_XDECREF(prim); Py_XDECREF(u); Py_XDECREF(v); Py_XDECREF(ng);
+  rays_free(&r);
+  return result;
+}
+
+static PyObject *scene_occluded(SceneObject *s, PyObject *args, PyObject *kw) {
+  rays_in r;
+  if (!begin_trace(s, args, kw, &r, NULL)) return NULL;
+  PyArrayObject *occ = out_array(&r, 0, NPY_BOOL);
+  PyObject *result = NULL;
+  if (!occ) goto done;
+  size_t bad = (size_t)-1, n = r.n, chunks = (n + CHUNK - 1) / CHUNK;
+  const fr_scene *sc = s->scene;
+  uint8_t *op = PyArray_DATA(occ); /* numpy bools are bytes of 0 or 1, as the call writes */
+  Py_BEGIN_ALLOW_THREADS
+#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads ? n_threads : omp_get_max_threads())
+  for (size_t c = 0; c < chunks; c++) {
+    fr_ray rays[CHUNK];
+    size_t i0 = c * CHUNK, k = n - i0 < CHUNK ? n - i0 : CHUNK, b;
+    if (!rays_pack(&r, i0, k, rays, &b)) {
+#pragma omp critical(frusta_bad_ray)
+      if (b < bad) bad = b;
+      continue;
+    }
+    fr_occluded_stream(sc, rays, op + i0, k);
+  }
+  Py_END_ALLOW_THREADS
+  if (bad != (size_t)-1) { bad_ray(bad); goto done; }
+  result = (PyObject *)occ;
+  Py_INCREF(result);
+done:
+  s->busy--;
+  Py_XDECREF(occ);
+  rays_free(&r);
+  return result;
+}
+
+/* ---- all hits ------------------------------------------------------------------- */
+
+/* One chunk's hits, packed: kept[j] of its rays' max_hits slots. */
+typedef struct chunk_hits {
+  fr_hit *hits;
+  size_t kept;
+} chunk_hits;
+
+static PyObject *scene_intersect_all(SceneObject *s, PyObject *args, PyObject *kw) {
+  rays_in r;
+  Py_ssize_t max_hits = 16;
+  if (!begin_trace(s, args, kw, &r, &max_hits)) return NULL;
+  /* a chunk's slots take at most 64 * CHUNK hits, however large max_hits */
+  size_t K = (size_t)max_hits, n = r.n, per = K <= 64 ? CHUNK : (K >= 64 * CHUNK ? 1 : 64 * CHUNK / K);
+  size_t chunks = (n + per - 1) / per;
+  PyArrayObject *count = out_array(&r, 0, NPY_UINT32);
+  chunk_hits *ch = calloc(chunks ? chunks : 1, sizeof *ch);
+  PyArrayObject *ray = NULL, *prim = NULL, *t = NULL, *u = NULL, *v = NULL;
+  PyObject *result = NULL;
+  if (!count || !ch) { if (!ch) PyErr_NoMemory(); goto done; }
+  if (K > ((size_t)1 << 24)) { PyErr_SetString(PyExc_ValueError, "max_hits: at most 16777216"); goto done; }
+  size_t bad = (size_t)-1;
+  fr_error err = FR_OK;
+  char msg[512] = "";
+  const fr_scene *sc = s->scene;
+  uint32_t *cp = PyArray_DATA(count);
+  Py_BEGIN_ALLOW_THREADS
+#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads ? n_threads : omp_get_max_threads())
+  for (size_t c = 0; c < chunks; c++) {
+    fr_ray rays[CHUNK];
+    size_t i0 = c * per, k = n - i0 < per ? n - i0 : per, b;
+    if (!rays_pack(&r, i0, k, rays, &b)) {
+#pragma omp critical(frusta_bad_ray)
+      if (b < bad) bad = b;
+      continue;
+    }
+    fr_hit *h = K ? malloc(k * K * sizeof *h) : NULL;
+    fr_error e = K && !h ? FR_ERR_NOMEM : fr_intersect_all(sc, rays, k, h, K, cp + i0);
+    if (e != FR_OK) {
+#pragma omp critical(frusta_error)
+      if (err == FR_OK) { err = e; snprintf(msg, sizeof msg, "%s", e == FR_ERR_NOMEM && !h ? "out of memory" : fr_last_error()); }
+      free(h);
+      continue;
+    }
+    /* pack ray j's first min(count, K) slots together */
+    size_t kept = 0;
+    for (size_t j = 0; j < k; j++) {
+      size_t m = cp[i0 + j] < K ? cp[i0 + j] : K;
+      memmove(h + kept, h + j * K, m * sizeof *h);
+      kept += m;
+    }
+    ch[c].hits = h;
+    ch[c].kept = kept;
+  }
+  Py_END_ALLOW_THREADS
+  if (bad != (size_t)-1) { bad_ray(bad); goto done; }
+  if (err != FR_OK) { raise_fr(err, msg); goto done; }
+  size_t total = 0;
+  for (size_t c = 0; c < chunks; c++) total += ch[c].kept;
+  npy_intp dim = (npy_intp)total;
+  ray = (PyArrayObject *)PyArray_SimpleNew(1, &dim, NPY_INT64);
+  prim = (PyArrayObject *)PyArray_SimpleNew(1, &dim, NPY_UINT32);
+  t = (PyArrayObject *)PyArray_SimpleNew(1, &dim, NPY_FLOAT32);
+  u = (PyArrayObject *)PyArray_SimpleNew(1, &dim, NPY_FLOAT32);
+  v = (PyArrayObject *)PyArray_SimpleNew(1, &dim, NPY_FLOAT32);
+  if (!ray || !prim || !t || !u || !v) goto done;
+  int64_t *rp = PyArray_DATA(ray);
+  uint32_t *pp = PyArray_DATA(prim);
+  float *tp = PyArray_DATA(t), *up = PyArray_DATA(u), *vp = PyArray_DATA(v);
+  size_t at = 0;
+  for (size_t c = 0; c < chunks; c++) {
+    size_t i0 = c * per, k = n - i0 < per ? n - i0 : per, q = 0;
+    for (size_t j = 0; j < k; j++) {
+      size_t m = cp[i0 + j] < K ? cp[i0 + j] : K;
+      for (size_t h = 0; h < m; h++, q++, at++) {
+        const fr_hit *x = &ch[c].hits[q];
+        rp[at] = (int64_t)(i0 + j); pp[at] = x->prim; tp[at] = x->t; up[at] = x->u; vp[at] = x->v;
+      }
+    }
+  }
+  result = Py_BuildValue("(OOOOOO)", ray, prim, t, u, v, count);
+done:
+  s->busy--;
+  if (ch)
+    for (size_t c = 0; c < chunks; c++) free(ch[c].hits);
+  free(ch);
+  Py_XDECREF(count); Py_XDECREF(ray); Py_XDECREF(prim); Py_XDECREF(t); Py_XDECREF(u); Py_XDECREF(v);
+  rays_free(&r);
+  return result;
+}
+
+/* ---- properties ------------------------------------------------------------------ */
+
+static const char *mode_names[] = {"auto", "single", "packet8", "packet16", "hybrid16", "raystream"};
+#define N_MODES 6
+
+static PyObject *scene_get_mode(SceneObject *s, void *c) {
+  (void)c;
+  if (!scene_open(s)) return NULL;
+  int m = (int)fr_scene_get_trace_mode(s->scene);
+  return PyUnicode_FromString(m >= 0 && m < N_MODES ? mode_names[m] : "auto");
+}
+
+static int scene_set_mode(SceneObject *s, PyObject *value, void *c) {
+  (void)c;
+  if (!scene_open(s)) return -1;
+  const char *name = value ? PyUnicode_AsUTF8(value) : NULL;
+  if (!name) { if (!PyErr_Occurred()) PyErr_SetString(PyExc_TypeError, "trace_mode: expected a name"); return -1; }
+  if (s->busy) { PyErr_SetString(PyExc_RuntimeError, "trace_mode: the scene is being traced"); return -1; }
+  for (int m = 0; m < N_MODES; m++)
+    if (!strcmp(name, mode_names[m])) return fr_scene_set_trace_mode(s->scene, (fr_trace_mode)m) == FR_OK ? 0 : -1;
+  PyErr_Format(PyExc_ValueError, "trace_mode: '%s' is none of auto, single, packet8, packet16, hybrid16, raystream",
+               name);
+  return -1;
+}
+
+static PyObject *scene_triangle_count(SceneObject *s, void *c) {
+  (void)c;
+  return scene_open(s) ? PyLong_FromSize_t(fr_scene_triangle_count(s->scene)) : NULL;
+}
+
+static PyObject *scene_bounds(SceneObject *s, void *c) {
+  (void)c;
+  if (!scene_open(s)) return NULL;
+  float lo[3], hi[3];
+  fr_scene_bounds(s->scene, lo, hi);
+  npy_intp dims[2] = {2, 3};
+  PyArrayObject *b = (PyArrayObject *)PyArray_SimpleNew(2, dims, NPY_FLOAT32);
+  if (!b) return NULL;
+  float *p = PyArray_DATA(b);
+  memcpy(p, lo, sizeof lo);
+  memcpy(p + 3, hi, sizeof hi);
+  return (PyObject *)b;
+}
+
+/* Copies of the scene's arrays (after loading: fan-triangulated, in file order). */
+static PyObject *scene_vertices(SceneObject *s, void *c) {
+  (void)c;
+  if (!scene_open(s)) return NULL;
+  npy_intp dims[2] = {(npy_intp)fr_scene_vertex_count(s->scene), 3};
+  PyArrayObject *a = (PyArrayObject *)PyArray_SimpleNew(2, dims, NPY_FLOAT32);
+  if (a && dims[0]) memcpy(PyArray_DATA(a), fr_scene_vertices(s->scene), (size_t)dims[0] * 3 * sizeof(float));
+  return (PyObject *)a;
+}
+
+static PyObject *scene_triangles(SceneObject *s, void *c) {
+  (void)c;
+  if (!scene_open(s)) return NULL;
+  npy_intp dims[2] = {(npy_intp)fr_scene_triangle_count(s->scene), 3};
+  PyArrayObject *a = (PyArrayObject *)PyArray_SimpleNew(2, dims, NPY_UINT32);
+  if (a && dims[0]) memcpy(PyArray_DATA(a), fr_scene_indices(s->scene), (size_t)dims[0] * 3 * sizeof(uint32_t));
+  return (PyObject *)a;
+}
+
+static PyMethodDef scene_methods[] = {
+    {"load", (PyCFunction)scene_load, METH_VARARGS | METH_CLASS, "load(path): a scene file (PLY, OBJ, any Assimp format, .zst)"},
+    {"builtin", (PyCFunction)scene_builtin, METH_VARARGS | METH_CLASS, "builtin(name='default'): a built-in scene"},
+    {"close", (PyCFunction)scene_close, METH_NOARGS, "close(): frees the scene now"},
+    {"_intersect", (PyCFunction)(void (*)(void))scene_intersect, METH_VARARGS | METH_KEYWORDS, NULL},
+    {"_occluded", (PyCFunction)(void (*)(void))scene_occluded, METH_VARARGS | METH_KEYWORDS, NULL},
+    {"_intersect_all", (PyCFunction)(void (*)(void))scene_intersect_all, METH_VARARGS | METH_KEYWORDS, NULL},
+    {NULL, NULL, 0, NULL}};
+
+static PyGetSetDef scene_getset[] = {
+    {"trace_mode", (getter)scene_get_mode, (setter)scene_set_mode, "how streams are traced", NULL},
+    {"triangle_count", (getter)scene_triangle_count, NULL, "triangles in the scene", NULL},
+    {"bounds", (getter)scene_bounds, NULL, "[[xmin, ymin, zmin], [xmax, ymax, zmax]]", NULL},
+    {"vertices", (getter)scene_vertices, NULL, "a copy of the vertex positions, (n, 3) float32", NULL},
+    {"triangles", (getter)scene_triangles, NULL, "a copy of the triangles' vertex indices, (n, 3) uint32", NULL},
+    {NULL, NULL, NULL, NULL, NULL}};
+
+static PyTypeObject SceneType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "frusta._frusta.Scene",
+    .tp_basicsize = sizeof(SceneObject),
+    .tp_flags = Py_TPFLAGS_DEFAULT | Py_TPFLAGS_BASETYPE,
+    .tp_doc = "Scene(vertices, triangles): a committed triangle scene",
+    .tp_new = scene_new,
+    .tp_dealloc = (destructor)scene_dealloc,
+    .tp_methods = scene_methods,
+    .tp_getset = scene_getset,
+};
+
+/* ---- the module --------------------------------------------------------------- */
+
+static PyObject *set_threads(PyObject *m, PyObject *args) {
+  (void)m;
+  int n;
+  if (!PyArg_ParseTuple(args, "i", &n)) return NULL;
+  if (n < 0 || n > 4096) return PyErr_Format(PyExc_ValueError, "set_threads: %d is not in 0..4096", n);
+  n_threads = n;
+  Py_RETURN_NONE;
+}
+
+static PyObject *get_threads(PyObject *m, PyObject *unused) {
+  (void)m; (void)unused;
+  return PyLong_FromLong(n_threads ? n_threads : omp_get_max_threads());
+}
+
+static PyObject *isa(PyObject *m, PyObject *unused) {
+  (void)m; (void)unused;
+  return PyUnicode_FromString(fr_isa_name(fr_get_isa()));
+}
+
+static PyMethodDef module_methods[] = {
+    {"set_threads", set_threads, METH_VARARGS, "set_threads(n): threads per call (0: all cores)"},
+    {"get_threads", get_threads, METH_NOARGS, "threads a call uses"},
+    {"isa", isa, METH_NOARGS, "the instruction set the kernels use"},
+    {NULL, NULL, 0, NULL}};
+
+static struct PyModuleDef module_def = {PyModuleDef_HEAD_INIT, "_frusta", "frusta's C extension", -1, module_methods,
+                                        NULL, NULL, NULL, NULL};
+
+PyMODINIT_FUNC PyInit__frusta(void) {
+  import_array();
+  if (PyType_Ready(&SceneType) < 0) return NULL;
+  PyObject *m = PyModule_Create(&module_def);
+  if (!m) return NULL;
+  Py_INCREF(&SceneType);
+  if (PyModule_AddObject(m, "Scene", (PyObject *)&SceneType) < 0) {
+    Py_DECREF(&SceneType);
+    Py_DECREF(m);
+    return NULL;
+  }
+  PyModule_AddIntConstant(m, "INVALID_ID", (long)FR_INVALID_ID);
+  PyModule_AddIntConstant(m, "VERSION_MAJOR", FR_VERSION_MAJOR);
+  PyModule_AddIntConstant(m, "VERSION_MINOR", FR_VERSION_MINOR);
+  return m;
+}
