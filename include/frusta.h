@@ -256,6 +256,43 @@ fr_trace_mode fr_scene_get_trace_mode(const fr_scene *s);
 fr_error fr_intersect_all(const fr_scene *s, const fr_ray *rays, size_t n, fr_hit *hits, size_t max_hits,
                           uint32_t *counts);
 
+/* ---- camera rays by multi-frusta --------------------------------------------------
+ * A pinhole camera: eye looking at `at`, `up` roughly up, vertical field of
+ * view fov_deg (0..180) over height pixels, square pixels, rays through the
+ * pixel centres, row 0 at the top. */
+typedef struct fr_pinhole {
+  float eye[3], at[3], up[3];
+  float fov_deg;
+  int width, height;
+} fr_pinhole;
+
+/* The closest hits of the camera rays of image rows [y0, y0 + rows), traced
+ * as multi-frusta (Benthin & Wald): 16x16 pixel tiles as 16 frusta of 4x4
+ * rays, made from the camera on the fly; pixels of 4x4 blocks the image
+ * cuts off go as single rays. hits[(y - y0) * width + x] is pixel (x, y);
+ * rays (may be NULL) gets the rays traced, directions normalized, and hits'
+ * t is in units of them. Each answer is the one fr_intersect1 gives for that
+ * ray (t to rounding; the triangle up to ties). Bands of 16 rows starting at
+ * multiples of 16 waste no work; threads may trace different bands of one
+ * image at once. Caller-owned arrays. Errors: FR_ERR_ARG (NULL, a bad
+ * camera, rows outside the image), FR_ERR_STATE (not committed),
+ * FR_ERR_UNSUPPORTED (the scene has spheres). */
+fr_error fr_intersect_camera(const fr_scene *s, const fr_pinhole *camera, int y0, int rows, fr_ray *rays,
+                             fr_hit *hits);
+
+/* Whether each of n points (xyz, 3 floats each) is in shadow of a point
+ * light: occluded[i] = 1 if a triangle or sphere lies on the segment from
+ * light to points[i], leaving out its last eps (scene units; for a point on
+ * a surface) and its first 1e-4 of the length (for a light on one). Traced
+ * from the light as multi-frusta (16 consecutive points make a frustum),
+ * so order the points coherently: an image's hit points in 4x4 blocks or
+ * rows. The answers are those of fr_occluded1 on the same segments. A
+ * point nearer than eps, or not finite, is not occluded. May be called from
+ * several threads at once. Errors: FR_ERR_ARG (NULL, a light or eps not
+ * finite), FR_ERR_STATE (not committed). */
+fr_error fr_occluded_point_light(const fr_scene *s, const float light[3], const float *points, size_t n, float eps,
+                                 uint8_t *occluded);
+
 #ifdef __cplusplus
 }
 #endif

@@ -61,6 +61,26 @@ class Scene(_Scene):
         (odd: it starts inside a closed, consistently wound mesh)."""
         return self._intersect_all(origins, directions, 0, tnear, tfar)[5]
 
+    def intersect_camera(self, eye, at, up, fov, width, height):
+        """The closest hits of a pinhole camera's rays (vertical field of view
+        fov in degrees, rays through pixel centres, row 0 at the top), traced
+        as multi-frusta: Hits of shape (height, width), and the rays'
+        normalized directions (height, width, 3); the origin is eye and t is
+        in units of those directions."""
+        *h, directions = self._intersect_camera(eye, at, up, fov, width, height)
+        return Hits(*h), directions
+
+    def occluded_point_light(self, points, light, eps=None):
+        """Whether each point (..., 3) is in shadow of a point light: anything
+        on the segment from light to the point, leaving out its last eps
+        (default: 1e-5 of the scene's diagonal, for points on surfaces).
+        Traced from the light as multi-frusta, 16 consecutive points a
+        frustum: order them coherently (an image's hit points row by row)."""
+        if eps is None:
+            lo, hi = self.bounds
+            eps = 1e-5 * float(((hi - lo) ** 2).sum()) ** 0.5
+        return self._occluded_point_light(points, light, eps)
+
     def contains(self, points):
         """Whether each point lies inside the closed mesh: an odd count of
         crossings along a fixed, irrational-ish direction."""

@@ -448,6 +448,114 @@ done:
   return result;
 }
 
+/* ---- camera rays by multi-frusta -------------------------------------------------- */
+
+static int vec3_arg(PyObject *o, const char *name, float out[3]) {
+  PyArrayObject *a = (PyArrayObject *)PyArray_FROM_OTF(o, NPY_FLOAT32, NPY_ARRAY_IN_ARRAY | NPY_ARRAY_FORCECAST);
+  if (!a) return 0;
+  int ok = PyArray_SIZE(a) == 3;
+  if (ok) memcpy(out, PyArray_DATA(a), 3 * sizeof(float));
+  for (int i = 0; ok && i < 3; i++) ok = isfinite(out[i]);
+  Py_DECREF(a);
+  if (!ok) PyErr_Format(PyExc_ValueError, "%s: expected 3 finite numbers", name);
+  return ok;
+}
+
+static PyObject *scene_intersect_camera(SceneObject *s, PyObject *args, PyObject *kw) {
+  static char *names[] = {"eye", "at", "up", "fov", "width", "height", NULL};
+  PyObject *eo, *ao, *uo;
+  fr_pinhole cam;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOfii", names, &eo, &ao, &uo, &cam.fov_deg, &cam.width, &cam.height))
+    return NULL;
+  if (!scene_open(s) || !vec3_arg(eo, "eye", cam.eye) || !vec3_arg(ao, "at", cam.at) || !vec3_arg(uo, "up", cam.up))
+    return NULL;
+  if (cam.width <= 0 || cam.height <= 0 || (int64_t)cam.width * cam.height > ((int64_t)1 << 28))
+    return PyErr_Format(PyExc_ValueError, "intersect_camera: image size %dx%d is empty or too large", cam.width,
+                        cam.height);
+  rays_in r;
+  memset(&r, 0, sizeof r);
+  r.ndim = 2;
+  r.shape[0] = cam.height;
+  r.shape[1] = cam.width;
+  PyArrayObject *t = out_array(&r, 0, NPY_FLOAT32), *prim = out_array(&r, 0, NPY_UINT32);
+  PyArrayObject *u = out_array(&r, 0, NPY_FLOAT32), *v = out_array(&r, 0, NPY_FLOAT32);
+  PyArrayObject *ng = out_array(&r, 3, NPY_FLOAT32), *dir = out_array(&r, 3, NPY_FLOAT32);
+  PyObject *result = NULL;
+  if (!t || !prim || !u || !v || !ng || !dir) goto done;
+  s->busy++;
+  const fr_scene *sc = s->scene;
+  int bands = (cam.height + 15) / 16;
+  fr_error err = FR_OK;
+  char msg[512] = "";
+  float *tp = PyArray_DATA(t), *up = PyArray_DATA(u), *vp = PyArray_DATA(v), *np = PyArray_DATA(ng);
+  float *dp = PyArray_DATA(dir);
+  uint32_t *pp = PyArray_DATA(prim);
+  Py_BEGIN_ALLOW_THREADS
+#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads ? n_threads : omp_get_max_threads())
+  for (int band = 0; band < bands; band++) {
+    int y0 = 16 * band, rows = cam.height - y0 < 16 ? cam.height - y0 : 16;
+    fr_ray *rb = malloc((size_t)cam.width * 16 * sizeof *rb);
+    fr_hit *hb = malloc((size_t)cam.width * 16 * sizeof *hb);
+    fr_error e = rb && hb ? fr_intersect_camera(sc, &cam, y0, rows, rb, hb) : FR_ERR_NOMEM;
+    if (e != FR_OK) {
+#pragma omp critical(frusta_error)
+      if (err == FR_OK) { err = e; snprintf(msg, sizeof msg, "%s", e == FR_ERR_NOMEM ? "out of memory" : fr_last_error()); }
+    } else {
+      for (size_t j = 0; j < (size_t)rows * (size_t)cam.width; j++) {
+        size_t i = (size_t)y0 * (size_t)cam.width + j;
+        tp[i] = hb[j].t; up[i] = hb[j].u; vp[i] = hb[j].v; pp[i] = hb[j].prim;
+        for (int a = 0; a < 3; a++) { np[3 * i + a] = hb[j].ng[a]; dp[3 * i + a] = rb[j].dir[a]; }
+      }
+    }
+    free(rb);
+    free(hb);
+  }
+  Py_END_ALLOW_THREADS
+  s->busy--;
+  if (err != FR_OK) { raise_fr(err, msg); goto done; }
+  result = Py_BuildValue("(OOOOOO)", t, prim, u, v, ng, dir);
+done:
+  Py_XDECREF(t); Py_XDECREF(prim); Py_XDECREF(u); Py_XDECREF(v); Py_XDECREF(ng); Py_XDECREF(dir);
+  return result;
+}
+
+static PyObject *scene_occluded_point_light(SceneObject *s, PyObject *args, PyObject *kw) {
+  static char *names[] = {"points", "light", "eps", NULL};
+  PyObject *po, *lo;
+  float light[3], eps;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "OOf", names, &po, &lo, &eps)) return NULL;
+  if (!scene_open(s) || !vec3_arg(lo, "light", light)) return NULL;
+  if (!(eps >= 0.0f) || !isfinite(eps)) return PyErr_Format(PyExc_ValueError, "eps: expected a finite number >= 0");
+  rays_in r;
+  memset(&r, 0, sizeof r);
+  if (!(r.org = vec3_array(po, "points"))) return NULL;
+  r.ndim = PyArray_NDIM(r.org) - 1;
+  for (int i = 0; i < r.ndim; i++) r.shape[i] = PyArray_DIM(r.org, i);
+  r.n = (size_t)(PyArray_SIZE(r.org) / 3);
+  const float *pts = PyArray_DATA(r.org);
+  for (size_t i = 0; i < 3 * r.n; i++)
+    if (!isfinite(pts[i])) {
+      rays_free(&r);
+      return PyErr_Format(PyExc_ValueError, "point %zu is NaN or infinite", i / 3);
+    }
+  PyArrayObject *occ = out_array(&r, 0, NPY_BOOL);
+  if (!occ) { rays_free(&r); return NULL; }
+  s->busy++;
+  const fr_scene *sc = s->scene;
+  uint8_t *op = PyArray_DATA(occ);
+  size_t n = r.n, per = 4 * CHUNK, chunks = (n + per - 1) / per;
+  Py_BEGIN_ALLOW_THREADS
+#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads ? n_threads : omp_get_max_threads())
+  for (size_t c = 0; c < chunks; c++) {
+    size_t i0 = c * per, k = n - i0 < per ? n - i0 : per;
+    fr_occluded_point_light(sc, light, pts + 3 * i0, k, eps, op + i0); /* arguments checked above */
+  }
+  Py_END_ALLOW_THREADS
+  s->busy--;
+  rays_free(&r);
+  return (PyObject *)occ;
+}
+
 /* ---- properties ------------------------------------------------------------------ */
 
 static const char *mode_names[] = {"auto", "single", "packet8", "packet16", "hybrid16", "raystream"};
@@ -518,6 +626,9 @@ static PyMethodDef scene_methods[] = {
     {"_intersect", (PyCFunction)(void (*)(void))scene_intersect, METH_VARARGS | METH_KEYWORDS, NULL},
     {"_occluded", (PyCFunction)(void (*)(void))scene_occluded, METH_VARARGS | METH_KEYWORDS, NULL},
     {"_intersect_all", (PyCFunction)(void (*)(void))scene_intersect_all, METH_VARARGS | METH_KEYWORDS, NULL},
+    {"_occluded_point_light", (PyCFunction)(void (*)(void))scene_occluded_point_light, METH_VARARGS | METH_KEYWORDS,
+     NULL},
+    {"_intersect_camera", (PyCFunction)(void (*)(void))scene_intersect_camera, METH_VARARGS | METH_KEYWORDS, NULL},
     {NULL, NULL, 0, NULL}};
 
 static PyGetSetDef scene_getset[] = {

@@ -9,6 +9,7 @@
 #include "render/views.h"
 #include "base/timer.h"
 #include "base/vec3.h"
+#include "render/shadow_frusta.h"
 #include "render/whitted_shade.h"
 #include "render/workload.h"
 #include "trace/kernels.h"
@@ -206,50 +207,6 @@ static void trace_runs(const fr_tracer *t, wgen g, fr_hit *hits, uint8_t *occ, s
   }
 }
 
-/* Shadow frusta from a point light pay where they pass little geometry on
- * the way (museum: 2 inner nodes per frustum) and lose where they fan out
- * among dense geometry (hairball: over 100), where packets in the 8-wide
- * BVH take fewer, cheaper steps. Nodes per frustum vary too much over a
- * frame for a few probe tiles to tell, so each batch gets a budget of this
- * many visits per frustum, and a batch over it sends the rest of its tile's
- * shadow rays to the streams. */
-#define SHADOW_FRUSTA_MAX_NODES 6u
-
-/* Shadow rays [0, n) of a generation through a multi-frusta tracer: 16
- * consecutive rays from the light make a frustum (the rays of a 4x4 block
- * and, past its mirrors and unlit pixels, of the next: full frusta measured
- * faster than one per block, museum 0.018 s against 0.023), 256 a batch.
- * What makes no frustum (see fr_mft_fns.from_rays) goes as rays; a batch
- * over its node budget goes as rays, and so does the rest of the
- * generation (with w->mft_no_fallback, no budget). */
-static void trace_shadow_frusta(const fr_workload *w, const fr_tracer *t, const fr_ray *rays, uint8_t *occ, size_t n) {
-  fr_mft_batch b;
-  static _Thread_local fr_mft_sets T;
-  uint16_t bits[FR_MFT_FRUSTA];
-  const size_t per = FR_MFT_FRUSTA * FR_MFT_RAYS;
-  size_t a = 0;
-  while (a < n) {
-    const size_t m = n - a < per ? n - a : per;
-    const unsigned valid = fr_mft_active()->from_rays(&b, &T, rays + a, m);
-    fr_mft_budget budget = {w->mft_no_fallback ? 0 : SHADOW_FRUSTA_MAX_NODES * (unsigned)__builtin_popcount(valid), 0, 0,
-                            0, 0};
-    /* no occluder cache: point-light frusta are thin and end at their first
-     * occluder anyway (museum and kitchen whitted measured the same) */
-    if (valid) t->occluded_frusta(t->ctx, &b, &T, bits, &budget, NULL);
-    if (budget.stopped) break; /* these rays too */
-    for (size_t f = 0; f * FR_MFT_RAYS < m; f++) {
-      size_t first = a + f * FR_MFT_RAYS, cnt = m - f * FR_MFT_RAYS < FR_MFT_RAYS ? m - f * FR_MFT_RAYS : FR_MFT_RAYS;
-      if (!((valid >> f) & 1)) {
-        t->occluded(t->ctx, rays + first, occ + first, cnt, 1);
-        continue;
-      }
-      for (size_t k = 0; k < cnt; k++) occ[first + k] = (uint8_t)((bits[f] >> k) & 1);
-    }
-    a += m;
-  }
-  if (a < n) t->occluded(t->ctx, rays + a, occ + a, n - a, 1);
-}
-
 /* The pixel of ray i of a 16x16 quarter's frusta (ray k = i % 16 of 4x4
  * frustum f = i / 16), from the quarter's corner in a tile row of WT:
  * row 4 (f / 4) + k / 4, column 4 (f % 4) + k % 4. */
@@ -374,7 +331,7 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
     const size_t ns = shadow.n, nn = next.n;
     /* shadow rays, packet by packet (they follow their block's order) */
     const double t_shadow = fr_seconds();
-    if (t->occluded_frusta && depth == 0) trace_shadow_frusta(w, t, S->shadow.r, S->occ, ns);
+    if (t->occluded_frusta && depth == 0) fr_shadow_frusta_occluded(t, S->shadow.r, S->occ, ns, !w->mft_no_fallback);
     else trace_runs(t, S->shadow, NULL, S->occ, ns);
     const double ds = fr_seconds() - t_shadow;
     S->stage[FR_STAGE_SHADOW] += ds;

@@ -413,3 +413,53 @@ def test_context_manager_and_repr():
         assert s.vertices.shape == v.shape and s.triangles.shape == t.shape
     with pytest.raises(ValueError):
         s.bounds
+
+
+# ---- multi-frusta calls -------------------------------------------------------------
+
+def test_intersect_camera_equals_rays():
+    s = frusta.Scene.builtin()
+    eye, at, up = (0.0, 3.0, 9.0), (0.0, 0.5, 0.0), (0.0, 1.0, 0.0)
+    h, d = s.intersect_camera(eye, at, up, 50.0, 203, 117)
+    assert h.t.shape == (117, 203) and d.shape == (117, 203, 3)
+    np.testing.assert_allclose(np.linalg.norm(d, axis=-1), 1, rtol=1e-6)
+    o = np.broadcast_to(np.float32(eye), d.shape).copy()
+    g = s.intersect(o, d)
+    both_miss = np.isinf(g.t) & np.isinf(h.t)
+    both_hit = np.isfinite(g.t) & np.isfinite(h.t)
+    gt, ht = np.where(both_hit, g.t, 0), np.where(both_hit, h.t, 0)
+    close = both_hit & (np.abs(gt - ht) <= 1e-4 * np.maximum(1, np.abs(gt)))
+    assert (both_miss | close).mean() > 0.999
+    assert np.isfinite(h.t).mean() > 0.3
+    same = g.prim == h.prim
+    assert same.mean() > 0.999
+    np.testing.assert_allclose(h.normal[same], g.normal[same], rtol=1e-5, atol=1e-6)
+    with pytest.raises(ValueError, match="field of view"):
+        s.intersect_camera(eye, at, up, 0.0, 8, 8)
+    with pytest.raises(ValueError, match="empty or too large"):
+        s.intersect_camera(eye, at, up, 50.0, 0, 8)
+    with pytest.raises(ValueError, match="3 finite"):
+        s.intersect_camera((0, np.nan, 0), at, up, 50.0, 8, 8)
+
+
+def test_occluded_point_light_equals_rays():
+    s = frusta.Scene.builtin()
+    eye = (0.0, 3.0, 9.0)
+    h, d = s.intersect_camera(eye, (0.0, 0.5, 0.0), (0.0, 1.0, 0.0), 50.0, 256, 192)
+    hit = np.isfinite(h.t)
+    p = (np.float32(eye) + h.t[..., None] * d)[hit].astype(np.float32)
+    light = np.float32([2.0, 6.0, 3.0])
+    lo, hi = s.bounds
+    eps = 1e-5 * float(np.linalg.norm(hi - lo))
+    occ = s.occluded_point_light(p, light)
+    v = p - light
+    dist = np.linalg.norm(v, axis=1)
+    o = np.broadcast_to(light, p.shape).copy()
+    ref = s.occluded(o, (v / dist[:, None]).astype(np.float32), (1e-4 * dist).astype(np.float32),
+                     (dist - eps).astype(np.float32))
+    assert 0.05 < occ.mean() < 0.95
+    assert (occ != ref).sum() <= len(p) // 1000
+    with pytest.raises(ValueError, match="point 1"):
+        s.occluded_point_light(np.array([[0, 0, 0], [np.inf, 0, 0]], np.float32), light)
+    with pytest.raises(ValueError, match="eps"):
+        s.occluded_point_light(p, light, eps=-1.0)

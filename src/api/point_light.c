@@ -1,0 +1,41 @@
+/* fr_occluded_point_light: shadow rays from a point light to many points,
+ * traced as multi-frusta (render/shadow_frusta.h) in runs of RUN points,
+ * each run deciding for itself whether its frusta pay (as a Whitted tile
+ * does). */
+#include <math.h>
+#include "base/error.h"
+#include "render/shadow_frusta.h"
+#include "render/tracer.h"
+#include "scene.h"
+
+#define RUN 1024
+
+fr_error fr_occluded_point_light(const fr_scene *s, const float light[3], const float *points, size_t n, float eps,
+                                 uint8_t *occluded) {
+  if (!s || !light || (n && (!points || !occluded)))
+    return fr_fail(FR_ERR_ARG, "fr_occluded_point_light: NULL scene, light, points or answers");
+  if (!s->committed) return fr_fail(FR_ERR_STATE, "fr_occluded_point_light: the scene is not committed");
+  if (!(eps >= 0.0f) || !isfinite(light[0]) || !isfinite(light[1]) || !isfinite(light[2]))
+    return fr_fail(FR_ERR_ARG, "fr_occluded_point_light: the light or eps is not finite and non-negative");
+  const fr_mft_tracer m = fr_mft_tracer_of(s, fr_mft_opts_default());
+  const fr_tracer t = s->sphere_bvh.nprims ? fr_tracer_frusta(s) : fr_tracer_mft(&m);
+  fr_ray rays[RUN];
+  for (size_t a = 0; a < n; a += RUN) {
+    size_t k = n - a < RUN ? n - a : RUN;
+    for (size_t j = 0; j < k; j++) {
+      const float *p = points + 3 * (a + j);
+      float d[3] = {p[0] - light[0], p[1] - light[1], p[2] - light[2]};
+      float dist = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      fr_ray *r = &rays[j];
+      for (int i = 0; i < 3; i++) { r->org[i] = light[i]; r->dir[i] = dist > 0.0f ? d[i] / dist : 0.0f; }
+      /* the light's end skips 1e-4 of the way, for a light on a surface; a
+         point closer than eps (or not finite) has nothing in between */
+      r->tnear = 1e-4f * dist;
+      r->tfar = dist - eps;
+      if (!(r->tfar > r->tnear)) r->tnear = r->tfar = 0.0f, r->dir[0] = r->dir[1] = r->dir[2] = 0.0f;
+    }
+    if (t.occluded_frusta) fr_shadow_frusta_occluded(&t, rays, occluded + a, k, 1);
+    else fr_occluded_stream(s, rays, occluded + a, k);
+  }
+  return FR_OK;
+}

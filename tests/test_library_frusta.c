@@ -1,0 +1,168 @@
+/*
+ * Multi-frusta for library users, against the ray calls ray by ray, at
+ * every ISA: fr_intersect_camera (whole images and odd bands, image sizes
+ * that cut 4x4 blocks and 16x16 tiles) against fr_intersect1 on the rays it
+ * returns and on the camera's own rays; fr_occluded_point_light against
+ * fr_occluded1 on the same segments. A disagreement must be a ray within
+ * rounding of an edge or of its range's ends (rayfile.md's rule). Errors.
+ */
+#include "test_util.h"
+#include "render/camera.h"
+
+typedef struct tally { long rays, hits, disagree, excused; } tally;
+
+static void check_hit(const fr_scene *s, const mesh_ref *m, const fr_ray *r, const fr_hit *got, tally *tl) {
+  fr_hit want;
+  fr_intersect1(s, r, &want);
+  tl->rays++;
+  tl->hits += got->prim != FR_INVALID_ID;
+  int agree = (got->prim == FR_INVALID_ID && want.prim == FR_INVALID_ID) ||
+              (got->prim != FR_INVALID_ID && want.prim != FR_INVALID_ID &&
+               fabsf(got->t - want.t) <= 1e-4f * fmaxf(1.0f, fabsf(want.t)));
+  if (agree && got->prim == want.prim)
+    for (int k = 0; k < 3; k++) assert_true(fabsf(got->ng[k] - want.ng[k]) <= 1e-5f * (fabsf(want.ng[0]) + fabsf(want.ng[1]) + fabsf(want.ng[2])));
+  if (agree) return;
+  tl->disagree++;
+  if (!ambiguous(m, r)) fail_msg("ray (%g %g %g) -> (%g %g %g): got prim %u t %g, fr_intersect1 prim %u t %g", r->org[0],
+                                 r->org[1], r->org[2], r->dir[0], r->dir[1], r->dir[2], got->prim, got->t, want.prim,
+                                 want.t);
+  tl->excused++;
+}
+
+static void camera_against_rays(const fr_scene *s, const fr_pinhole *p, tally *tl) {
+  mesh_ref m = scene_mesh(s);
+  size_t n = (size_t)p->width * (size_t)p->height;
+  fr_ray *rays = malloc(n * sizeof *rays);
+  fr_hit *hits = malloc(n * sizeof *hits);
+  assert_int_equal(fr_intersect_camera(s, p, 0, p->height, rays, hits), FR_OK);
+  fr_camera cam;
+  assert_int_equal(fr_camera_setup(&cam, v3_load(p->eye), v3_load(p->at), v3_load(p->up), p->fov_deg, p->width, p->height),
+                   FR_OK);
+  for (int y = 0; y < p->height; y++)
+    for (int x = 0; x < p->width; x++) {
+      size_t i = (size_t)y * (size_t)p->width + (size_t)x;
+      fr_ray own = fr_camera_ray(&cam, x, y);
+      for (int k = 0; k < 3; k++) {
+        assert_true(rays[i].org[k] == p->eye[k]);
+        assert_true(fabsf(rays[i].dir[k] - own.dir[k]) <= 1e-5f);
+      }
+      check_hit(s, &m, &rays[i], &hits[i], tl);
+    }
+  /* a band starting off the tiles' grid: its own frusta, the same answers */
+  int y0 = 5, rows = p->height - 9 < 37 ? p->height - 9 : 37;
+  fr_ray *br = malloc((size_t)rows * (size_t)p->width * sizeof *br);
+  fr_hit *bh = malloc((size_t)rows * (size_t)p->width * sizeof *bh);
+  assert_int_equal(fr_intersect_camera(s, p, y0, rows, br, bh), FR_OK);
+  for (size_t i = 0; i < (size_t)rows * (size_t)p->width; i++) check_hit(s, &m, &br[i], &bh[i], tl);
+  /* rays may be NULL */
+  assert_int_equal(fr_intersect_camera(s, p, y0, rows, NULL, bh), FR_OK);
+  free(br); free(bh);
+
+  /* shadows of the image's hit points towards a point light */
+  float lo[3], hi[3];
+  fr_scene_bounds(s, lo, hi);
+  float light[3] = {0.5f * (lo[0] + hi[0]), hi[1] - 0.05f * (hi[1] - lo[1]), 0.5f * (lo[2] + hi[2])};
+  float eps = 1e-5f * v3_len(v3_sub(v3_load(hi), v3_load(lo)));
+  float *pts = malloc(3 * n * sizeof *pts);
+  size_t np = 0;
+  for (size_t i = 0; i < n; i++) {
+    if (hits[i].prim == FR_INVALID_ID) continue;
+    for (int k = 0; k < 3; k++) pts[3 * np + k] = rays[i].org[k] + hits[i].t * rays[i].dir[k];
+    np++;
+  }
+  uint8_t *occ = malloc(np + 1);
+  assert_int_equal(fr_occluded_point_light(s, light, pts, np, eps, occ), FR_OK);
+  long shadowed = 0;
+  for (size_t i = 0; i < np; i++) {
+    const float *q = pts + 3 * i;
+    float d[3] = {q[0] - light[0], q[1] - light[1], q[2] - light[2]};
+    float dist = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    fr_ray r = {{light[0], light[1], light[2]}, 1e-4f * dist, {d[0] / dist, d[1] / dist, d[2] / dist}, dist - eps};
+    int want = fr_occluded1(s, &r);
+    shadowed += occ[i];
+    tl->rays++;
+    if (occ[i] == want) continue;
+    tl->disagree++;
+    if (!ambiguous(&m, &r)) fail_msg("point %zu: occluded %d, fr_occluded1 %d", i, occ[i], want);
+    tl->excused++;
+  }
+  assert_true(shadowed > 0 && shadowed < (long)np); /* the light is neither everywhere nor nowhere */
+  free(pts); free(occ); free(rays); free(hits);
+}
+
+static void scenes_at_every_isa(void **state) {
+  (void)state;
+  fr_scene *b;
+  assert_int_equal(fr_scene_builtin(&b), FR_OK);
+  assert_int_equal(fr_scene_commit(b), FR_OK);
+  fr_pinhole pb = {{0.0f, 3.0f, 9.0f}, {0.0f, 0.5f, 0.0f}, {0.0f, 1.0f, 0.0f}, 50.0f, 150, 98};
+  char path[512];
+  shared_scene_path(path, sizeof path, "kitchen/kitchen.ply.zst");
+  fr_scene *k = NULL;
+  if (fr_scene_load(path, &k) == FR_OK) assert_int_equal(fr_scene_commit(k), FR_OK);
+  else k = NULL;
+  fr_pinhole pk = {{3.75f, 2.30f, 3.60f}, {3.4365f, 1.8802f, 2.7482f}, {-0.127f, 0.907f, -0.4005f}, 40.0f, 130, 77};
+  const fr_isa isas[] = {FR_ISA_SCALAR, FR_ISA_AVX2, FR_ISA_AVX512};
+  fr_isa was = fr_get_isa();
+  for (int i = 0; i < 3; i++) {
+    if (!fr_isa_supported(isas[i])) continue;
+    assert_int_equal(fr_set_isa(isas[i]), FR_OK);
+    tally tl = {0};
+    camera_against_rays(b, &pb, &tl);
+    if (k) camera_against_rays(k, &pk, &tl);
+    printf("%s: %ld rays (%ld hits), %ld disagree, all within rounding of an edge or range end\n",
+           fr_isa_name(isas[i]), tl.rays, tl.hits, tl.disagree);
+    assert_true(tl.hits > tl.rays / 4);
+    assert_true(tl.disagree <= tl.rays / 1000);
+  }
+  fr_set_isa(was);
+  if (k) fr_scene_release(k);
+  fr_scene_release(b);
+}
+
+static void errors(void **state) {
+  (void)state;
+  float p[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  uint32_t ix[3] = {0, 1, 2};
+  fr_scene *s;
+  assert_int_equal(fr_scene_from_arrays(p, 3, ix, 1, &s), FR_OK);
+  fr_pinhole cam = {{0.2f, 0.2f, 2.0f}, {0.2f, 0.2f, 0.0f}, {0.0f, 1.0f, 0.0f}, 30.0f, 8, 8};
+  fr_hit h[64];
+  float light[3] = {0.2f, 0.2f, 5.0f}, pts[6] = {0.2f, 0.2f, -1.0f, 0.2f, 0.2f, 1.0f};
+  uint8_t occ[2];
+  assert_int_equal(fr_intersect_camera(s, &cam, 0, 8, NULL, h), FR_ERR_STATE);
+  assert_int_equal(fr_occluded_point_light(s, light, pts, 2, 0.0f, occ), FR_ERR_STATE);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  assert_int_equal(fr_intersect_camera(s, &cam, 0, 8, NULL, h), FR_OK);
+  assert_true(h[27].prim == 0 && fabsf(h[27].t - 2.0f) < 0.01f); /* the middle sees the triangle */
+  assert_int_equal(fr_intersect_camera(NULL, &cam, 0, 8, NULL, h), FR_ERR_ARG);
+  assert_int_equal(fr_intersect_camera(s, &cam, 4, 5, NULL, h), FR_ERR_ARG);
+  assert_int_equal(fr_intersect_camera(s, &cam, -1, 2, NULL, h), FR_ERR_ARG);
+  cam.fov_deg = 180.0f;
+  assert_int_equal(fr_intersect_camera(s, &cam, 0, 8, NULL, h), FR_ERR_ARG);
+  assert_int_equal(fr_occluded_point_light(s, light, pts, 2, 0.0f, occ), FR_OK);
+  assert_true(occ[0] == 1 && occ[1] == 0); /* behind the triangle, in front of it */
+  assert_int_equal(fr_occluded_point_light(s, light, pts, 2, -1.0f, occ), FR_ERR_ARG);
+  light[0] = NAN;
+  assert_int_equal(fr_occluded_point_light(s, light, pts, 2, 0.0f, occ), FR_ERR_ARG);
+  fr_scene_release(s);
+  /* spheres: the camera call refuses them; point-light shadows see them */
+  assert_int_equal(fr_scene_new(&s), FR_OK);
+  float c[3] = {0.0f, 0.0f, 0.0f};
+  assert_int_equal(fr_scene_add_sphere(s, c, 1.0f, FR_INVALID_ID), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  cam.fov_deg = 30.0f;
+  assert_int_equal(fr_intersect_camera(s, &cam, 0, 8, NULL, h), FR_ERR_UNSUPPORTED);
+  float l2[3] = {0.0f, 0.0f, 5.0f}, behind[3] = {0.0f, 0.0f, -5.0f};
+  assert_int_equal(fr_occluded_point_light(s, l2, behind, 1, 0.0f, occ), FR_OK);
+  assert_int_equal(occ[0], 1);
+  fr_scene_release(s);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(scenes_at_every_isa),
+      cmocka_unit_test(errors),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
