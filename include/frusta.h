@@ -25,6 +25,10 @@ extern "C" {
 
 #define FR_VERSION_MAJOR 0
 #define FR_VERSION_MINOR 1
+/* The library's version, "MAJOR.MINOR", and its build: the ISAs compiled
+ * in, as "0.1 (avx512 avx2 scalar)". Compare with the macros to detect a
+ * header and a library from different releases. */
+const char *fr_version(void);
 
 #define FR_INVALID_ID 0xFFFFFFFFu
 
@@ -78,6 +82,18 @@ fr_error fr_scene_builtin(fr_scene **out);
 /* A scene from arrays (copied). idx holds 3 indices per triangle. */
 fr_error fr_scene_from_arrays(const float *xyz, size_t nverts, const uint32_t *idx,
                               size_t ntris, fr_scene **out);
+/* A scene from the caller's buffers: vertex i's x, y, z are the first 3
+ * floats at positions + i * vertex_stride bytes, triangle j's indices the
+ * first 3 at indices + j * index_stride (a stride of 0: tightly packed).
+ * Copied, or with FR_SHARE_BUFFERS (tightly packed buffers only) used in
+ * place: the scene then reads them until fr_scene_release, and the caller
+ * keeps them alive and unchanged until then (the BVH is built on them).
+ * Errors: FR_ERR_ARG (NULL, strides that are not whole records, sharing
+ * strided buffers, unknown flags), FR_ERR_FORMAT (an index out of range, a
+ * non-finite vertex, no triangles), FR_ERR_NOMEM. */
+#define FR_SHARE_BUFFERS 1u
+fr_error fr_scene_from_buffers(const float *positions, size_t nverts, size_t vertex_stride, const uint32_t *indices,
+                               size_t ntris, size_t index_stride, unsigned flags, fr_scene **out);
 /* An empty scene, for adding spheres and materials to. */
 fr_error fr_scene_new(fr_scene **out);
 void fr_scene_release(fr_scene *s);

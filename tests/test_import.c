@@ -312,6 +312,74 @@ static void test_textures(void **st) {
   fr_scene_release(s);
 }
 
+/* Scenes on the caller's buffers: strided copies and shared buffers give
+ * the same answers as fr_scene_from_arrays; sharing reads the caller's
+ * memory in place and never frees it (ASan would see a double free). */
+static void test_from_buffers(void **state) {
+  (void)state;
+  fr_scene *ref;
+  assert_int_equal(fr_scene_builtin(&ref), FR_OK);
+  size_t nv = fr_scene_vertex_count(ref), nt = fr_scene_triangle_count(ref);
+  const float *pos = fr_scene_vertices(ref);
+  const uint32_t *idx = fr_scene_indices(ref);
+  /* strided: 5 floats per vertex, 4 indices per triangle */
+  float *v5 = malloc(nv * 5 * sizeof(float));
+  uint32_t *t4 = malloc(nt * 4 * sizeof(uint32_t));
+  for (size_t i = 0; i < nv; i++) {
+    memcpy(v5 + 5 * i, pos + 3 * i, 3 * sizeof(float));
+    v5[5 * i + 3] = NAN; /* padding is never read */
+    v5[5 * i + 4] = -1.0f;
+  }
+  for (size_t j = 0; j < nt; j++) {
+    memcpy(t4 + 4 * j, idx + 3 * j, 3 * sizeof(uint32_t));
+    t4[4 * j + 3] = 0xDEADBEEFu;
+  }
+  float *v3 = malloc(nv * 3 * sizeof(float));
+  uint32_t *t3 = malloc(nt * 3 * sizeof(uint32_t));
+  memcpy(v3, pos, nv * 3 * sizeof(float));
+  memcpy(t3, idx, nt * 3 * sizeof(uint32_t));
+  fr_scene *strided, *shared;
+  assert_int_equal(fr_scene_from_buffers(v5, nv, 5 * sizeof(float), t4, nt, 4 * sizeof(uint32_t), 0, &strided), FR_OK);
+  assert_int_equal(fr_scene_from_buffers(v3, nv, 0, t3, nt, 0, FR_SHARE_BUFFERS, &shared), FR_OK);
+  assert_true(fr_scene_vertices(shared) == v3 && fr_scene_indices(shared) == t3); /* not copied */
+  assert_true(fr_scene_vertices(strided) != v5);
+  assert_int_equal(fr_scene_commit(ref), FR_OK);
+  assert_int_equal(fr_scene_commit(strided), FR_OK);
+  assert_int_equal(fr_scene_commit(shared), FR_OK);
+  assert_int_equal(fr_scene_add_sphere(shared, v3, 1.0f, FR_INVALID_ID), FR_ERR_STATE); /* committed */
+  fr_rng r = fr_rng_seed(3, 4);
+  float lo[3], hi[3];
+  fr_scene_bounds(ref, lo, hi);
+  int hits = 0;
+  for (int i = 0; i < 2000; i++) {
+    fr_ray ray = {{urand(&r, lo[0], hi[0]), urand(&r, lo[1], hi[1]), urand(&r, lo[2], hi[2])}, 0.0f,
+                  {urand(&r, -1, 1), urand(&r, -1, 1), urand(&r, -1, 1)}, INFINITY};
+    fr_hit a, b, c;
+    fr_intersect1(ref, &ray, &a);
+    fr_intersect1(strided, &ray, &b);
+    fr_intersect1(shared, &ray, &c);
+    assert_true(a.prim == b.prim && a.prim == c.prim && a.t == b.t && a.t == c.t);
+    hits += a.prim != FR_INVALID_ID;
+  }
+  assert_true(hits > 500);
+  fr_scene_release(shared); /* leaves v3 and t3 to us */
+  assert_true(v3[0] == pos[0] && t3[2] == idx[2]);
+  fr_scene_release(strided);
+  /* errors */
+  fr_scene *s = NULL;
+  assert_int_equal(fr_scene_from_buffers(v5, nv, 5 * sizeof(float), t3, nt, 0, FR_SHARE_BUFFERS, &s), FR_ERR_ARG);
+  assert_true(strstr(fr_last_error(), "tightly packed") != NULL);
+  assert_int_equal(fr_scene_from_buffers(v3, nv, 10, t3, nt, 0, 0, &s), FR_ERR_ARG);
+  assert_int_equal(fr_scene_from_buffers(v3, nv, 0, t3, nt, 0, 8, &s), FR_ERR_ARG);
+  assert_int_equal(fr_scene_from_buffers(NULL, nv, 0, t3, nt, 0, 0, &s), FR_ERR_ARG);
+  t3[5] = (uint32_t)nv; /* out of range: refused, shared or not */
+  assert_int_equal(fr_scene_from_buffers(v3, nv, 0, t3, nt, 0, FR_SHARE_BUFFERS, &s), FR_ERR_FORMAT);
+  assert_true(s == NULL);
+  assert_true(strncmp(fr_version(), "0.1 ", 4) == 0);
+  free(v5); free(t4); free(v3); free(t3);
+  fr_scene_release(ref);
+}
+
 int main(void) {
   snprintf(tmpdir, sizeof tmpdir, "/tmp/frusta_test_import_%d", (int)getpid());
   char cmd[300];
@@ -320,7 +388,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_ply_ascii_fan),  cmocka_unit_test(test_ply_binary),   cmocka_unit_test(test_ply_hostile),
       cmocka_unit_test(test_obj_mtl_and_zst), cmocka_unit_test(test_assimp_path), cmocka_unit_test(test_degenerate_only),
-      cmocka_unit_test(test_normals),     cmocka_unit_test(test_textures),
+      cmocka_unit_test(test_normals),     cmocka_unit_test(test_textures),    cmocka_unit_test(test_from_buffers),
   };
   int rc = cmocka_run_group_tests(tests, NULL, NULL);
   snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);

@@ -212,13 +212,43 @@ fr_error fr_scene_builtin(fr_scene **out) {
 }
 
 fr_error fr_scene_from_arrays(const float *xyz, size_t nverts, const uint32_t *idx, size_t ntris, fr_scene **out) {
-  if (!out || (!xyz && nverts) || (!idx && ntris)) return fr_fail(FR_ERR_ARG, "fr_scene_from_arrays: NULL array");
+  return fr_scene_from_buffers(xyz, nverts, 0, idx, ntris, 0, 0, out);
+}
+
+fr_error fr_scene_from_buffers(const float *positions, size_t nverts, size_t vertex_stride, const uint32_t *indices,
+                               size_t ntris, size_t index_stride, unsigned flags, fr_scene **out) {
+  if (!out || (!positions && nverts) || (!indices && ntris))
+    return fr_fail(FR_ERR_ARG, "fr_scene_from_buffers: NULL array");
   *out = NULL;
+  const size_t vs = vertex_stride ? vertex_stride : 3 * sizeof(float);
+  const size_t is = index_stride ? index_stride : 3 * sizeof(uint32_t);
+  if (vs < 3 * sizeof(float) || vs % sizeof(float) || is < 3 * sizeof(uint32_t) || is % sizeof(uint32_t))
+    return fr_fail(FR_ERR_ARG, "fr_scene_from_buffers: strides %zu and %zu bytes are not whole records of at least "
+                   "3 floats and 3 indices", vs, is);
+  if (flags & ~(unsigned)FR_SHARE_BUFFERS) return fr_fail(FR_ERR_ARG, "fr_scene_from_buffers: unknown flags 0x%x", flags);
+  const int share = (flags & FR_SHARE_BUFFERS) != 0;
+  if (share && (vs != 3 * sizeof(float) || is != 3 * sizeof(uint32_t)))
+    return fr_fail(FR_ERR_ARG, "fr_scene_from_buffers: shared buffers must be tightly packed (strides 12 and 12)");
   fr_scene *s = scene_new();
   if (!s) return fr_fail(FR_ERR_NOMEM, "out of memory");
   fr_error e = FR_OK;
-  for (size_t i = 0; i < nverts && !e; i++) e = fr_mesh_add_vertex(&s->mesh, xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
-  for (size_t i = 0; i < ntris && !e; i++) e = fr_mesh_add_triangle(&s->mesh, idx[3 * i], idx[3 * i + 1], idx[3 * i + 2], FR_INVALID_ID);
+  if (share) {
+    s->mesh.borrowed = 1;
+    s->mesh.pos = (float *)positions; /* read only: the scene never writes to a borrowed mesh */
+    s->mesh.nverts = nverts;
+    s->mesh.idx = (uint32_t *)indices;
+    s->mesh.ntris = ntris;
+  } else {
+    const unsigned char *pv = (const unsigned char *)positions, *pi = (const unsigned char *)indices;
+    for (size_t i = 0; i < nverts && !e; i++) {
+      const float *v = (const float *)(pv + i * vs);
+      e = fr_mesh_add_vertex(&s->mesh, v[0], v[1], v[2]);
+    }
+    for (size_t i = 0; i < ntris && !e; i++) {
+      const uint32_t *t = (const uint32_t *)(pi + i * is);
+      e = fr_mesh_add_triangle(&s->mesh, t[0], t[1], t[2], FR_INVALID_ID);
+    }
+  }
   if (!e) e = fr_mesh_validate(&s->mesh, "arrays");
   if (e) { fr_scene_release(s); return e; }
   snprintf(s->name, sizeof s->name, "arrays");

@@ -9,8 +9,10 @@
 void fr_mesh_init(fr_mesh *m) { memset(m, 0, sizeof *m); }
 
 void fr_mesh_free(fr_mesh *m) {
-  free(m->pos);
-  free(m->idx);
+  if (!m->borrowed) {
+    free(m->pos);
+    free(m->idx);
+  }
   free(m->mat);
   free(m->mats);
   free(m->nrm.val);
@@ -32,6 +34,7 @@ static int grow(void **p, size_t *cap, size_t n, size_t elem) {
 }
 
 fr_error fr_mesh_add_vertex(fr_mesh *m, float x, float y, float z) {
+  if (m->borrowed) return fr_fail(FR_ERR_STATE, "a mesh on shared buffers takes no more vertices");
   if (!grow((void **)&m->pos, &m->cap_verts, m->nverts, 3 * sizeof(float)))
     return fr_fail(FR_ERR_NOMEM, "out of memory at vertex %zu", m->nverts);
   float *p = m->pos + 3 * m->nverts++;
@@ -40,6 +43,7 @@ fr_error fr_mesh_add_vertex(fr_mesh *m, float x, float y, float z) {
 }
 
 fr_error fr_mesh_add_triangle(fr_mesh *m, uint32_t a, uint32_t b, uint32_t c, uint32_t mat) {
+  if (m->borrowed) return fr_fail(FR_ERR_STATE, "a mesh on shared buffers takes no more triangles");
   size_t old_cap = m->cap_tris;
   if (!grow((void **)&m->idx, &m->cap_tris, m->ntris, 3 * sizeof(uint32_t)))
     return fr_fail(FR_ERR_NOMEM, "out of memory at triangle %zu", m->ntris);

@@ -23,6 +23,7 @@ typedef struct fr_mesh {
   size_t nmats, cap_mats;
   fr_corner_attr nrm; /* shading normals (unit; 0, 0, 0: none) */
   fr_corner_attr uv;  /* texture coordinates */
+  int borrowed;       /* pos and idx are the caller's (fr_scene_from_buffers): never grown or freed */
 } fr_mesh;
 
 void fr_mesh_init(fr_mesh *m);
