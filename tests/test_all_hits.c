@@ -40,7 +40,7 @@ static size_t brute_crossings(const fr_scene *s, const uint8_t *traced, const fr
     if (n < cap) out[n] = h;
     n++;
   }
-  qsort(out, n < cap ? n : cap, sizeof *out, by_t_prim);
+  if (n > 1) qsort(out, n < cap ? n : cap, sizeof *out, by_t_prim);
   return n;
 }
 

@@ -114,7 +114,7 @@ fr_error fr_bvh2_all_hits(const fr_bvh2 *b, const fr_mesh *m, const fr_ray *ray,
   }
   /* A triangle split into several leaf references crosses at the same t
    * in each: after sorting, its copies are neighbours. */
-  qsort(c->items, c->n, sizeof *c->items, by_t_then_prim);
+  if (c->n > 1) qsort(c->items, c->n, sizeof *c->items, by_t_then_prim);
   size_t k = 0;
   for (size_t i = 0; i < c->n; i++)
     if (k == 0 || c->items[i].prim != c->items[k - 1].prim || c->items[i].t != c->items[k - 1].t)
