@@ -7,7 +7,9 @@ threads; bench/embree_python.c through ctypes, packing in C), and also with
 its 16-wide packets; for each workload Embree's best of those and of its two
 coherence flags counts, with its high-quality build. frusta runs in its
 default trace mode (auto) from the same arrays, and through its multi-frusta
-calls where they apply; its fastest call counts. Workloads per scene:
+calls where they apply; its fastest call counts. Both return t, triangle,
+u and v (frusta's camera call without normals, as Embree's hits are read
+here; with them it fetches each hit triangle). Workloads per scene:
 1024x1024 camera rays (frusta's camera call, and the same rays as arrays, row
 by row), shadow segments between their hits and the scene's point light
 (frusta's point-light call, and arrays from the light and to it), and 1M
@@ -103,6 +105,13 @@ def camera(view, w, h):
             np.ascontiguousarray(d.reshape(-1, 3), dtype=np.float32))
 
 
+def tile_order(w, h):
+    """Pixel indices of a w x h image (multiples of 16) in 16x16 tiles of
+    4x4 blocks."""
+    i = np.arange(w * h).reshape(h // 16, 4, 4, w // 16, 4, 4)  # tile row, block row, row; tile col, block col, col
+    return i.transpose(0, 3, 1, 4, 2, 5).reshape(-1)
+
+
 def agree_hits(t1, t2):
     """docs/rayfile.md: both miss, or both hit at t within 1e-4 * max(1, |t|)."""
     m1, m2 = np.isinf(t1), np.isinf(t2)
@@ -160,15 +169,18 @@ def main():
             eye, at, up, fov, light = view
             # camera rays: frusta's camera call (multi-frusta, rays made on the
             # fly) and the same rays from arrays; Embree from those arrays
-            hits, d = fs.intersect_camera(eye, at, up, fov, a.size, a.size)
+            hits, d = fs.intersect_camera(eye, at, up, fov, a.size, a.size, directions=True)
             d = np.ascontiguousarray(d.reshape(-1, 3))
             o = np.ascontiguousarray(np.broadcast_to(np.float32(eye), d.shape))
             t_cam = hits.t.reshape(-1)
             # shadow rays: the camera's hit points and the point light, from
             # the light (frusta's point-light call, and arrays) and from the
-            # points (arrays), the same segments
-            hit = np.isfinite(t_cam)
-            pts = np.ascontiguousarray((o[hit] + t_cam[hit, None] * d[hit]).astype(np.float32))
+            # points (arrays), the same segments; the points in 4x4 blocks of
+            # 16x16 tiles, the order a renderer keeps them in, for both
+            order = tile_order(a.size, a.size)
+            hit = np.isfinite(t_cam[order])
+            oo, dd, tt = o[order][hit], d[order][hit], t_cam[order][hit]
+            pts = np.ascontiguousarray((oo + tt[:, None] * dd).astype(np.float32))
             lo, hi = fs.bounds
             eps = np.float32(1e-5 * np.linalg.norm(hi - lo))
             L = np.float32(light)
@@ -182,7 +194,10 @@ def main():
             ro = rng.uniform(lo, hi, (a.rays, 3)).astype(np.float32)
             rd = rng.normal(size=(a.rays, 3)).astype(np.float32)
             work = {
-                "camera": ({"camera call": lambda: fs.intersect_camera(eye, at, up, fov, a.size, a.size)[0].t.reshape(-1),
+                "camera": ({"camera call": lambda: fs.intersect_camera(eye, at, up, fov, a.size, a.size,
+                                                                       normals=False).t.reshape(-1),
+                            "camera call with normals": lambda: fs.intersect_camera(eye, at, up, fov, a.size,
+                                                                                    a.size).t.reshape(-1),
                             "arrays": lambda: fs.intersect(o, d).t},
                            embree_variants(lambda c, p16: em.intersect(o, d, c, p16)), len(o), agree_hits),
                 "shadow": ({"point-light call": lambda: fs.occluded_point_light(pts, L, eps),

@@ -290,11 +290,14 @@ typedef struct fr_pinhole {
  * t is in units of them. Each answer is the one fr_intersect1 gives for that
  * ray (t to rounding; the triangle up to ties). Bands of 16 rows starting at
  * multiples of 16 waste no work; threads may trace different bands of one
- * image at once. Caller-owned arrays. Errors: FR_ERR_ARG (NULL, a bad
- * camera, rows outside the image), FR_ERR_STATE (not committed),
- * FR_ERR_UNSUPPORTED (the scene has spheres). */
-fr_error fr_intersect_camera(const fr_scene *s, const fr_pinhole *camera, int y0, int rows, fr_ray *rays,
-                             fr_hit *hits);
+ * image at once. flags: FR_CAMERA_NO_NORMALS leaves ng zero (it costs a
+ * fetch of the triangle per pixel). Caller-owned arrays. Errors:
+ * FR_ERR_ARG (NULL, a bad camera, rows outside the image, unknown flags),
+ * FR_ERR_STATE (not committed), FR_ERR_UNSUPPORTED (the scene has
+ * spheres). */
+#define FR_CAMERA_NO_NORMALS 1u
+fr_error fr_intersect_camera(const fr_scene *s, const fr_pinhole *camera, int y0, int rows, unsigned flags,
+                             fr_ray *rays, fr_hit *hits);
 
 /* Whether each of n points (xyz, 3 floats each) is in shadow of a point
  * light: occluded[i] = 1 if a triangle or sphere lies on the segment from

@@ -34,7 +34,7 @@ static void camera_against_rays(const fr_scene *s, const fr_pinhole *p, tally *t
   size_t n = (size_t)p->width * (size_t)p->height;
   fr_ray *rays = malloc(n * sizeof *rays);
   fr_hit *hits = malloc(n * sizeof *hits);
-  assert_int_equal(fr_intersect_camera(s, p, 0, p->height, rays, hits), FR_OK);
+  assert_int_equal(fr_intersect_camera(s, p, 0, p->height, 0, rays, hits), FR_OK);
   fr_camera cam;
   assert_int_equal(fr_camera_setup(&cam, v3_load(p->eye), v3_load(p->at), v3_load(p->up), p->fov_deg, p->width, p->height),
                    FR_OK);
@@ -52,10 +52,17 @@ static void camera_against_rays(const fr_scene *s, const fr_pinhole *p, tally *t
   int y0 = 5, rows = p->height - 9 < 37 ? p->height - 9 : 37;
   fr_ray *br = malloc((size_t)rows * (size_t)p->width * sizeof *br);
   fr_hit *bh = malloc((size_t)rows * (size_t)p->width * sizeof *bh);
-  assert_int_equal(fr_intersect_camera(s, p, y0, rows, br, bh), FR_OK);
+  assert_int_equal(fr_intersect_camera(s, p, y0, rows, 0, br, bh), FR_OK);
   for (size_t i = 0; i < (size_t)rows * (size_t)p->width; i++) check_hit(s, &m, &br[i], &bh[i], tl);
-  /* rays may be NULL */
-  assert_int_equal(fr_intersect_camera(s, p, y0, rows, NULL, bh), FR_OK);
+  /* rays may be NULL; without normals, the same hits and ng zero */
+  fr_hit *nn = malloc((size_t)rows * (size_t)p->width * sizeof *nn);
+  assert_int_equal(fr_intersect_camera(s, p, y0, rows, FR_CAMERA_NO_NORMALS, NULL, nn), FR_OK);
+  for (size_t i = 0; i < (size_t)rows * (size_t)p->width; i++) {
+    assert_true(nn[i].t == bh[i].t && nn[i].prim == bh[i].prim && nn[i].u == bh[i].u);
+    assert_true(nn[i].ng[0] == 0.0f && nn[i].ng[1] == 0.0f && nn[i].ng[2] == 0.0f);
+  }
+  free(nn);
+  assert_int_equal(fr_intersect_camera(s, p, y0, rows, 2, NULL, bh), FR_ERR_ARG);
   free(br); free(bh);
 
   /* shadows of the image's hit points towards a point light */
@@ -130,16 +137,16 @@ static void errors(void **state) {
   fr_hit h[64];
   float light[3] = {0.2f, 0.2f, 5.0f}, pts[6] = {0.2f, 0.2f, -1.0f, 0.2f, 0.2f, 1.0f};
   uint8_t occ[2];
-  assert_int_equal(fr_intersect_camera(s, &cam, 0, 8, NULL, h), FR_ERR_STATE);
+  assert_int_equal(fr_intersect_camera(s, &cam, 0, 8, 0, NULL, h), FR_ERR_STATE);
   assert_int_equal(fr_occluded_point_light(s, light, pts, 2, 0.0f, occ), FR_ERR_STATE);
   assert_int_equal(fr_scene_commit(s), FR_OK);
-  assert_int_equal(fr_intersect_camera(s, &cam, 0, 8, NULL, h), FR_OK);
+  assert_int_equal(fr_intersect_camera(s, &cam, 0, 8, 0, NULL, h), FR_OK);
   assert_true(h[27].prim == 0 && fabsf(h[27].t - 2.0f) < 0.01f); /* the middle sees the triangle */
-  assert_int_equal(fr_intersect_camera(NULL, &cam, 0, 8, NULL, h), FR_ERR_ARG);
-  assert_int_equal(fr_intersect_camera(s, &cam, 4, 5, NULL, h), FR_ERR_ARG);
-  assert_int_equal(fr_intersect_camera(s, &cam, -1, 2, NULL, h), FR_ERR_ARG);
+  assert_int_equal(fr_intersect_camera(NULL, &cam, 0, 8, 0, NULL, h), FR_ERR_ARG);
+  assert_int_equal(fr_intersect_camera(s, &cam, 4, 5, 0, NULL, h), FR_ERR_ARG);
+  assert_int_equal(fr_intersect_camera(s, &cam, -1, 2, 0, NULL, h), FR_ERR_ARG);
   cam.fov_deg = 180.0f;
-  assert_int_equal(fr_intersect_camera(s, &cam, 0, 8, NULL, h), FR_ERR_ARG);
+  assert_int_equal(fr_intersect_camera(s, &cam, 0, 8, 0, NULL, h), FR_ERR_ARG);
   assert_int_equal(fr_occluded_point_light(s, light, pts, 2, 0.0f, occ), FR_OK);
   assert_true(occ[0] == 1 && occ[1] == 0); /* behind the triangle, in front of it */
   assert_int_equal(fr_occluded_point_light(s, light, pts, 2, -1.0f, occ), FR_ERR_ARG);
@@ -152,7 +159,7 @@ static void errors(void **state) {
   assert_int_equal(fr_scene_add_sphere(s, c, 1.0f, FR_INVALID_ID), FR_OK);
   assert_int_equal(fr_scene_commit(s), FR_OK);
   cam.fov_deg = 30.0f;
-  assert_int_equal(fr_intersect_camera(s, &cam, 0, 8, NULL, h), FR_ERR_UNSUPPORTED);
+  assert_int_equal(fr_intersect_camera(s, &cam, 0, 8, 0, NULL, h), FR_ERR_UNSUPPORTED);
   float l2[3] = {0.0f, 0.0f, 5.0f}, behind[3] = {0.0f, 0.0f, -5.0f};
   assert_int_equal(fr_occluded_point_light(s, l2, behind, 1, 0.0f, occ), FR_OK);
   assert_int_equal(occ[0], 1);

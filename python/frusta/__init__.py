@@ -61,14 +61,16 @@ class Scene(_Scene):
         (odd: it starts inside a closed, consistently wound mesh)."""
         return self._intersect_all(origins, directions, 0, tnear, tfar)[5]
 
-    def intersect_camera(self, eye, at, up, fov, width, height):
+    def intersect_camera(self, eye, at, up, fov, width, height, directions=False, normals=True):
         """The closest hits of a pinhole camera's rays (vertical field of view
         fov in degrees, rays through pixel centres, row 0 at the top), traced
-        as multi-frusta: Hits of shape (height, width), and the rays'
-        normalized directions (height, width, 3); the origin is eye and t is
-        in units of those directions."""
-        *h, directions = self._intersect_camera(eye, at, up, fov, width, height)
-        return Hits(*h), directions
+        as multi-frusta: Hits of shape (height, width), t in units of the
+        rays' normalized directions (the origin is eye). With
+        directions=True, returns (hits, directions), the directions of shape
+        (height, width, 3). normals=False leaves hits.normal None, sparing a
+        fetch of the triangle per pixel."""
+        *h, dirs = self._intersect_camera(eye, at, up, fov, width, height, directions, normals)
+        return (Hits(*h), dirs) if directions else Hits(*h)
 
     def occluded_point_light(self, points, light, eps=None):
         """Whether each point (..., 3) is in shadow of a point light: anything

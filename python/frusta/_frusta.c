@@ -462,10 +462,12 @@ static int vec3_arg(PyObject *o, const char *name, float out[3]) {
 }
 
 static PyObject *scene_intersect_camera(SceneObject *s, PyObject *args, PyObject *kw) {
-  static char *names[] = {"eye", "at", "up", "fov", "width", "height", NULL};
+  static char *names[] = {"eye", "at", "up", "fov", "width", "height", "directions", "normals", NULL};
   PyObject *eo, *ao, *uo;
   fr_pinhole cam;
-  if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOfii", names, &eo, &ao, &uo, &cam.fov_deg, &cam.width, &cam.height))
+  int want_dir = 0, want_normals = 1;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOfii|pp", names, &eo, &ao, &uo, &cam.fov_deg, &cam.width,
+                                   &cam.height, &want_dir, &want_normals))
     return NULL;
   if (!scene_open(s) || !vec3_arg(eo, "eye", cam.eye) || !vec3_arg(ao, "at", cam.at) || !vec3_arg(uo, "up", cam.up))
     return NULL;
@@ -479,33 +481,42 @@ static PyObject *scene_intersect_camera(SceneObject *s, PyObject *args, PyObject
   r.shape[1] = cam.width;
   PyArrayObject *t = out_array(&r, 0, NPY_FLOAT32), *prim = out_array(&r, 0, NPY_UINT32);
   PyArrayObject *u = out_array(&r, 0, NPY_FLOAT32), *v = out_array(&r, 0, NPY_FLOAT32);
-  PyArrayObject *ng = out_array(&r, 3, NPY_FLOAT32), *dir = out_array(&r, 3, NPY_FLOAT32);
+  PyArrayObject *ng = want_normals ? out_array(&r, 3, NPY_FLOAT32) : NULL;
+  PyArrayObject *dir = want_dir ? out_array(&r, 3, NPY_FLOAT32) : NULL;
   PyObject *result = NULL;
-  if (!t || !prim || !u || !v || !ng || !dir) goto done;
+  if (!t || !prim || !u || !v || (want_normals && !ng) || (want_dir && !dir)) goto done;
   s->busy++;
   const fr_scene *sc = s->scene;
   int bands = (cam.height + 15) / 16;
   fr_error err = FR_OK;
   char msg[512] = "";
-  float *tp = PyArray_DATA(t), *up = PyArray_DATA(u), *vp = PyArray_DATA(v), *np = PyArray_DATA(ng);
-  float *dp = PyArray_DATA(dir);
+  float *tp = PyArray_DATA(t), *up = PyArray_DATA(u), *vp = PyArray_DATA(v), *np = ng ? PyArray_DATA(ng) : NULL;
+  float *dp = dir ? PyArray_DATA(dir) : NULL;
   uint32_t *pp = PyArray_DATA(prim);
   Py_BEGIN_ALLOW_THREADS
 #pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads ? n_threads : omp_get_max_threads())
   for (int band = 0; band < bands; band++) {
     int y0 = 16 * band, rows = cam.height - y0 < 16 ? cam.height - y0 : 16;
-    fr_ray *rb = malloc((size_t)cam.width * 16 * sizeof *rb);
+    fr_ray *rb = dp ? malloc((size_t)cam.width * 16 * sizeof *rb) : NULL;
     fr_hit *hb = malloc((size_t)cam.width * 16 * sizeof *hb);
-    fr_error e = rb && hb ? fr_intersect_camera(sc, &cam, y0, rows, rb, hb) : FR_ERR_NOMEM;
+    fr_error e = (rb || !dp) && hb ? fr_intersect_camera(sc, &cam, y0, rows, want_normals ? 0 : FR_CAMERA_NO_NORMALS, rb, hb) : FR_ERR_NOMEM;
     if (e != FR_OK) {
 #pragma omp critical(frusta_error)
       if (err == FR_OK) { err = e; snprintf(msg, sizeof msg, "%s", e == FR_ERR_NOMEM ? "out of memory" : fr_last_error()); }
     } else {
-      for (size_t j = 0; j < (size_t)rows * (size_t)cam.width; j++) {
-        size_t i = (size_t)y0 * (size_t)cam.width + j;
+      const size_t i0 = (size_t)y0 * (size_t)cam.width, m = (size_t)rows * (size_t)cam.width;
+      for (size_t j = 0; j < m; j++) {
+        size_t i = i0 + j;
         tp[i] = hb[j].t; up[i] = hb[j].u; vp[i] = hb[j].v; pp[i] = hb[j].prim;
-        for (int a = 0; a < 3; a++) { np[3 * i + a] = hb[j].ng[a]; dp[3 * i + a] = rb[j].dir[a]; }
       }
+      if (want_normals)
+        for (size_t j = 0; j < m; j++) {
+          size_t i = i0 + j;
+          np[3 * i] = hb[j].ng[0]; np[3 * i + 1] = hb[j].ng[1]; np[3 * i + 2] = hb[j].ng[2];
+        }
+      if (dp)
+        for (size_t j = 0; j < m; j++)
+          for (int a = 0; a < 3; a++) dp[3 * (i0 + j) + a] = rb[j].dir[a];
     }
     free(rb);
     free(hb);
@@ -513,7 +524,7 @@ static PyObject *scene_intersect_camera(SceneObject *s, PyObject *args, PyObject
   Py_END_ALLOW_THREADS
   s->busy--;
   if (err != FR_OK) { raise_fr(err, msg); goto done; }
-  result = Py_BuildValue("(OOOOOO)", t, prim, u, v, ng, dir);
+  result = Py_BuildValue("(OOOOOO)", t, prim, u, v, ng ? (PyObject *)ng : Py_None, dir ? (PyObject *)dir : Py_None);
 done:
   Py_XDECREF(t); Py_XDECREF(prim); Py_XDECREF(u); Py_XDECREF(v); Py_XDECREF(ng); Py_XDECREF(dir);
   return result;

@@ -9,20 +9,27 @@
 #include "scene.h"
 #include "trace/kernels.h"
 
-static void set_normal(const fr_scene *s, fr_hit *h) {
+/* Neighbouring pixels mostly hit one triangle: *last keeps the previous
+ * hit's normal. */
+static void set_normal(const fr_scene *s, fr_hit *h, fr_hit *last) {
   if (h->prim == FR_INVALID_ID) { h->ng[0] = h->ng[1] = h->ng[2] = 0.0f; return; }
+  if (h->prim == last->prim) { memcpy(h->ng, last->ng, sizeof h->ng); return; }
   const uint32_t *ix = s->mesh.idx + 3 * (size_t)h->prim;
   const float *a = s->mesh.pos + 3 * (size_t)ix[0], *b = s->mesh.pos + 3 * (size_t)ix[1], *c = s->mesh.pos + 3 * (size_t)ix[2];
   fr_tri_normal_lane(a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], &h->ng[0], &h->ng[1], &h->ng[2]);
+  *last = *h;
 }
 
-fr_error fr_intersect_camera(const fr_scene *s, const fr_pinhole *p, int y0, int rows, fr_ray *rays, fr_hit *hits) {
+fr_error fr_intersect_camera(const fr_scene *s, const fr_pinhole *p, int y0, int rows, unsigned flags, fr_ray *rays,
+                             fr_hit *hits) {
   if (!s || !p || !hits) return fr_fail(FR_ERR_ARG, "fr_intersect_camera: NULL scene, camera or hits");
   if (!s->committed) return fr_fail(FR_ERR_STATE, "fr_intersect_camera: the scene is not committed");
   if (s->sphere_bvh.nprims) return fr_fail(FR_ERR_UNSUPPORTED, "fr_intersect_camera: scenes with spheres are not supported");
   fr_camera cam;
   fr_error e = fr_camera_setup(&cam, v3_load(p->eye), v3_load(p->at), v3_load(p->up), p->fov_deg, p->width, p->height);
   if (e != FR_OK) return e;
+  if (flags & ~(unsigned)FR_CAMERA_NO_NORMALS) return fr_fail(FR_ERR_ARG, "fr_intersect_camera: unknown flags 0x%x", flags);
+  const int normals = !(flags & FR_CAMERA_NO_NORMALS);
   if (y0 < 0 || rows < 0 || rows > p->height - y0)
     return fr_fail(FR_ERR_ARG, "fr_intersect_camera: rows %d..%d are not in the image's %d", y0, y0 + rows, p->height);
   if (!s->bvh2.nprims) { /* nothing to hit */
@@ -45,6 +52,7 @@ fr_error fr_intersect_camera(const fr_scene *s, const fr_pinhole *p, int y0, int
   fr_ray r256[256], left[256];
   fr_hit h256[256], left_hit[256];
   size_t left_at[256];
+  fr_hit last = {0.0f, 0.0f, 0.0f, FR_INVALID_ID, {0.0f, 0.0f, 0.0f}};
   for (int ty = y0; ty < y0 + rows; ty += 16)
     for (int tx = 0; tx < p->width; tx += 16) {
       fr_mft_batch_camera(&b, &cam, tx, ty);
@@ -61,7 +69,7 @@ fr_error fr_intersect_camera(const fr_scene *s, const fr_pinhole *p, int y0, int
           if (b.valid >> f & 1) {
             if (rays) rays[i] = r256[16 * f + j];
             hits[i] = h256[16 * f + j];
-            set_normal(s, &hits[i]);
+            if (normals) set_normal(s, &hits[i], &last);
           } else {
             left[nleft] = fr_camera_ray(&cam, x, y);
             left_at[nleft++] = i;
@@ -72,6 +80,7 @@ fr_error fr_intersect_camera(const fr_scene *s, const fr_pinhole *p, int y0, int
       for (int j = 0; j < nleft; j++) {
         if (rays) rays[left_at[j]] = left[j];
         hits[left_at[j]] = left_hit[j];
+        if (!normals) memset(hits[left_at[j]].ng, 0, sizeof hits[left_at[j]].ng);
       }
     }
   return FR_OK;

@@ -420,7 +420,7 @@ def test_context_manager_and_repr():
 def test_intersect_camera_equals_rays():
     s = frusta.Scene.builtin()
     eye, at, up = (0.0, 3.0, 9.0), (0.0, 0.5, 0.0), (0.0, 1.0, 0.0)
-    h, d = s.intersect_camera(eye, at, up, 50.0, 203, 117)
+    h, d = s.intersect_camera(eye, at, up, 50.0, 203, 117, directions=True)
     assert h.t.shape == (117, 203) and d.shape == (117, 203, 3)
     np.testing.assert_allclose(np.linalg.norm(d, axis=-1), 1, rtol=1e-6)
     o = np.broadcast_to(np.float32(eye), d.shape).copy()
@@ -434,6 +434,10 @@ def test_intersect_camera_equals_rays():
     same = g.prim == h.prim
     assert same.mean() > 0.999
     np.testing.assert_allclose(h.normal[same], g.normal[same], rtol=1e-5, atol=1e-6)
+    bare = s.intersect_camera(eye, at, up, 50.0, 203, 117, normals=False)
+    assert bare.normal is None
+    np.testing.assert_array_equal(bare.t, h.t)
+    np.testing.assert_array_equal(bare.prim, h.prim)
     with pytest.raises(ValueError, match="field of view"):
         s.intersect_camera(eye, at, up, 0.0, 8, 8)
     with pytest.raises(ValueError, match="empty or too large"):
@@ -445,7 +449,7 @@ def test_intersect_camera_equals_rays():
 def test_occluded_point_light_equals_rays():
     s = frusta.Scene.builtin()
     eye = (0.0, 3.0, 9.0)
-    h, d = s.intersect_camera(eye, (0.0, 0.5, 0.0), (0.0, 1.0, 0.0), 50.0, 256, 192)
+    h, d = s.intersect_camera(eye, (0.0, 0.5, 0.0), (0.0, 1.0, 0.0), 50.0, 256, 192, directions=True)
     hit = np.isfinite(h.t)
     p = (np.float32(eye) + h.t[..., None] * d)[hit].astype(np.float32)
     light = np.float32([2.0, 6.0, 3.0])
