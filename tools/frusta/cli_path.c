@@ -52,52 +52,25 @@ int cli_path_from_args(const cli_args *a, cli_path *o) {
   return 0;
 }
 
+/* the scene file's materials, by name */
+static const fr_bsdf *file_material(const void *ctx, const char *name) {
+  return fr_scene_file_find_material((const fr_scene_file *)ctx, name);
+}
+
 int cli_path_setup(const cli_path *o, fr_workload *w, cli_path_run *r) {
-  memset(r, 0, sizeof *r);
   const fr_view *v = &w->view;
-  if (o->env_file) {
-    if (fr_env_load(&r->env, o->env_file)) return cli_error(1, "%s", fr_last_error());
-  } else {
-    fr_env_constant(&r->env, o->env_color);
-  }
-  if (!(o->lights & CLI_LIGHT_ENV)) { fr_env_free(&r->env); fr_env_constant(&r->env, v3(0, 0, 0)); }
-  fr_env_orient(&r->env, v->up, o->env_rotate, o->env_intensity);
-  size_t count;
-  fr_error e = fr_path_mats_build(w->scene, o->mirror, o->glass, &r->mats, &count, &r->textures, &r->ntextures);
-  if (e) {
-    cli_path_free(r);
-    return cli_error(e == FR_ERR_ARG ? CLI_USAGE_ERROR : 1, "%s", fr_last_error());
-  }
+  fr_path_options po;
+  fr_path_options_default(&po);
+  po.spp = o->spp, po.max_depth = o->max_depth, po.lights = o->lights, po.sampler = o->sampler, po.seed = o->seed;
+  po.env_file = o->env_file, po.env_color = o->env_color, po.env_intensity = o->env_intensity;
+  po.env_rotate = o->env_rotate, po.mirror = o->mirror, po.glass = o->glass;
+  po.aperture = o->aperture, po.focus = o->focus;
   const fr_scene_file *file = cli_scene_file();
-  for (size_t i = 0; file && i + 1 < count; i++) { /* the scene file's materials, by name */
-    const fr_bsdf *b = fr_scene_file_find_material(file, fr_scene_material(w->scene, i)->name);
-    if (b) r->mats[i] = *b;
-  }
+  fr_error e = fr_path_scene_init(r, w->scene, v, &po, file ? file_material : NULL, file);
+  if (e) return cli_error(e == FR_ERR_ARG ? CLI_USAGE_ERROR : 1, "%s", fr_last_error());
   fr_path_setup *P = &r->setup;
-  P->mats = r->mats, P->count = count;
-  if (fr_surfaces_build(w->scene, (int32_t)count - 1, &r->surf, &P->nsurf)) { cli_path_free(r); return cli_error(1, "%s", fr_last_error()); }
-  P->surf = r->surf;
-  P->textures = r->textures;
-  P->lights.env = &r->env;
-  /* the area and point lights bright enough that a white surface where the
-   * camera looks, facing them, is as bright as under a white sky (irradiance pi) */
-  const vec3 ac = v3_add(v->area_c, v3_scale(v3_add(v->area_e1, v->area_e2), 0.5f));
-  const float area = v3_len(v3_cross(v->area_e1, v->area_e2));
-  const float da = v3_len(v3_sub(ac, v->at)), dp = v3_len(v3_sub(v->light, v->at));
-  P->lights.area = (o->lights & CLI_LIGHT_AREA) && area > 0.0f;
-  P->lights.area_c = v->area_c, P->lights.area_e1 = v->area_e1, P->lights.area_e2 = v->area_e2;
-  const float la = area > 0.0f ? 3.14159265f * da * da / area : 0.0f;
-  P->lights.area_radiance = file && file->has_area_radiance ? file->area_radiance : v3(la, la, la);
-  P->lights.point = (o->lights & CLI_LIGHT_POINT) != 0;
-  P->lights.point_pos = v->light;
-  const float ip = 3.14159265f * dp * dp;
-  P->lights.point_intensity = file && file->has_point_intensity ? file->point_intensity : v3(ip, ip, ip);
-  P->max_depth = o->max_depth;
-  P->sampler = o->sampler;
-  P->spp = o->spp, P->spp_begin = 0, P->spp_end = o->spp;
-  P->aperture = o->aperture;
-  P->focus = o->focus > 0.0f ? o->focus : v3_len(v3_sub(v->at, v->eye));
-  P->seed = o->seed;
+  if (file && file->has_area_radiance) P->lights.area_radiance = file->area_radiance;
+  if (file && file->has_point_intensity) P->lights.point_intensity = file->point_intensity;
   w->path = P;
   char lights[32] = "";
   if (o->lights & CLI_LIGHT_ENV) strcat(lights, ",env");
@@ -111,10 +84,4 @@ int cli_path_setup(const cli_path *o, fr_workload *w, cli_path_run *r) {
   return 0;
 }
 
-void cli_path_free(cli_path_run *r) {
-  fr_env_free(&r->env);
-  free(r->mats);
-  free(r->surf);
-  fr_path_textures_free(r->textures, r->ntextures);
-  memset(r, 0, sizeof *r);
-}
+void cli_path_free(cli_path_run *r) { fr_path_scene_free(r); }

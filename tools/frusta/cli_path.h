@@ -5,9 +5,10 @@
 #include "flags.h"
 #include "light/environment.h"
 #include "render/path.h"
+#include "render/path_scene.h"
 #include "render/workload.h"
 
-enum { CLI_LIGHT_ENV = 1, CLI_LIGHT_AREA = 2, CLI_LIGHT_POINT = 4 };
+enum { CLI_LIGHT_ENV = FR_PATH_LIGHT_ENV, CLI_LIGHT_AREA = FR_PATH_LIGHT_AREA, CLI_LIGHT_POINT = FR_PATH_LIGHT_POINT };
 
 typedef struct cli_path {
   int spp, max_depth, lights;
@@ -19,14 +20,7 @@ typedef struct cli_path {
   int aov;
 } cli_path;
 
-typedef struct cli_path_run {
-  fr_env env;
-  fr_bsdf *mats;
-  struct fr_texture *textures;
-  size_t ntextures;
-  struct fr_surface *surf;
-  fr_path_setup setup;
-} cli_path_run;
+typedef fr_path_scene cli_path_run;
 
 /* The flags; 0, or 2 after reporting a usage error. */
 int cli_path_from_args(const cli_args *a, cli_path *o);
