@@ -312,6 +312,62 @@ fr_error fr_intersect_camera(const fr_scene *s, const fr_pinhole *camera, int y0
 fr_error fr_occluded_point_light(const fr_scene *s, const float light[3], const float *points, size_t n, float eps,
                                  uint8_t *occluded);
 
+/* ---- rendering --------------------------------------------------------------------
+ * frusta's renderers behind one handle: a camera, a shade mode and its
+ * options, progressive passes, and the image with its guides (AOVs). */
+typedef enum fr_render_shade {
+  FR_RENDER_EYELIGHT,   /* headlight shading: one pass */
+  FR_RENDER_NORMALS,    /* the normal as colour: one pass */
+  FR_RENDER_SHADOWS,    /* a point light's hard shadows: one pass */
+  FR_RENDER_SOFTSHADOW, /* an area light's soft shadows by multi-frusta: spp 16 is the filtered
+                          real-time frame, more are passes of 16 spread samples summed */
+  FR_RENDER_WHITTED,    /* mirrors, glass and shadows (Whitted): one pass */
+  FR_RENDER_AO,         /* ambient occlusion: 16 hemisphere rays a pass */
+  FR_RENDER_PATH        /* path tracing (materials from the MTL, environment and area light) */
+} fr_render_shade;
+
+typedef struct fr_render_desc {
+  fr_pinhole camera;      /* the view; fov_deg 0: the scene's own view (the shared scenes' views,
+                             else one framing its bounds) at camera.width x camera.height */
+  fr_render_shade shade;
+  int spp;                /* samples per pixel in all (0: 16): path samples, ao's hemisphere and
+                             softshadow's light samples (multiples of 16 for those two) */
+  int has_light;          /* 1: light is the point light (shadows, whitted); else the view's */
+  float light[3];
+  const char *environment; /* path: a lat-long .hdr or .exr environment (NULL: a white sky) */
+  float exposure;         /* path: stops, for fr_renderer_image's display values */
+  int denoise;            /* 1: fr_renderer_image denoises path, ao and softshadow sums */
+  int threads;            /* 0: all cores */
+} fr_render_desc;
+
+typedef struct fr_renderer fr_renderer;
+
+/* A renderer of s as d says (d is copied; the environment is loaded now).
+ * s must be committed and outlive the renderer. Errors: FR_ERR_ARG (an
+ * empty image, a bad camera or shade, spp not a multiple of 16 where it
+ * must be), FR_ERR_STATE (not committed), FR_ERR_IO and FR_ERR_FORMAT (the
+ * environment), FR_ERR_NOMEM. */
+fr_error fr_renderer_new(const fr_scene *s, const fr_render_desc *d, fr_renderer **out);
+void fr_renderer_release(fr_renderer *r);
+/* One more pass on all the renderer's threads; *done (may be NULL) becomes
+ * 1 once another pass would change nothing (spp reached; at once for the
+ * one-pass shades). FR_ERR_NOMEM. */
+fr_error fr_renderer_pass(fr_renderer *r, int *done);
+/* Passes until done. */
+fr_error fr_renderer_render(fr_renderer *r);
+/* Samples per pixel summed so far. */
+int fr_renderer_spp(const fr_renderer *r);
+/* A new view of the same image size: the passes start again. FR_ERR_ARG
+ * for a bad camera or another size. */
+fr_error fr_renderer_set_camera(fr_renderer *r, const fr_pinhole *camera);
+/* The image so far, width * height RGB floats, row 0 at the top: linear
+ * (display 0), or display values (display 1: path through the filmic
+ * curve at the exposure; the other shades are in [0, 1] already), denoised
+ * if asked. albedo and normal (3 floats a pixel) and depth (1; 1e30 where
+ * the camera sees nothing) get the guides when not NULL. FR_ERR_NOMEM. A
+ * renderer serves one thread at a time. */
+fr_error fr_renderer_image(fr_renderer *r, int display, float *rgb, float *albedo, float *normal, float *depth);
+
 #ifdef __cplusplus
 }
 #endif

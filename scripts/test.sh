@@ -15,7 +15,7 @@ bash scripts/setup.sh
 B="$(cd "${FRUSTA_BUILD_DIR:-build}" && pwd)"
 [ -e "$B/python/frusta/__init__.py" ] || { echo "the Python module was not built (python3-numpy missing?)"; exit 1; }
 SH="${FRUSTA_SHARED:-../shared}"; case "$SH" in /*) ;; *) SH="$(pwd)/$SH" ;; esac
-FRUSTA_LIB="$B/libfrusta.so" FRUSTA_SHARED="$SH" PYTHONPATH="$B/python" \
+FRUSTA_LIB="$B/libfrusta.so" FRUSTA_BIN="$B/frusta" FRUSTA_SHARED="$SH" PYTHONPATH="$B/python" \
   /usr/bin/python3 -m pytest -q -p no:cacheprovider tests/python
 (cd / && /usr/bin/python3 -c "import frusta; print('python3: frusta', frusta.__version__, 'from', frusta.__file__)")
 if [ "${FRUSTA_SANITIZE_TESTS:-1}" != 0 ]; then

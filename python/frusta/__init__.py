@@ -18,12 +18,17 @@ from ._frusta import INVALID_ID, VERSION_MAJOR, VERSION_MINOR, get_threads, isa,
 from ._frusta import Scene as _Scene
 
 __version__ = f"{VERSION_MAJOR}.{VERSION_MINOR}"
-__all__ = ["Scene", "Hits", "AllHits", "INVALID_ID", "set_threads", "get_threads", "isa"]
+__all__ = ["Scene", "Hits", "AllHits", "Image", "INVALID_ID", "set_threads", "get_threads", "isa", "to_srgb8"]
 
 Hits = namedtuple("Hits", "t prim u v normal")
 Hits.__doc__ = """Closest hits: t (float32, inf on a miss), prim (uint32 triangle number,
 INVALID_ID on a miss), barycentrics u, v of the 2nd and 3rd vertex, and the
 unnormalized geometric normal (v1 - v0) x (v2 - v0) (zero on a miss)."""
+
+Image = namedtuple("Image", "rgb albedo normal depth spp")
+Image.__doc__ = """A rendered image: rgb (height, width, 3) float32, row 0 at the top; the
+guides albedo and normal (height, width, 3) and depth (height, width; 1e30
+where the camera sees nothing); spp, the samples per pixel summed."""
 
 AllHits = namedtuple("AllHits", "ray prim t u v count")
 AllHits.__doc__ = """Every crossing, flat and grouped by ray in order of t: ray (int64 index
@@ -33,13 +38,26 @@ number of all crossings of each ray, also those beyond max_hits."""
 INF = float("inf")
 
 
+def to_srgb8(image):
+    """Display values in [0, 1] (an Image's rgb with display=True) as 8-bit
+    sRGB, the encoding frusta render writes to PNG."""
+    import numpy as np
+
+    v = np.clip(np.nan_to_num(np.asarray(image, dtype=np.float32), nan=0.0), 0.0, 1.0)
+    s = np.where(v <= 0.0031308, 12.92 * v, 1.055 * np.power(v, 1 / 2.4) - 0.055)
+    return (s * 255.0 + 0.5).astype(np.uint8)
+
+
 class Scene(_Scene):
-    """Scene(vertices, triangles): a triangle mesh, ready to trace.
+    """Scene(vertices, triangles, smooth=0): a triangle mesh, ready to trace.
 
     vertices: (n, 3) floats (copied); triangles: (m, 3) integer vertex
     indices. Degenerate triangles are kept in the numbering but never hit.
-    Scene.load(path) reads PLY, OBJ and the formats Assimp reads (also
-    .zst-compressed); Scene.builtin() is frusta's built-in scene.
+    Scene.load(path, smooth=30) reads PLY, OBJ and the formats Assimp reads
+    (also .zst-compressed); Scene.builtin() is frusta's built-in scene.
+    smooth: the crease angle in degrees of the shading normals render()
+    makes where the file gives none (30, as frusta render; 0: flat); tracing
+    never uses them.
     """
 
     def intersect(self, origins, directions, tnear=0.0, tfar=INF):
@@ -82,6 +100,20 @@ class Scene(_Scene):
             lo, hi = self.bounds
             eps = 1e-5 * float(((hi - lo) ** 2).sum()) ** 0.5
         return self._occluded_point_light(points, light, eps)
+
+    def render(self, width, height, shade="eyelight", eye=None, at=None, up=None, fov=None, spp=0, light=None,
+               environment=None, exposure=0.0, denoise=False, display=True):
+        """frusta's renderers, as `frusta render` draws: shade is eyelight,
+        normals, shadows, softshadow, whitted, ao or path. The view is the
+        scene's own unless eye and at are given (up defaults to +y, fov to 50
+        degrees vertical). spp: samples per pixel (0: 16; multiples of 16 for
+        ao and softshadow). light: the point light of shadows and whitted.
+        environment: path's lat-long .hdr or .exr sky (default white).
+        display=True gives display values (path through the filmic curve at
+        exposure stops), else linear radiance; denoise=True denoises path,
+        ao and softshadow. Returns an Image."""
+        return Image(*self._render(width, height, shade, eye, at, up, 0.0 if fov is None else fov, spp, light,
+                                   environment, exposure, denoise, display))
 
     def contains(self, points):
         """Whether each point lies inside the closed mesh: an odd count of

@@ -54,8 +54,15 @@ static int scene_open(SceneObject *s) {
   return 0;
 }
 
-static PyObject *wrap_scene(PyTypeObject *type, fr_scene *sc) {
-  fr_error e = fr_scene_commit(sc);
+/* Smooth shading normals (for rendering; crease in degrees, 0: none), then
+ * the commit. */
+static PyObject *wrap_scene(PyTypeObject *type, fr_scene *sc, float smooth) {
+  if (!(smooth >= 0.0f && smooth <= 180.0f)) {
+    fr_scene_release(sc);
+    return PyErr_Format(PyExc_ValueError, "smooth: %g is not in 0..180 degrees", (double)smooth);
+  }
+  fr_error e = smooth > 0.0f ? fr_scene_smooth(sc, smooth) : FR_OK;
+  if (!e) e = fr_scene_commit(sc);
   if (e != FR_OK) {
     raise_fr(e, fr_last_error());
     fr_scene_release(sc);
@@ -93,9 +100,10 @@ static PyArrayObject *vec3_array(PyObject *obj, const char *name) {
 }
 
 static PyObject *scene_new(PyTypeObject *type, PyObject *args, PyObject *kw) {
-  static char *names[] = {"vertices", "triangles", NULL};
+  static char *names[] = {"vertices", "triangles", "smooth", NULL};
   PyObject *vo, *to;
-  if (!PyArg_ParseTupleAndKeywords(args, kw, "OO", names, &vo, &to)) return NULL;
+  float smooth = 0.0f;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|f", names, &vo, &to, &smooth)) return NULL;
   PyArrayObject *v = vec3_array(vo, "vertices");
   if (!v) return NULL;
   PyArrayObject *ta = (PyArrayObject *)PyArray_FROM_O(to);
@@ -130,7 +138,7 @@ static PyObject *scene_new(PyTypeObject *type, PyObject *args, PyObject *kw) {
   fr_scene *sc;
   fr_error e = fr_scene_from_arrays(pos, nv, idx, nt, &sc);
   if (e != FR_OK) { raise_fr(e, fr_last_error()); goto done; }
-  result = wrap_scene(type, sc);
+  result = wrap_scene(type, sc, smooth);
 done:
   free(idx);
   Py_DECREF(v);
@@ -138,9 +146,11 @@ done:
   return result;
 }
 
-static PyObject *scene_load(PyObject *cls, PyObject *args) {
+static PyObject *scene_load(PyObject *cls, PyObject *args, PyObject *kw) {
+  static char *names[] = {"path", "smooth", NULL};
   PyObject *path;
-  if (!PyArg_ParseTuple(args, "O&", PyUnicode_FSConverter, &path)) return NULL;
+  float smooth = 30.0f;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "O&|f", names, PyUnicode_FSConverter, &path, &smooth)) return NULL;
   fr_scene *sc;
   fr_error e;
   Py_BEGIN_ALLOW_THREADS
@@ -148,19 +158,21 @@ static PyObject *scene_load(PyObject *cls, PyObject *args) {
   Py_END_ALLOW_THREADS
   Py_DECREF(path);
   if (e != FR_OK) return raise_fr(e, fr_last_error());
-  return wrap_scene((PyTypeObject *)cls, sc);
+  return wrap_scene((PyTypeObject *)cls, sc, smooth);
 }
 
-static PyObject *scene_builtin(PyObject *cls, PyObject *args) {
+static PyObject *scene_builtin(PyObject *cls, PyObject *args, PyObject *kw) {
+  static char *names[] = {"name", "smooth", NULL};
   const char *name = "default";
-  if (!PyArg_ParseTuple(args, "|s", &name)) return NULL;
+  float smooth = 30.0f;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "|sf", names, &name, &smooth)) return NULL;
   fr_scene *sc;
   fr_error e;
   if (!strcmp(name, "default")) e = fr_scene_builtin(&sc);
   else if (!strcmp(name, "materials")) e = fr_scene_builtin_materials(&sc);
   else return PyErr_Format(PyExc_ValueError, "builtin: no scene named '%s' (default, materials)", name);
   if (e != FR_OK) return raise_fr(e, fr_last_error());
-  return wrap_scene((PyTypeObject *)cls, sc);
+  return wrap_scene((PyTypeObject *)cls, sc, smooth);
 }
 
 static void scene_dealloc(SceneObject *s) {
@@ -567,6 +579,85 @@ static PyObject *scene_occluded_point_light(SceneObject *s, PyObject *args, PyOb
   return (PyObject *)occ;
 }
 
+/* ---- rendering --------------------------------------------------------------------- */
+
+static const char *shade_names[] = {"eyelight", "normals", "shadows", "softshadow", "whitted", "ao", "path"};
+
+static PyObject *scene_render(SceneObject *s, PyObject *args, PyObject *kw) {
+  static char *names[] = {"width", "height", "shade", "eye", "at", "up", "fov", "spp", "light", "environment",
+                          "exposure", "denoise", "display", NULL};
+  int width, height, spp = 0, denoise = 0, display = 1;
+  const char *shade = "eyelight";
+  PyObject *eo = Py_None, *ao = Py_None, *uo = Py_None, *lo = Py_None, *envo = Py_None;
+  float fov = 0.0f, exposure = 0.0f;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "ii|sOOOfiOOfpp", names, &width, &height, &shade, &eo, &ao, &uo, &fov,
+                                   &spp, &lo, &envo, &exposure, &denoise, &display))
+    return NULL;
+  if (!scene_open(s)) return NULL;
+  fr_render_desc d;
+  memset(&d, 0, sizeof d);
+  d.camera.width = width, d.camera.height = height;
+  if (width <= 0 || height <= 0 || (int64_t)width * height > ((int64_t)1 << 26))
+    return PyErr_Format(PyExc_ValueError, "render: image size %dx%d is empty or too large", width, height);
+  int m = -1;
+  for (int k = 0; k < 7; k++)
+    if (!strcmp(shade, shade_names[k])) m = k;
+  if (m < 0)
+    return PyErr_Format(PyExc_ValueError, "render: shade '%s' is none of eyelight, normals, shadows, softshadow, "
+                        "whitted, ao, path", shade);
+  d.shade = (fr_render_shade)m;
+  if ((eo != Py_None) != (ao != Py_None))
+    return PyErr_Format(PyExc_ValueError, "render: give eye and at together (or neither: the scene's own view)");
+  if (eo != Py_None) {
+    float upv[3] = {0.0f, 1.0f, 0.0f};
+    if (!vec3_arg(eo, "eye", d.camera.eye) || !vec3_arg(ao, "at", d.camera.at) ||
+        (uo != Py_None && !vec3_arg(uo, "up", upv)))
+      return NULL;
+    memcpy(d.camera.up, upv, sizeof upv);
+    d.camera.fov_deg = fov > 0.0f ? fov : 50.0f;
+  } else if (uo != Py_None || fov != 0.0f) {
+    return PyErr_Format(PyExc_ValueError, "render: up and fov need eye and at");
+  }
+  if (lo != Py_None) {
+    if (!vec3_arg(lo, "light", d.light)) return NULL;
+    d.has_light = 1;
+  }
+  PyObject *env = NULL;
+  if (envo != Py_None) {
+    if (!PyUnicode_FSConverter(envo, &env)) return NULL;
+    d.environment = PyBytes_AS_STRING(env);
+  }
+  d.spp = spp, d.exposure = exposure, d.denoise = denoise, d.threads = n_threads;
+  npy_intp dims[3] = {height, width, 3}, dims1[2] = {height, width};
+  PyArrayObject *img = (PyArrayObject *)PyArray_SimpleNew(3, dims, NPY_FLOAT32);
+  PyArrayObject *alb = (PyArrayObject *)PyArray_SimpleNew(3, dims, NPY_FLOAT32);
+  PyArrayObject *nrm = (PyArrayObject *)PyArray_SimpleNew(3, dims, NPY_FLOAT32);
+  PyArrayObject *dep = (PyArrayObject *)PyArray_SimpleNew(2, dims1, NPY_FLOAT32);
+  PyObject *result = NULL;
+  if (!img || !alb || !nrm || !dep) goto done;
+  s->busy++;
+  const fr_scene *sc = s->scene;
+  fr_error e;
+  char msg[512] = "";
+  int got_spp = 0;
+  Py_BEGIN_ALLOW_THREADS
+  fr_renderer *r = NULL;
+  e = fr_renderer_new(sc, &d, &r);
+  if (!e) e = fr_renderer_render(r);
+  if (!e) e = fr_renderer_image(r, display, PyArray_DATA(img), PyArray_DATA(alb), PyArray_DATA(nrm), PyArray_DATA(dep));
+  if (e) snprintf(msg, sizeof msg, "%s", fr_last_error());
+  got_spp = fr_renderer_spp(r);
+  fr_renderer_release(r);
+  Py_END_ALLOW_THREADS
+  s->busy--;
+  if (e) { raise_fr(e, msg); goto done; }
+  result = Py_BuildValue("(OOOOi)", img, alb, nrm, dep, got_spp);
+done:
+  Py_XDECREF(env);
+  Py_XDECREF(img); Py_XDECREF(alb); Py_XDECREF(nrm); Py_XDECREF(dep);
+  return result;
+}
+
 /* ---- properties ------------------------------------------------------------------ */
 
 static const char *mode_names[] = {"auto", "single", "packet8", "packet16", "hybrid16", "raystream"};
@@ -631,14 +722,18 @@ static PyObject *scene_triangles(SceneObject *s, void *c) {
 }
 
 static PyMethodDef scene_methods[] = {
-    {"load", (PyCFunction)scene_load, METH_VARARGS | METH_CLASS, "load(path): a scene file (PLY, OBJ, any Assimp format, .zst)"},
-    {"builtin", (PyCFunction)scene_builtin, METH_VARARGS | METH_CLASS, "builtin(name='default'): a built-in scene"},
+    {"load", (PyCFunction)(void (*)(void))scene_load, METH_VARARGS | METH_KEYWORDS | METH_CLASS,
+     "load(path, smooth=30): a scene file (PLY, OBJ, any Assimp format, .zst); smooth: the crease angle of the "
+     "shading normals made where the file has none (0: flat), as frusta render"},
+    {"builtin", (PyCFunction)(void (*)(void))scene_builtin, METH_VARARGS | METH_KEYWORDS | METH_CLASS,
+     "builtin(name='default', smooth=30): a built-in scene (default, materials)"},
     {"close", (PyCFunction)scene_close, METH_NOARGS, "close(): frees the scene now"},
     {"_intersect", (PyCFunction)(void (*)(void))scene_intersect, METH_VARARGS | METH_KEYWORDS, NULL},
     {"_occluded", (PyCFunction)(void (*)(void))scene_occluded, METH_VARARGS | METH_KEYWORDS, NULL},
     {"_intersect_all", (PyCFunction)(void (*)(void))scene_intersect_all, METH_VARARGS | METH_KEYWORDS, NULL},
     {"_occluded_point_light", (PyCFunction)(void (*)(void))scene_occluded_point_light, METH_VARARGS | METH_KEYWORDS,
      NULL},
+    {"_render", (PyCFunction)(void (*)(void))scene_render, METH_VARARGS | METH_KEYWORDS, NULL},
     {"_intersect_camera", (PyCFunction)(void (*)(void))scene_intersect_camera, METH_VARARGS | METH_KEYWORDS, NULL},
     {NULL, NULL, 0, NULL}};
 

@@ -6,6 +6,7 @@ the library's own answers bit for bit.
 """
 import ctypes
 import os
+import subprocess
 import threading
 import time
 
@@ -467,3 +468,64 @@ def test_occluded_point_light_equals_rays():
         s.occluded_point_light(np.array([[0, 0, 0], [np.inf, 0, 0]], np.float32), light)
     with pytest.raises(ValueError, match="eps"):
         s.occluded_point_light(p, light, eps=-1.0)
+
+
+# ---- rendering ---------------------------------------------------------------------
+
+def read_pfm(path):
+    with open(path, "rb") as f:
+        assert f.readline().strip() == b"PF"
+        w, h = map(int, f.readline().split())
+        scale = float(f.readline())
+        v = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4").reshape(h, w, 3)
+    return v[::-1]  # rows are stored bottom to top
+
+
+@pytest.mark.parametrize("shade,spp", [("eyelight", 0), ("normals", 0), ("shadows", 0), ("softshadow", 16),
+                                       ("softshadow", 32), ("whitted", 0), ("ao", 32), ("path", 4)])
+def test_render_equals_the_command(tmp_path, shade, spp):
+    command = os.environ.get("FRUSTA_BIN")
+    if not command or not os.path.exists(command):
+        pytest.skip("FRUSTA_BIN names no frusta command")
+    out = tmp_path / "c.pfm"
+    flags = ["--spp", str(spp)] if shade in ("path", "ao") else []
+    if shade == "softshadow":
+        flags = ["--light-samples", str(spp)]
+    subprocess.run([command, "render", "--builtin", "--shade", shade, "--size", "96x64", "--out", str(out)] + flags,
+                   check=True, capture_output=True)
+    want = read_pfm(out)
+    scene = frusta.Scene.builtin()
+    got = scene.render(96, 64, shade, spp=spp, display=False)
+    assert got.rgb.shape == (64, 96, 3)
+    np.testing.assert_array_equal(got.rgb, want)
+    assert got.spp == {"eyelight": 1, "normals": 1, "shadows": 1, "whitted": 1}.get(shade, spp)
+
+
+def test_render_options_and_errors():
+    scene = frusta.Scene.builtin()
+    a = scene.render(48, 32, "eyelight", eye=(0, 3, 9), at=(0, 0.5, 0), fov=40)
+    b = scene.render(48, 32, "eyelight")
+    assert not np.array_equal(a.rgb, b.rgb)  # another view
+    assert (a.depth < 1e29).mean() > 0.3 and a.normal.shape == (32, 48, 3)
+    p = scene.render(48, 32, "path", spp=2, denoise=True)
+    assert p.rgb.max() < 1.0 and p.spp == 2  # display values through the filmic curve
+    lin = scene.render(48, 32, "path", spp=2, display=False, exposure=3.0)
+    assert lin.rgb.max() > 0
+    lit = scene.render(48, 32, "shadows", light=(0, 50, 0))
+    assert not np.array_equal(lit.rgb, scene.render(48, 32, "shadows").rgb)
+    flat = frusta.Scene.builtin(smooth=0).render(48, 32, "eyelight")
+    assert not np.array_equal(flat.rgb, b.rgb)  # shading normals, as frusta render --smooth 0
+    with pytest.raises(ValueError, match="smooth"):
+        frusta.Scene.builtin(smooth=400)
+    img8 = frusta.to_srgb8(p.rgb)
+    assert img8.dtype == np.uint8 and img8.shape == (32, 48, 3)
+    with pytest.raises(ValueError, match="none of"):
+        scene.render(8, 8, "raytraced")
+    with pytest.raises(ValueError, match="multiples of 16"):
+        scene.render(8, 8, "ao", spp=20)
+    with pytest.raises(ValueError, match="eye and at"):
+        scene.render(8, 8, eye=(0, 0, 1))
+    with pytest.raises(ValueError, match="empty"):
+        scene.render(0, 8)
+    with pytest.raises(OSError):
+        scene.render(8, 8, "path", environment="/nonexistent/sky.hdr")
