@@ -149,6 +149,20 @@ static void errors(void **state) {
   assert_int_equal(fr_intersect_camera(s, &cam, 0, 8, 0, NULL, h), FR_ERR_ARG);
   assert_int_equal(fr_occluded_point_light(s, light, pts, 2, 0.0f, occ), FR_OK);
   assert_true(occ[0] == 1 && occ[1] == 0); /* behind the triangle, in front of it */
+  /* points at the light or not finite, among ordinary ones in one batch:
+     not occluded, and the others still answered */
+  {
+    float many[3 * 40];
+    uint8_t o40[40];
+    for (int i = 0; i < 40; i++) {
+      many[3 * i] = 0.1f + 0.005f * (float)i, many[3 * i + 1] = 0.2f, many[3 * i + 2] = -1.0f;
+    }
+    memcpy(many + 3 * 7, light, sizeof light);
+    many[3 * 11 + 1] = NAN;
+    many[3 * 13] = INFINITY;
+    assert_int_equal(fr_occluded_point_light(s, light, many, 40, 0.0f, o40), FR_OK);
+    for (int i = 0; i < 40; i++) assert_int_equal(o40[i], i == 7 || i == 11 || i == 13 ? 0 : 1);
+  }
   assert_int_equal(fr_occluded_point_light(s, light, pts, 2, -1.0f, occ), FR_ERR_ARG);
   light[0] = NAN;
   assert_int_equal(fr_occluded_point_light(s, light, pts, 2, 0.0f, occ), FR_ERR_ARG);
