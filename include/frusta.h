@@ -312,6 +312,23 @@ fr_error fr_intersect_camera(const fr_scene *s, const fr_pinhole *camera, int y0
 fr_error fr_occluded_point_light(const fr_scene *s, const float light[3], const float *points, size_t n, float eps,
                                  uint8_t *occluded);
 
+/* The fraction of a quad area light (corner + a e1 + b e2, a and b in
+ * [0, 1)) each of n points sees: visibility[i] from `samples` shadow rays
+ * (a multiple of 16 in 16..4096: per pass of 16, one stratified 4x4 over
+ * the whole quad from the interleaved sets of a (0,2)-net scrambled by
+ * seed + pass). Traced as multi-frusta (Benthin & Wald): a point's 16 rays
+ * a frustum, 16 consecutive points a batch, so give neighbouring points
+ * together (an image's hit points in 4x4 blocks); where frusta meet many
+ * small triangles, a run of 256 points goes as ray streams. A ray leaves
+ * out eps (scene units) at the point and 1e-4 of the way at the light. A
+ * point not finite gets 0. Each ray's answer is fr_occluded1's on that ray
+ * up to rounding at edges. May be called from several threads at once.
+ * Errors: FR_ERR_ARG (NULL, samples, a light or eps not finite),
+ * FR_ERR_STATE, FR_ERR_NOMEM. */
+fr_error fr_visibility_area_light(const fr_scene *s, const float corner[3], const float e1[3], const float e2[3],
+                                  const float *points, size_t n, int samples, uint64_t seed, float eps,
+                                  float *visibility);
+
 /* ---- rendering --------------------------------------------------------------------
  * frusta's renderers behind one handle: a camera, a shade mode and its
  * options, progressive passes, and the image with its guides (AOVs). */

@@ -115,6 +115,18 @@ class Scene(_Scene):
         return Image(*self._render(width, height, shade, eye, at, up, 0.0 if fov is None else fov, spp, light,
                                    environment, exposure, denoise, display))
 
+    def visibility_area_light(self, points, corner, e1, e2, samples=16, seed=1, eps=None):
+        """The fraction of a quad light (corner + a e1 + b e2, a and b in
+        [0, 1)) each point (..., 3) sees, from samples shadow rays a point (a
+        multiple of 16), traced as multi-frusta: a point's 16 rays a frustum,
+        16 consecutive points a batch, so give neighbours together (an
+        image's hit points in 4x4 blocks). eps (default 1e-5 of the scene's
+        diagonal) is left out at the point."""
+        if eps is None:
+            lo, hi = self.bounds
+            eps = 1e-5 * float(((hi - lo) ** 2).sum()) ** 0.5
+        return self._visibility_area_light(points, corner, e1, e2, samples, seed, eps)
+
     def contains(self, points):
         """Whether each point lies inside the closed mesh: an odd count of
         crossings along a fixed, irrational-ish direction."""

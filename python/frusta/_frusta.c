@@ -579,6 +579,56 @@ static PyObject *scene_occluded_point_light(SceneObject *s, PyObject *args, PyOb
   return (PyObject *)occ;
 }
 
+static PyObject *scene_visibility_area_light(SceneObject *s, PyObject *args, PyObject *kw) {
+  static char *names[] = {"points", "corner", "e1", "e2", "samples", "seed", "eps", NULL};
+  PyObject *po, *co, *e1o, *e2o;
+  float c[3], e1[3], e2[3], eps;
+  int samples;
+  unsigned long long seed;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOOiKf", names, &po, &co, &e1o, &e2o, &samples, &seed, &eps))
+    return NULL;
+  if (!scene_open(s) || !vec3_arg(co, "corner", c) || !vec3_arg(e1o, "e1", e1) || !vec3_arg(e2o, "e2", e2)) return NULL;
+  if (samples < 16 || samples > 4096 || samples % 16)
+    return PyErr_Format(PyExc_ValueError, "samples: %d is not a multiple of 16 in 16..4096", samples);
+  if (!(eps >= 0.0f) || !isfinite(eps)) return PyErr_Format(PyExc_ValueError, "eps: expected a finite number >= 0");
+  rays_in r;
+  memset(&r, 0, sizeof r);
+  if (!(r.org = vec3_array(po, "points"))) return NULL;
+  r.ndim = PyArray_NDIM(r.org) - 1;
+  for (int i = 0; i < r.ndim; i++) r.shape[i] = PyArray_DIM(r.org, i);
+  r.n = (size_t)(PyArray_SIZE(r.org) / 3);
+  const float *pts = PyArray_DATA(r.org);
+  for (size_t i = 0; i < 3 * r.n; i++)
+    if (!isfinite(pts[i])) {
+      rays_free(&r);
+      return PyErr_Format(PyExc_ValueError, "point %zu is NaN or infinite", i / 3);
+    }
+  PyArrayObject *vis = out_array(&r, 0, NPY_FLOAT32);
+  if (!vis) { rays_free(&r); return NULL; }
+  s->busy++;
+  const fr_scene *sc = s->scene;
+  float *vp = PyArray_DATA(vis);
+  size_t n = r.n, per = 16 * 256, chunks = (n + per - 1) / per; /* whole batches of 256 points */
+  int failed = 0;
+  Py_BEGIN_ALLOW_THREADS
+#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads ? n_threads : omp_get_max_threads())
+  for (size_t ch = 0; ch < chunks; ch++) {
+    size_t i0 = ch * per, k = n - i0 < per ? n - i0 : per;
+    if (fr_visibility_area_light(sc, c, e1, e2, pts + 3 * i0, k, samples, seed, eps, vp + i0) != FR_OK) {
+#pragma omp atomic write
+      failed = 1;
+    }
+  }
+  Py_END_ALLOW_THREADS
+  s->busy--;
+  rays_free(&r);
+  if (failed) { /* arguments were checked: only memory can fail */
+    Py_DECREF(vis);
+    return PyErr_NoMemory();
+  }
+  return (PyObject *)vis;
+}
+
 /* ---- rendering --------------------------------------------------------------------- */
 
 static const char *shade_names[] = {"eyelight", "normals", "shadows", "softshadow", "whitted", "ao", "path"};
@@ -733,6 +783,8 @@ static PyMethodDef scene_methods[] = {
     {"_intersect_all", (PyCFunction)(void (*)(void))scene_intersect_all, METH_VARARGS | METH_KEYWORDS, NULL},
     {"_occluded_point_light", (PyCFunction)(void (*)(void))scene_occluded_point_light, METH_VARARGS | METH_KEYWORDS,
      NULL},
+    {"_visibility_area_light", (PyCFunction)(void (*)(void))scene_visibility_area_light,
+     METH_VARARGS | METH_KEYWORDS, NULL},
     {"_render", (PyCFunction)(void (*)(void))scene_render, METH_VARARGS | METH_KEYWORDS, NULL},
     {"_intersect_camera", (PyCFunction)(void (*)(void))scene_intersect_camera, METH_VARARGS | METH_KEYWORDS, NULL},
     {NULL, NULL, 0, NULL}};

@@ -470,6 +470,27 @@ def test_occluded_point_light_equals_rays():
         s.occluded_point_light(p, light, eps=-1.0)
 
 
+def test_visibility_area_light():
+    s = frusta.Scene.builtin()
+    eye = (0.0, 3.0, 9.0)
+    h, d = s.intersect_camera(eye, (0.0, 0.5, 0.0), (0.0, 1.0, 0.0), 50.0, 128, 96, directions=True)
+    hit = np.isfinite(h.t)
+    p = (np.float32(eye) + h.t[..., None] * d)[hit].astype(np.float32)
+    corner, e1, e2 = (-2.0, 8.0, -2.0), (4.0, 0.0, 0.0), (0.0, 0.0, 4.0)
+    v16 = s.visibility_area_light(p, corner, e1, e2)
+    assert v16.shape == (len(p),) and v16.dtype == np.float32
+    assert ((v16 * 16) % 1 == 0).all() and 0 < v16.mean() < 1 and ((v16 > 0) & (v16 < 1)).any()
+    v64 = s.visibility_area_light(p, corner, e1, e2, samples=64)
+    assert np.abs(v64 - v16).mean() < 0.1  # the same light, more samples
+    # a point far above everything sees the whole light; one under the floor none
+    tops = s.visibility_area_light(np.array([[0, 7.9, 0], [0, -50, 0]], np.float32), corner, e1, e2)
+    assert tops[0] == 1.0
+    with pytest.raises(ValueError, match="multiple of 16"):
+        s.visibility_area_light(p, corner, e1, e2, samples=10)
+    with pytest.raises(ValueError, match="point 0"):
+        s.visibility_area_light(np.full((2, 3), np.nan, np.float32), corner, e1, e2)
+
+
 # ---- rendering ---------------------------------------------------------------------
 
 def read_pfm(path):
