@@ -106,7 +106,9 @@ class RaycastingScene:
 
     def list_intersections(self, rays, nthreads=0):
         o, d = self._rays(rays)
-        a = self._committed().intersect_all(o, d, max_hits=1 << 16)
+        scene = self._committed()
+        most = int(scene.count_intersections(o, d).max(initial=0))  # room for every crossing, no more
+        a = scene.intersect_all(o, d, max_hits=max(most, 1))
         geom, local = self._geometry(a.prim)
         splits = np.concatenate([[0], np.cumsum(a.count.reshape(-1), dtype=np.int64)]).astype(np.uint32)
         return {
