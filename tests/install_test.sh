@@ -2,9 +2,9 @@
 # frusta installed as a user installs it: `cmake --install` into a fresh
 # prefix puts the shared library (with its SONAME), the static one,
 # frusta.h alone, the command, its manual page, frusta.pc and the CMake
-# package there; an example program builds against it from outside the
-# build tree through pkg-config (shared and static) and through
-# find_package(frusta), and runs.
+# package there; every example program builds against it from outside the
+# build tree through pkg-config and through find_package(frusta) (one also
+# statically), and runs.
 # usage: install_test.sh BUILD_DIR SOURCE_DIR
 set -u
 B="$1"; SRC="$2"
@@ -23,14 +23,18 @@ done
 readelf -d "$LIB/libfrusta.so" | grep -q 'SONAME.*libfrusta\.so\.0' && ok || bad "libfrusta.so has no SONAME libfrusta.so.0"
 "$P/bin/frusta" --version >/dev/null && ok || bad "the installed command does not run"
 
-# pkg-config, shared and static; the example checks its own answer
-EX="$(cd "$SRC" && pwd)/examples/trace_one_ray.c"
+# pkg-config, shared and static; each example checks its own answer
+EXAMPLES="$(cd "$SRC" && pwd)/examples"
 export PKG_CONFIG_PATH="$LIB/pkgconfig"
-if cc "$EX" $(pkg-config --cflags --libs frusta) -lm -o "$T/one_shared" 2>"$T/cc.log"; then
-  LD_LIBRARY_PATH="$LIB" "$T/one_shared" >/dev/null && ok || bad "the example built through pkg-config does not run"
-else
-  bad "the example does not build through pkg-config"; cat "$T/cc.log"
-fi
+for EX in "$EXAMPLES"/*.c; do
+  name=$(basename "$EX" .c)
+  if cc "$EX" $(pkg-config --cflags --libs frusta) -lm -o "$T/${name}_shared" 2>"$T/cc.log"; then
+    LD_LIBRARY_PATH="$LIB" "$T/${name}_shared" >/dev/null && ok || bad "$name built through pkg-config does not run"
+  else
+    bad "$name does not build through pkg-config"; cat "$T/cc.log"
+  fi
+done
+EX="$EXAMPLES/trace_one_ray.c"
 if cc "$EX" $(pkg-config --cflags frusta) "$LIB/libfrusta.a" $(pkg-config --static --libs-only-l frusta | sed 's/-lfrusta //') \
      -o "$T/one_static" 2>"$T/cc.log"; then
   "$T/one_static" >/dev/null && ok || bad "the example linked statically does not run"
@@ -39,12 +43,15 @@ else
   bad "the example does not link statically through pkg-config --static"; cat "$T/cc.log"
 fi
 
-# CMake: find_package(frusta) and frusta::frusta
-if cmake -S "$SRC/tests/install_consumer" -B "$T/consumer" -DCMAKE_PREFIX_PATH="$P" -DEXAMPLE="$EX" >"$T/cm.log" 2>&1 &&
+# CMake: find_package(frusta) and frusta::frusta, every example
+if cmake -S "$SRC/tests/install_consumer" -B "$T/consumer" -DCMAKE_PREFIX_PATH="$P" -DEXAMPLES="$EXAMPLES" >"$T/cm.log" 2>&1 &&
    cmake --build "$T/consumer" >>"$T/cm.log" 2>&1; then
-  LD_LIBRARY_PATH="$LIB" "$T/consumer/trace_one_ray" >/dev/null && ok || bad "the example built through CMake does not run"
+  for EX in "$EXAMPLES"/*.c; do
+    name=$(basename "$EX" .c)
+    LD_LIBRARY_PATH="$LIB" "$T/consumer/$name" >/dev/null && ok || bad "$name built through CMake does not run"
+  done
 else
-  bad "the example does not build through find_package(frusta)"; tail -20 "$T/cm.log"
+  bad "the examples do not build through find_package(frusta)"; tail -20 "$T/cm.log"
 fi
 
 # the Python module, where it was built: installed under the prefix, it

@@ -1,0 +1,38 @@
+/* frusta's renderers from a program: the built-in scene, path traced, as a
+ * PPM image (the file named by the first argument, or none) of display
+ * values, written as they are (no sRGB encoding: a quick look). */
+#include <stdio.h>
+#include <stdlib.h>
+#include "frusta.h"
+
+int main(int argc, char **argv) {
+  fr_scene *s;
+  if (fr_scene_builtin(&s) != FR_OK || fr_scene_smooth(s, 30.0f) != FR_OK || fr_scene_commit(s) != FR_OK) {
+    fprintf(stderr, "frusta: %s\n", fr_last_error());
+    return 1;
+  }
+  enum { W = 160, H = 120 };
+  fr_render_desc d = {.camera = {.width = W, .height = H}, .shade = FR_RENDER_PATH, .spp = 8};
+  fr_renderer *r;
+  float *rgb = malloc(sizeof(float) * W * H * 3);
+  if (!rgb || fr_renderer_new(s, &d, &r) != FR_OK) {
+    fprintf(stderr, "frusta: %s\n", rgb ? fr_last_error() : "out of memory");
+    return 1;
+  }
+  int done = 0, passes = 0;
+  while (!done && fr_renderer_pass(r, &done) == FR_OK) passes++;
+  fr_renderer_image(r, 1, rgb, NULL, NULL, NULL); /* display values in [0, 1) */
+  double mean = 0.0;
+  for (int i = 0; i < W * H * 3; i++) mean += rgb[i] / (W * H * 3);
+  printf("path traced %dx%d, %d spp in %d passes, mean %.3f\n", W, H, fr_renderer_spp(r), passes, mean);
+  FILE *f = argc > 1 ? fopen(argv[1], "wb") : NULL;
+  if (f) {
+    fprintf(f, "P6\n%d %d\n255\n", W, H);
+    for (int i = 0; i < W * H * 3; i++) fputc((int)(rgb[i] * 255.0f + 0.5f), f);
+    fclose(f);
+  }
+  fr_renderer_release(r);
+  fr_scene_release(s);
+  free(rgb);
+  return mean > 0.05 ? 0 : 1;
+}
