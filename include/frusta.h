@@ -349,7 +349,8 @@ typedef struct fr_render_desc {
   fr_render_shade shade;
   int spp;                /* samples per pixel in all (0: 16): path samples, ao's hemisphere and
                              softshadow's light samples (multiples of 16 for those two) */
-  int has_light;          /* 1: light is the point light (shadows, whitted); else the view's */
+  int has_light;          /* 1: light is the point light (shadows, whitted); else the view's (the
+                             area light of softshadow and path is always the view's) */
   float light[3];
   const char *environment; /* path: a lat-long .hdr or .exr environment (NULL: a white sky) */
   float exposure;         /* path: stops, for fr_renderer_image's display values */
