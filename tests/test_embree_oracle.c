@@ -19,8 +19,7 @@
  * from each hit (in the same order), then random rays through the bounds: as
  * coherent in groups of 16 as the renderers' rays, for the packet modes. */
 static size_t make_rays(const fr_scene *s, fr_ray *rays, size_t cap) {
-  fr_view v;
-  if (!fr_view_lookup(s->name, &v)) v = fr_view_from_bounds(s->bounds);
+  fr_view v = fr_view_of(s->name, s->bounds);
   fr_camera cam;
   assert_int_equal(fr_camera_setup(&cam, v.eye, v.at, v.up, v.fov, SIDE, SIDE), FR_OK);
   float eps = 1e-4f * v3_len(v3_sub(s->bounds.hi, s->bounds.lo));

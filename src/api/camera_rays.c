@@ -14,9 +14,7 @@
 static void set_normal(const fr_scene *s, fr_hit *h, fr_hit *last) {
   if (h->prim == FR_INVALID_ID) { h->ng[0] = h->ng[1] = h->ng[2] = 0.0f; return; }
   if (h->prim == last->prim) { memcpy(h->ng, last->ng, sizeof h->ng); return; }
-  const uint32_t *ix = s->mesh.idx + 3 * (size_t)h->prim;
-  const float *a = s->mesh.pos + 3 * (size_t)ix[0], *b = s->mesh.pos + 3 * (size_t)ix[1], *c = s->mesh.pos + 3 * (size_t)ix[2];
-  fr_tri_normal_lane(a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], &h->ng[0], &h->ng[1], &h->ng[2]);
+  fr_scene_triangle_normal(s, h->prim, h->ng);
   *last = *h;
 }
 

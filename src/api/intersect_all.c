@@ -6,14 +6,12 @@
 #include "trace/all_hits.h"
 #include "trace/kernels.h"
 
-static void to_hit(const fr_mesh *m, const fr_crossing *x, fr_hit *h) {
-  const uint32_t *ix = m->idx + 3 * (size_t)x->prim;
-  const float *a = m->pos + 3 * (size_t)ix[0], *b = m->pos + 3 * (size_t)ix[1], *c = m->pos + 3 * (size_t)ix[2];
+static void to_hit(const fr_scene *s, const fr_crossing *x, fr_hit *h) {
   h->t = x->t;
   h->u = x->u;
   h->v = x->v;
   h->prim = x->prim;
-  fr_tri_normal_lane(a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], &h->ng[0], &h->ng[1], &h->ng[2]);
+  fr_scene_triangle_normal(s, x->prim, h->ng);
 }
 
 fr_error fr_intersect_all(const fr_scene *s, const fr_ray *rays, size_t n, fr_hit *hits, size_t max_hits,
@@ -30,7 +28,7 @@ fr_error fr_intersect_all(const fr_scene *s, const fr_ray *rays, size_t n, fr_hi
     counts[i] = c.n > UINT32_MAX ? UINT32_MAX : (uint32_t)c.n;
     fr_hit *h = hits + i * max_hits;
     for (size_t j = 0; j < max_hits; j++) {
-      if (j < c.n) to_hit(&s->mesh, &c.items[j], &h[j]);
+      if (j < c.n) to_hit(s, &c.items[j], &h[j]);
       else fr_hit_miss(&h[j]);
     }
   }

@@ -34,7 +34,7 @@ struct fr_renderer {
 };
 
 static fr_error view_of(const fr_scene *s, const fr_render_desc *d, fr_view *v, fr_camera *cam) {
-  if (!fr_view_lookup(s->name, v)) *v = fr_view_from_bounds(s->bounds);
+  *v = fr_view_of(s->name, s->bounds);
   const fr_pinhole *c = &d->camera;
   if (c->fov_deg != 0.0f) {
     v->eye = v3_load(c->eye), v->at = v3_load(c->at), v->up = v3_load(c->up), v->fov = c->fov_deg;

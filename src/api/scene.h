@@ -69,6 +69,13 @@ int fr_scene_shading_normal(const fr_scene *s, uint32_t prim, float u, float v, 
 /* The texture coordinates of triangle prim at barycentrics (u, v); 0
  * where it has none. */
 int fr_scene_texcoord(const fr_scene *s, uint32_t prim, float u, float v, float st[2]);
+/* Triangle prim's unnormalized normal (v1 - v0) x (v2 - v0) made in double
+ * and rounded once, the bits the kernels report (fr_tri_normal_lane). */
+static inline void fr_scene_triangle_normal(const fr_scene *s, uint32_t prim, float ng[3]) {
+  const uint32_t *ix = s->mesh.idx + 3 * (size_t)prim;
+  const float *a = s->mesh.pos + 3 * (size_t)ix[0], *b = s->mesh.pos + 3 * (size_t)ix[1], *c = s->mesh.pos + 3 * (size_t)ix[2];
+  fr_tri_normal_lane(a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], &ng[0], &ng[1], &ng[2]);
+}
 /* The first sphere's prim number (the triangle count). */
 static inline uint32_t fr_scene_sphere_base(const fr_scene *s) { return (uint32_t)s->mesh.ntris; }
 #endif

@@ -71,3 +71,9 @@ int fr_names_contain(const char *list, const char *name) {
   }
   return 0;
 }
+
+fr_view fr_view_of(const char *name, aabb bounds) {
+  fr_view v;
+  if (!fr_view_lookup(name, &v)) v = fr_view_from_bounds(bounds);
+  return v;
+}

@@ -20,4 +20,6 @@ void fr_view_surfaces(const char *name, const char **mirror, const char **glass)
 int fr_names_contain(const char *list, const char *name);
 /* A 3/4 view of the box with lights above it. */
 fr_view fr_view_from_bounds(aabb b);
+/* A scene's own view: the known one of its name, else one of its bounds. */
+fr_view fr_view_of(const char *name, aabb bounds);
 #endif

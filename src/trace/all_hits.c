@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include "base/error.h"
 #include "geom/tri_watertight.h"
-#include "trace/kernels.h"
+#include "trace/bvh2_reference.h"
 
 /* A vertex in the ray's sheared frame (as fr_tri_watertight places it). */
 typedef struct projected { float x, y, z; } projected;
@@ -69,27 +69,11 @@ static int by_t_then_prim(const void *pa, const void *pb) {
   return (a->prim > b->prim) - (a->prim < b->prim);
 }
 
-/* The slab test of the reference traversal, exit widened by 2^-20 so that
- * rounding never drops a box a crossing lies in. */
-static int box_hit(const fr_bvh2_node *n, int k, const float o[3], const float rd[3], float tnear, float tfar) {
-  const float lo[3] = {n->lo_x[k], n->lo_y[k], n->lo_z[k]}, hi[3] = {n->hi_x[k], n->hi_y[k], n->hi_z[k]};
-  float tn = tnear, tf = tfar;
-  for (int a = 0; a < 3; a++) {
-    float t0 = (lo[a] - o[a]) * rd[a], t1 = (hi[a] - o[a]) * rd[a];
-    if (rd[a] < 0.0f) { float t = t0; t0 = t1; t1 = t; }
-    tn = t0 > tn ? t0 : tn;
-    tf = t1 < tf ? t1 : tf;
-  }
-  return tn <= fr_widen_exit(tf);
-}
-
-static float rcp(float d) { return 1.0f / (fabsf(d) < 1e-18f ? copysignf(1e-18f, d) : d); }
-
 fr_error fr_bvh2_all_hits(const fr_bvh2 *b, const fr_mesh *m, const fr_ray *ray, fr_crossings *c) {
   c->n = 0;
   if (fr_ray_invalid(ray) || !b->nprims) return FR_OK;
   fr_wt_ray w = fr_wt_setup(v3_load(ray->dir));
-  const float rd[3] = {rcp(ray->dir[0]), rcp(ray->dir[1]), rcp(ray->dir[2])};
+  const float rd[3] = {fr_bvh2_rcp(ray->dir[0]), fr_bvh2_rcp(ray->dir[1]), fr_bvh2_rcp(ray->dir[2])};
   uint32_t stack[256]; /* the build's depth limit keeps a binary tree's stack far below this */
   int sp = 0;
   stack[sp++] = b->root;
@@ -110,7 +94,7 @@ fr_error fr_bvh2_all_hits(const fr_bvh2 *b, const fr_mesh *m, const fr_ray *ray,
     }
     const fr_bvh2_node *n = &b->nodes[ref];
     for (int k = 0; k < 2; k++)
-      if (box_hit(n, k, ray->org, rd, ray->tnear, ray->tfar) && sp < 256) stack[sp++] = n->child[k];
+      if (fr_bvh2_box_hit(n, k, ray->org, rd, ray->tnear, ray->tfar) && sp < 256) stack[sp++] = n->child[k];
   }
   /* A triangle split into several leaf references crosses at the same t
    * in each: after sorting, its copies are neighbours. */

@@ -3,31 +3,13 @@
 #include "geom/tri_watertight.h"
 #include "trace/kernels.h"
 
-static int box_hit(const fr_bvh2_node *n, int k, vec3 o, vec3 rd, float tnear, float tfar) {
-  float lo[3] = {n->lo_x[k], n->lo_y[k], n->lo_z[k]}, hi[3] = {n->hi_x[k], n->hi_y[k], n->hi_z[k]};
-  float oo[3] = {o.x, o.y, o.z}, r[3] = {rd.x, rd.y, rd.z};
-  float tn = tnear, tf = tfar;
-  for (int a = 0; a < 3; a++) {
-    float t0 = (lo[a] - oo[a]) * r[a], t1 = (hi[a] - oo[a]) * r[a];
-    if (r[a] < 0.0f) { float t = t0; t0 = t1; t1 = t; }
-    tn = t0 > tn ? t0 : tn;
-    tf = t1 < tf ? t1 : tf;
-  }
-  return tn <= fr_widen_exit(tf);
-}
-
 static vec3 vertex(const fr_mesh *m, uint32_t prim, int k) { return v3_load(m->pos + 3 * (size_t)m->idx[3 * (size_t)prim + k]); }
-
-static float rcp(float d) {
-  if (fabsf(d) < 1e-18f) d = copysignf(1e-18f, d);
-  return 1.0f / d;
-}
 
 /* Visits every leaf whose box the ray reaches; stops early when any_hit finds one. */
 static int traverse(const fr_bvh2 *b, const fr_mesh *m, const fr_ray *ray, fr_hit *hit, int any_hit) {
   if (fr_ray_invalid(ray)) return 0;
   vec3 o = v3_load(ray->org), d = v3_load(ray->dir);
-  vec3 rd = v3(rcp(d.x), rcp(d.y), rcp(d.z));
+  const float rd[3] = {fr_bvh2_rcp(d.x), fr_bvh2_rcp(d.y), fr_bvh2_rcp(d.z)};
   fr_wt_ray w = fr_wt_setup(d);
   float tfar = ray->tfar;
   uint32_t stack[256];
@@ -53,7 +35,7 @@ static int traverse(const fr_bvh2 *b, const fr_mesh *m, const fr_ray *ray, fr_hi
     }
     const fr_bvh2_node *n = &b->nodes[ref];
     for (int k = 0; k < 2; k++)
-      if (box_hit(n, k, o, rd, ray->tnear, tfar) && sp < 256) stack[sp++] = n->child[k];
+      if (fr_bvh2_box_hit(n, k, ray->org, rd, ray->tnear, tfar) && sp < 256) stack[sp++] = n->child[k];
   }
   return found;
 }

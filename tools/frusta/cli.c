@@ -119,8 +119,7 @@ int cli_common_from_args(const cli_args *a, int *threads) {
 }
 
 fr_view cli_resolve_view(const fr_scene *s, const cli_view *v) {
-  fr_view view;
-  if (!fr_view_lookup(s->name, &view)) view = fr_view_from_bounds(s->bounds);
+  fr_view view = fr_view_of(s->name, s->bounds);
   if (v->has_eye) view.eye = v->eye;
   if (v->has_at) view.at = v->at;
   if (v->has_up) view.up = v->up;
