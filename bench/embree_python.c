@@ -61,6 +61,21 @@ static void pack(struct RTCRay *r, const float *o, const float *d, const float *
   r->time = 0; r->mask = 0xFFFFFFFFu; r->id = 0; r->flags = 0;
 }
 
+/* Rays [first, first + 16) of n as a packet; lanes past n repeat ray
+ * first and are left out of valid. */
+static void pack16(struct RTCRay16 *r, int valid[16], const float *o, const float *d, const float *tnear,
+                   const float *tfar, size_t first, size_t n) {
+  for (int l = 0; l < 16; l++) {
+    size_t i = first + (size_t)l;
+    valid[l] = i < n ? -1 : 0;
+    if (!valid[l]) i = first;
+    r->org_x[l] = o[3 * i]; r->org_y[l] = o[3 * i + 1]; r->org_z[l] = o[3 * i + 2];
+    r->dir_x[l] = d[3 * i]; r->dir_y[l] = d[3 * i + 1]; r->dir_z[l] = d[3 * i + 2];
+    r->tnear[l] = tnear ? tnear[i] : 0.0f; r->tfar[l] = tfar ? tfar[i] : INFINITY;
+    r->time[l] = 0; r->mask[l] = 0xFFFFFFFFu; r->id[l] = 0; r->flags[l] = 0;
+  }
+}
+
 /* tnear and tfar: one per ray, or NULL for 0 and inf. */
 
 /* Closest hits: t (inf on a miss) and prim (0xFFFFFFFF on a miss), u, v.
@@ -91,16 +106,8 @@ void ebp_intersect(const ebp_scene *s, const float *o, const float *d, size_t n,
     for (size_t b = 0; b < k; b += 16) {
       struct RTCRayHit16 rh;
       int valid[16];
-      for (int l = 0; l < 16; l++) {
-        size_t i = i0 + b + (size_t)l;
-        valid[l] = b + (size_t)l < k ? -1 : 0;
-        if (!valid[l]) i = i0 + b;
-        rh.ray.org_x[l] = o[3 * i]; rh.ray.org_y[l] = o[3 * i + 1]; rh.ray.org_z[l] = o[3 * i + 2];
-        rh.ray.dir_x[l] = d[3 * i]; rh.ray.dir_y[l] = d[3 * i + 1]; rh.ray.dir_z[l] = d[3 * i + 2];
-        rh.ray.tnear[l] = tnear ? tnear[i] : 0.0f; rh.ray.tfar[l] = tfar ? tfar[i] : INFINITY;
-        rh.ray.time[l] = 0; rh.ray.mask[l] = 0xFFFFFFFFu; rh.ray.id[l] = 0; rh.ray.flags[l] = 0;
-        rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
-      }
+      pack16(&rh.ray, valid, o, d, tnear, tfar, i0 + b, i0 + k);
+      for (int l = 0; l < 16; l++) rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
       rtcIntersect16(valid, s->scene, &ctx, &rh);
       for (int l = 0; l < 16 && b + (size_t)l < k; l++) {
         size_t i = i0 + b + (size_t)l;
@@ -132,15 +139,7 @@ void ebp_occluded(const ebp_scene *s, const float *o, const float *d, size_t n, 
     for (size_t b = 0; b < k; b += 16) {
       struct RTCRay16 r;
       int valid[16];
-      for (int l = 0; l < 16; l++) {
-        size_t i = i0 + b + (size_t)l;
-        valid[l] = b + (size_t)l < k ? -1 : 0;
-        if (!valid[l]) i = i0 + b;
-        r.org_x[l] = o[3 * i]; r.org_y[l] = o[3 * i + 1]; r.org_z[l] = o[3 * i + 2];
-        r.dir_x[l] = d[3 * i]; r.dir_y[l] = d[3 * i + 1]; r.dir_z[l] = d[3 * i + 2];
-        r.tnear[l] = tnear ? tnear[i] : 0.0f; r.tfar[l] = tfar ? tfar[i] : INFINITY;
-        r.time[l] = 0; r.mask[l] = 0xFFFFFFFFu; r.id[l] = 0; r.flags[l] = 0;
-      }
+      pack16(&r, valid, o, d, tnear, tfar, i0 + b, i0 + k);
       rtcOccluded16(valid, s->scene, &ctx, &r);
       for (int l = 0; l < 16 && b + (size_t)l < k; l++) occ[i0 + b + (size_t)l] = r.tfar[l] < 0.0f;
     }

@@ -158,6 +158,45 @@ static inline int for_each_shared_scene(void (*fn)(const char *path, void *ctx),
   return count;
 }
 
+/* A closed, consistently wound, star-shaped solid around c, committed: a
+ * lat-long grid of st rings of sl vertices, radii jittered by 0.8..1.2,
+ * one vertex per pole. *pos_out (the caller frees it) gets the vertices. */
+static inline fr_scene *closed_latlong_sphere(fr_rng *r, vec3 c, float radius, int st, int sl, float **pos_out,
+                                              size_t *nv_out) {
+  const size_t ST = (size_t)st, SL = (size_t)sl;
+  size_t nv = 2 + (ST - 1) * SL, nt = 2 * SL + 2 * SL * (ST - 2), v = 0, t = 0;
+  float *pos = malloc(nv * 3 * sizeof(float));
+  uint32_t *idx = malloc(nt * 3 * sizeof(uint32_t));
+#define PUT(x, y, z) (pos[3 * v] = (x), pos[3 * v + 1] = (y), pos[3 * v + 2] = (z), v++)
+  PUT(c.x, c.y + radius, c.z);
+  for (size_t i = 1; i < ST; i++)
+    for (size_t j = 0; j < SL; j++) {
+      float th = (float)M_PI * (float)i / (float)ST, ph = 2.0f * (float)M_PI * (float)j / (float)SL;
+      float rr = radius * urand(r, 0.8f, 1.2f);
+      PUT(c.x + rr * sinf(th) * cosf(ph), c.y + rr * cosf(th), c.z + rr * sinf(th) * sinf(ph));
+    }
+  PUT(c.x, c.y - radius, c.z);
+#define RING(i, j) (uint32_t)(1 + ((i) - 1) * SL + ((j) % SL))
+#define TRI(a, b, cc) (idx[3 * t] = (a), idx[3 * t + 1] = (b), idx[3 * t + 2] = (cc), t++)
+  for (size_t j = 0; j < SL; j++) TRI(0, RING(1, j + 1), RING(1, j));
+  for (size_t i = 1; i < ST - 1; i++)
+    for (size_t j = 0; j < SL; j++) {
+      TRI(RING(i, j), RING(i, j + 1), RING(i + 1, j + 1));
+      TRI(RING(i, j), RING(i + 1, j + 1), RING(i + 1, j));
+    }
+  for (size_t j = 0; j < SL; j++) TRI((uint32_t)(nv - 1), RING(ST - 1, j), RING(ST - 1, j + 1));
+#undef PUT
+#undef RING
+#undef TRI
+  fr_scene *s;
+  assert_int_equal(fr_scene_from_arrays(pos, nv, idx, nt, &s), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  free(idx);
+  *pos_out = pos;
+  *nv_out = nv;
+  return s;
+}
+
 /* Zero-area test on raw arrays, as the library's (double precision). */
 static inline int fr_mesh_degenerate_prim(const float *pos, const uint32_t *idx, uint32_t t) {
   const float *a = pos + 3 * (size_t)idx[3 * t], *b = pos + 3 * (size_t)idx[3 * t + 1], *c = pos + 3 * (size_t)idx[3 * t + 2];

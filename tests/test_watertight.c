@@ -6,45 +6,11 @@
 #include <stdlib.h>
 #include "test_util.h"
 
-#define ST 24
-#define SL 48
-
-/* An irregular closed sphere: lat-long grid, one vertex per pole, radii jittered. */
-static fr_scene *closed_sphere(fr_rng *r, vec3 c, float radius, float **pos_out, size_t *nv_out) {
-  size_t nv = 2 + (ST - 1) * SL, nt = 2 * SL + 2 * SL * (ST - 2), v = 0, t = 0;
-  float *pos = malloc(nv * 3 * sizeof(float));
-  uint32_t *idx = malloc(nt * 3 * sizeof(uint32_t));
-#define PUT(x, y, z) (pos[3 * v] = (x), pos[3 * v + 1] = (y), pos[3 * v + 2] = (z), v++)
-  PUT(c.x, c.y + radius, c.z);
-  for (int i = 1; i < ST; i++)
-    for (int j = 0; j < SL; j++) {
-      float th = (float)M_PI * (float)i / ST, ph = 2.0f * (float)M_PI * (float)j / SL, rr = radius * urand(r, 0.8f, 1.2f);
-      PUT(c.x + rr * sinf(th) * cosf(ph), c.y + rr * cosf(th), c.z + rr * sinf(th) * sinf(ph));
-    }
-  PUT(c.x, c.y - radius, c.z);
-#define RING(i, j) (uint32_t)(1 + ((i) - 1) * SL + ((j) % SL))
-#define TRI(a, b, cc) (idx[3 * t] = (a), idx[3 * t + 1] = (b), idx[3 * t + 2] = (cc), t++)
-  for (int j = 0; j < SL; j++) TRI(0, RING(1, j + 1), RING(1, j));
-  for (int i = 1; i < ST - 1; i++)
-    for (int j = 0; j < SL; j++) {
-      TRI(RING(i, j), RING(i, j + 1), RING(i + 1, j + 1));
-      TRI(RING(i, j), RING(i + 1, j + 1), RING(i + 1, j));
-    }
-  for (int j = 0; j < SL; j++) TRI((uint32_t)(nv - 1), RING(ST - 1, j), RING(ST - 1, j + 1));
-  fr_scene *s;
-  assert_int_equal(fr_scene_from_arrays(pos, nv, idx, nt, &s), FR_OK);
-  assert_int_equal(fr_scene_commit(s), FR_OK);
-  free(idx);
-  *pos_out = pos;
-  *nv_out = nv;
-  return s;
-}
-
 static void shoot_from_inside(vec3 center, float radius) {
   fr_rng r = fr_rng_seed(99, (uint64_t)(radius * 1000));
   float *pos;
   size_t nv;
-  fr_scene *s = closed_sphere(&r, center, radius, &pos, &nv);
+  fr_scene *s = closed_latlong_sphere(&r, center, radius, 24, 48, &pos, &nv);
   const uint32_t *idx = fr_scene_indices(s);
   size_t nt = fr_scene_triangle_count(s);
   long missed[6] = {0}, shot = 0;

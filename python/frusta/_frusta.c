@@ -227,6 +227,13 @@ static int range_arg(PyObject *o, const char *name, size_t n, float *value, PyAr
   return 1;
 }
 
+/* The leading shape and count of r->org, (..., 3). */
+static void rays_shape(rays_in *r) {
+  r->ndim = PyArray_NDIM(r->org) - 1;
+  for (int i = 0; i < r->ndim; i++) r->shape[i] = PyArray_DIM(r->org, i);
+  r->n = (size_t)(PyArray_SIZE(r->org) / 3);
+}
+
 static int rays_parse(PyObject *o, PyObject *d, PyObject *tnear, PyObject *tfar, rays_in *r) {
   memset(r, 0, sizeof *r);
   r->tfar = INFINITY;
@@ -235,9 +242,7 @@ static int rays_parse(PyObject *o, PyObject *d, PyObject *tnear, PyObject *tfar,
     PyErr_SetString(PyExc_ValueError, "origins and directions must have the same shape");
     goto fail;
   }
-  r->ndim = PyArray_NDIM(r->org) - 1;
-  for (int i = 0; i < r->ndim; i++) r->shape[i] = PyArray_DIM(r->org, i);
-  r->n = (size_t)(PyArray_SIZE(r->org) / 3);
+  rays_shape(r);
   if (tnear && !range_arg(tnear, "tnear", r->n, &r->tnear, &r->tnear_a)) goto fail;
   if (tfar && !range_arg(tfar, "tfar", r->n, &r->tfar, &r->tfar_a)) goto fail;
   return 1;
@@ -542,25 +547,38 @@ done:
   return result;
 }
 
+/* Points of shape (..., 3) in r->org (r->dir unused), every coordinate finite. */
+static int points_parse(PyObject *po, rays_in *r) {
+  memset(r, 0, sizeof *r);
+  if (!(r->org = vec3_array(po, "points"))) return 0;
+  rays_shape(r);
+  const float *pts = PyArray_DATA(r->org);
+  for (size_t i = 0; i < 3 * r->n; i++)
+    if (!isfinite(pts[i])) {
+      PyErr_Format(PyExc_ValueError, "point %zu is NaN or infinite", i / 3);
+      rays_free(r);
+      return 0;
+    }
+  return 1;
+}
+
+/* The distance left out at a point's end of a shadow ray. */
+static int eps_arg(float eps) {
+  if (eps >= 0.0f && isfinite(eps)) return 1;
+  PyErr_SetString(PyExc_ValueError, "eps: expected a finite number >= 0");
+  return 0;
+}
+
 static PyObject *scene_occluded_point_light(SceneObject *s, PyObject *args, PyObject *kw) {
   static char *names[] = {"points", "light", "eps", NULL};
   PyObject *po, *lo;
   float light[3], eps;
   if (!PyArg_ParseTupleAndKeywords(args, kw, "OOf", names, &po, &lo, &eps)) return NULL;
   if (!scene_open(s) || !vec3_arg(lo, "light", light)) return NULL;
-  if (!(eps >= 0.0f) || !isfinite(eps)) return PyErr_Format(PyExc_ValueError, "eps: expected a finite number >= 0");
+  if (!eps_arg(eps)) return NULL;
   rays_in r;
-  memset(&r, 0, sizeof r);
-  if (!(r.org = vec3_array(po, "points"))) return NULL;
-  r.ndim = PyArray_NDIM(r.org) - 1;
-  for (int i = 0; i < r.ndim; i++) r.shape[i] = PyArray_DIM(r.org, i);
-  r.n = (size_t)(PyArray_SIZE(r.org) / 3);
+  if (!points_parse(po, &r)) return NULL;
   const float *pts = PyArray_DATA(r.org);
-  for (size_t i = 0; i < 3 * r.n; i++)
-    if (!isfinite(pts[i])) {
-      rays_free(&r);
-      return PyErr_Format(PyExc_ValueError, "point %zu is NaN or infinite", i / 3);
-    }
   PyArrayObject *occ = out_array(&r, 0, NPY_BOOL);
   if (!occ) { rays_free(&r); return NULL; }
   s->busy++;
@@ -590,19 +608,10 @@ static PyObject *scene_visibility_area_light(SceneObject *s, PyObject *args, PyO
   if (!scene_open(s) || !vec3_arg(co, "corner", c) || !vec3_arg(e1o, "e1", e1) || !vec3_arg(e2o, "e2", e2)) return NULL;
   if (samples < 16 || samples > 4096 || samples % 16)
     return PyErr_Format(PyExc_ValueError, "samples: %d is not a multiple of 16 in 16..4096", samples);
-  if (!(eps >= 0.0f) || !isfinite(eps)) return PyErr_Format(PyExc_ValueError, "eps: expected a finite number >= 0");
+  if (!eps_arg(eps)) return NULL;
   rays_in r;
-  memset(&r, 0, sizeof r);
-  if (!(r.org = vec3_array(po, "points"))) return NULL;
-  r.ndim = PyArray_NDIM(r.org) - 1;
-  for (int i = 0; i < r.ndim; i++) r.shape[i] = PyArray_DIM(r.org, i);
-  r.n = (size_t)(PyArray_SIZE(r.org) / 3);
+  if (!points_parse(po, &r)) return NULL;
   const float *pts = PyArray_DATA(r.org);
-  for (size_t i = 0; i < 3 * r.n; i++)
-    if (!isfinite(pts[i])) {
-      rays_free(&r);
-      return PyErr_Format(PyExc_ValueError, "point %zu is NaN or infinite", i / 3);
-    }
   PyArrayObject *vis = out_array(&r, 0, NPY_FLOAT32);
   if (!vis) { rays_free(&r); return NULL; }
   s->busy++;

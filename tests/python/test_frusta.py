@@ -447,12 +447,17 @@ def test_intersect_camera_equals_rays():
         s.intersect_camera((0, np.nan, 0), at, up, 50.0, 8, 8)
 
 
+def camera_hit_points(s, width, height):
+    """The points a camera over the built-in scene sees, row by row."""
+    eye = (0.0, 3.0, 9.0)
+    h, d = s.intersect_camera(eye, (0.0, 0.5, 0.0), (0.0, 1.0, 0.0), 50.0, width, height, directions=True)
+    hit = np.isfinite(h.t)
+    return (np.float32(eye) + h.t[..., None] * d)[hit].astype(np.float32)
+
+
 def test_occluded_point_light_equals_rays():
     s = frusta.Scene.builtin()
-    eye = (0.0, 3.0, 9.0)
-    h, d = s.intersect_camera(eye, (0.0, 0.5, 0.0), (0.0, 1.0, 0.0), 50.0, 256, 192, directions=True)
-    hit = np.isfinite(h.t)
-    p = (np.float32(eye) + h.t[..., None] * d)[hit].astype(np.float32)
+    p = camera_hit_points(s, 256, 192)
     light = np.float32([2.0, 6.0, 3.0])
     lo, hi = s.bounds
     eps = 1e-5 * float(np.linalg.norm(hi - lo))
@@ -472,10 +477,7 @@ def test_occluded_point_light_equals_rays():
 
 def test_visibility_area_light():
     s = frusta.Scene.builtin()
-    eye = (0.0, 3.0, 9.0)
-    h, d = s.intersect_camera(eye, (0.0, 0.5, 0.0), (0.0, 1.0, 0.0), 50.0, 128, 96, directions=True)
-    hit = np.isfinite(h.t)
-    p = (np.float32(eye) + h.t[..., None] * d)[hit].astype(np.float32)
+    p = camera_hit_points(s, 128, 96)
     corner, e1, e2 = (-2.0, 8.0, -2.0), (4.0, 0.0, 0.0), (0.0, 0.0, 4.0)
     v16 = s.visibility_area_light(p, corner, e1, e2)
     assert v16.shape == (len(p),) and v16.dtype == np.float32
