@@ -34,11 +34,11 @@ if [ "${FRUSTA_TSAN_TESTS:-1}" != 0 ]; then
   TSAN="${FRUSTA_TSAN_DIR:-build-tsan}"
   CC=clang CXX=clang++ cmake -S . -B "$TSAN" -DCMAKE_BUILD_TYPE=Release -DFRUSTA_TSAN=ON \
     -DCMAKE_DISABLE_FIND_PACKAGE_MPI=ON >/dev/null
-  cmake --build "$TSAN" -j "$(nproc)" --target test_threads test_hybrid_tune frusta >/dev/null
+  cmake --build "$TSAN" -j "$(nproc)" --target test_threads test_same_answers frusta >/dev/null
   export TSAN_OPTIONS=halt_on_error=1:exitcode=66:ignore_noninstrumented_modules=1
   export OMP_TOOL_LIBRARIES=/usr/lib/llvm-14/lib/libarcher.so
   "$TSAN/tests/test_threads" >/dev/null
-  "$TSAN/tests/test_hybrid_tune" >/dev/null
+  "$TSAN/tests/test_same_answers" >/dev/null
   out=$(mktemp -d)
   for shade in eyelight softshadow whitted; do
     "$TSAN/frusta" render --builtin --shade "$shade" --size 96x96 --threads 4 --out "$out/$shade.png" >/dev/null

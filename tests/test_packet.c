@@ -64,27 +64,24 @@ typedef struct config {
   float spread; /* auto's stream_spread; 0: the default */
   int coherent; /* coherent_threshold, which hybrid16's one-octant packets use too; 0: the default */
   int no_quad;  /* quad_leaves off */
-  int no_tune;  /* hybrid_tune off: every packet at the threshold */
 } config;
 static const config configs[] = {
-    {"packet16", FR_TRACE_PACKET16, 0, 4, 0, 1, 1, 0, 0.0f, 0, 0, 0},  {"packet8", FR_TRACE_PACKET8, 0, 4, 0, 1, 1, 0, 0.0f, 0, 0, 0},
-    {"hybrid16", FR_TRACE_HYBRID16, 7, 4, 0, 1, 1, 0, 0.0f, 0, 0, 0},  {"hybrid16/t3", FR_TRACE_HYBRID16, 3, 4, 0, 1, 1, 0, 0.0f, 3, 0, 0},
-    {"hybrid16/t16", FR_TRACE_HYBRID16, 16, 4, 0, 1, 1, 0, 0.0f, 16, 0, 0}, {"packet16/bvh8", FR_TRACE_PACKET16, 0, 8, 0, 1, 1, 0, 0.0f, 0, 0, 0},
-    {"hybrid16/bvh8", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 0, 0.0f, 0, 0, 0}, {"packet16/mailbox", FR_TRACE_PACKET16, 0, 4, 1, 1, 1, 0, 0.0f, 0, 0, 0},
-    {"packet16/no-aa", FR_TRACE_PACKET16, 0, 4, 0, 0, 1, 0, 0.0f, 0, 0, 0}, {"packet16/no-ia", FR_TRACE_PACKET16, 0, 4, 0, 1, 0, 0, 0.0f, 0, 0, 0},
-    {"auto", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0, 0.0f, 0, 0, 0},
+    {"packet16", FR_TRACE_PACKET16, 0, 4, 0, 1, 1, 0, 0.0f, 0, 0},  {"packet8", FR_TRACE_PACKET8, 0, 4, 0, 1, 1, 0, 0.0f, 0, 0},
+    {"hybrid16", FR_TRACE_HYBRID16, 7, 4, 0, 1, 1, 0, 0.0f, 0, 0},  {"hybrid16/t3", FR_TRACE_HYBRID16, 3, 4, 0, 1, 1, 0, 0.0f, 3, 0},
+    {"hybrid16/t16", FR_TRACE_HYBRID16, 16, 4, 0, 1, 1, 0, 0.0f, 16, 0}, {"packet16/bvh8", FR_TRACE_PACKET16, 0, 8, 0, 1, 1, 0, 0.0f, 0, 0},
+    {"hybrid16/bvh8", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 0, 0.0f, 0, 0}, {"packet16/mailbox", FR_TRACE_PACKET16, 0, 4, 1, 1, 1, 0, 0.0f, 0, 0},
+    {"packet16/no-aa", FR_TRACE_PACKET16, 0, 4, 0, 0, 1, 0, 0.0f, 0, 0}, {"packet16/no-ia", FR_TRACE_PACKET16, 0, 4, 0, 1, 0, 0, 0.0f, 0, 0},
+    {"auto", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0, 0.0f, 0, 0},
     /* auto with every group a packet, and with the packet/stream split
        inside the camera and shadow packets too */
-    {"auto/packets", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0, 2.0f, 0, 0, 0},
-    {"auto/split", FR_TRACE_AUTO, 7, 8, 0, 1, 1, 0, 0.1f, 0, 0, 0},
-    {"raystream", FR_TRACE_RAYSTREAM, 7, 4, 0, 1, 1, 0, 0.0f, 0, 0, 0},
+    {"auto/packets", FR_TRACE_AUTO, 7, 4, 0, 1, 1, 0, 2.0f, 0, 0},
+    {"auto/split", FR_TRACE_AUTO, 7, 8, 0, 1, 1, 0, 0.1f, 0, 0},
+    {"raystream", FR_TRACE_RAYSTREAM, 7, 4, 0, 1, 1, 0, 0.0f, 0, 0},
     /* prefetching, which these small scenes leave off by default */
-    {"hybrid16/bvh8/prefetch", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 1, 0.0f, 0, 0, 0},
+    {"hybrid16/bvh8/prefetch", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 1, 0.0f, 0, 0},
     /* every leaf one triangle against all the packet's rays */
-    {"packet16/bvh8/no-quad", FR_TRACE_PACKET16, 0, 8, 0, 1, 1, 0, 0.0f, 0, 1, 0},
-    {"packet8/no-quad", FR_TRACE_PACKET8, 0, 4, 0, 1, 1, 0, 0.0f, 0, 1, 0},
-    /* the threshold fixed rather than tuned (trace/hybrid_tune.h) */
-    {"hybrid16/fixed", FR_TRACE_HYBRID16, 7, 8, 0, 1, 1, 0, 0.0f, 0, 0, 1},
+    {"packet16/bvh8/no-quad", FR_TRACE_PACKET16, 0, 8, 0, 1, 1, 0, 0.0f, 0, 1},
+    {"packet8/no-quad", FR_TRACE_PACKET8, 0, 4, 0, 1, 1, 0, 0.0f, 0, 1},
 };
 #define NCONFIGS (sizeof configs / sizeof configs[0])
 
@@ -98,7 +95,6 @@ static void set_config(fr_scene *s, const config *c) {
   o.axis_aligned = c->axis_aligned;
   o.ia_cull = c->ia;
   o.quad_leaves = !c->no_quad;
-  o.hybrid_tune = !c->no_tune;
   o.prefetch = c->prefetch ? 1 : -1;
   if (c->spread > 0.0f) o.stream_spread = c->spread;
   if (c->coherent > 0) o.coherent_threshold = c->coherent;
@@ -166,15 +162,10 @@ static void check_scene(vec3 center, float size, uint64_t seed) {
         fr_occluded_stream(s, copy, occs, 16);
         fr_intersect16(s, valid, &r16, &h16);
         unsigned occ16 = fr_occluded16(s, valid, &r16);
-        /* (fr_intersect16 is a hybrid at the config's threshold; tuned, it
-         * picks that or 16 by measured time, and the single-ray phase's u,
-         * v differ from the packet test's in their last bits: only its t
-         * and triangle are checked, below) */
-        const int tuned = !configs[c].no_tune && configs[c].threshold > 0 && configs[c].threshold < 16;
         if (!have_first) {
           first[c] = h16;
           first_occ[c] = occ16;
-        } else if (!tuned) {
+        } else {
           assert_int_equal(occ16, first_occ[c]);
           assert_memory_equal(&h16, &first[c], sizeof h16);
         }
@@ -276,7 +267,7 @@ static void test_leaf_against_scalar(void **st) {
       if (!fr_isa_supported((fr_isa)isa)) continue;
       fr_set_isa((fr_isa)isa);
       for (int aa = 0; aa < 2; aa++) {
-        config c = {"leaf", FR_TRACE_PACKET16, 0, 4, 0, aa, 1, 0, 0.0f, 0, 1, 0}; /* every leaf by Shevtsov's test */
+        config c = {"leaf", FR_TRACE_PACKET16, 0, 4, 0, aa, 1, 0, 0.0f, 0, 1}; /* every leaf by Shevtsov's test */
         set_config(s, &c);
         fr_tri_shevtsov use = rec;
         if (!aa) use.axis_aligned = 0;
@@ -392,12 +383,6 @@ static void test_options(void **st) {
   assert_int_equal(fr_scene_set_tuning(s, &o), FR_ERR_ARG);
   o.stream_spread = 0.0f;
   assert_int_equal(fr_scene_set_tuning(s, &o), FR_OK);
-  assert_int_equal(o.hybrid_tune, 1);
-  o.hybrid_tune = 2;
-  assert_int_equal(fr_scene_set_tuning(s, &o), FR_ERR_ARG);
-  o.hybrid_tune = 0;
-  assert_int_equal(fr_scene_set_tuning(s, &o), FR_OK);
-  o.hybrid_tune = 1;
   assert_int_equal(o.coherent_threshold, 2);
   o.coherent_threshold = -1;
   assert_int_equal(fr_scene_set_tuning(s, &o), FR_ERR_ARG);

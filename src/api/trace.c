@@ -20,15 +20,14 @@ static inline const fr_trace_fns *single_fns(const fr_scene *s, const fr_bvhn **
 }
 
 /* The packet kernels of the given size on the packet BVH, with their
- * options; tune: the hybrid may pick its threshold (trace/hybrid_tune.h). */
-static const fr_packet_fns *packet_fns(const fr_scene *s, int size, int threshold, int tune, fr_packet_opts *po,
+ * options. */
+static const fr_packet_fns *packet_fns(const fr_scene *s, int size, int threshold, fr_packet_opts *po,
                                        const fr_bvhn **b) {
   const fr_kernels *k = fr_kernels_active();
   int w8 = s->trace.packet_bvh_width == 8;
   *b = w8 ? &s->bvh8 : &s->bvh4;
   po->hybrid_threshold = threshold;
   po->uniform_threshold = threshold < s->trace.coherent_threshold ? threshold : s->trace.coherent_threshold;
-  po->tune = tune && s->trace.hybrid_tune;
   po->mailbox = s->trace.mailbox;
   po->axis_aligned = s->trace.axis_aligned;
   po->ia_cull = s->trace.ia_cull;
@@ -116,7 +115,7 @@ void fr_intersect16(const fr_scene *s, unsigned valid, const fr_ray16 *rays, fr_
   fr_packet_opts po;
   const fr_bvhn *b;
   const unsigned back = behind16(rays, valid);
-  packet_fns(s, 16, s->trace.hybrid_threshold, 1, &po, &b)->intersect(b, &po, valid & 0xFFFF & ~back, rays, hits);
+  packet_fns(s, 16, s->trace.hybrid_threshold, &po, &b)->intersect(b, &po, valid & 0xFFFF & ~back, rays, hits);
   for (unsigned m = back; m; m &= m - 1) {
     int i = __builtin_ctz(m);
     fr_ray r = lane_ray(rays, i);
@@ -139,7 +138,7 @@ unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays) 
   fr_packet_opts po;
   const fr_bvhn *b;
   const unsigned back = behind16(rays, valid);
-  unsigned occ = packet_fns(s, 16, s->trace.hybrid_threshold, 1, &po, &b)->occluded(b, &po, valid & 0xFFFF & ~back, rays);
+  unsigned occ = packet_fns(s, 16, s->trace.hybrid_threshold, &po, &b)->occluded(b, &po, valid & 0xFFFF & ~back, rays);
   for (unsigned m = back; m; m &= m - 1) {
     int i = __builtin_ctz(m);
     fr_ray r = lane_ray(rays, i);
@@ -267,7 +266,7 @@ static void octant_trace(const fr_scene *s, const fr_ray *rays, uint8_t *occ, fr
   stream_ctx c;
   c.st = s->single_width == 4 ? k->s4 : k->s8;
   c.sb = s->single_width == 4 ? &s->bvh4 : &s->bvh8;
-  c.pf = packet_fns(s, 16, s->trace.coherent_threshold, 0, &c.po, &c.pb);
+  c.pf = packet_fns(s, 16, s->trace.coherent_threshold, &c.po, &c.pb);
   uint32_t order[STREAM_CHUNK], pend[FR_STREAM_MAX], rest[STREAM_CHUNK];
   size_t run_end[8];
   const size_t min_packet = (size_t)s->trace.hybrid_threshold + 1;
@@ -339,7 +338,7 @@ static void triangles_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ
   int threshold, size = packet_size(s, &threshold);
   fr_packet_opts po;
   const fr_bvhn *pb;
-  const fr_packet_fns *pf = packet_fns(s, size, threshold, 1, &po, &pb);
+  const fr_packet_fns *pf = packet_fns(s, size, threshold, &po, &pb);
   for (size_t g = 0, m; g < n; g += m) {
     m = n - g < (size_t)size ? n - g : (size_t)size;
     if (hits) { pf->intersect_idx(pb, &po, rays + g, identity_idx, (int)m, hits + g); continue; }

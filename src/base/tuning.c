@@ -16,7 +16,6 @@ void fr_tuning_default(fr_tuning *t) {
   /* coherent packets keep their lanes busy down to few rays: 2, as Embree's
    * coherent packets (docs/design.md, "The hybrid") */
   t->coherent_threshold = 2;
-  t->hybrid_tune = 1;
   t->occluder_cache = 1;
   t->anyhit_order = -1;
 }
@@ -33,7 +32,6 @@ fr_error fr_tuning_check(const fr_tuning *t) {
     return fr_fail(FR_ERR_ARG, "stream spread %g (0..2)", (double)t->stream_spread);
   if (t->coherent_threshold < 0 || t->coherent_threshold > 16)
     return fr_fail(FR_ERR_ARG, "coherent threshold %d (0..16)", t->coherent_threshold);
-  if (t->hybrid_tune != 0 && t->hybrid_tune != 1) return fr_fail(FR_ERR_ARG, "hybrid tune %d (0 or 1)", t->hybrid_tune);
   if (t->occluder_cache != 0 && t->occluder_cache != 1)
     return fr_fail(FR_ERR_ARG, "occluder cache %d (0 or 1)", t->occluder_cache);
   if (t->anyhit_order < -1 || t->anyhit_order > 1)

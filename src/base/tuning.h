@@ -34,11 +34,6 @@ typedef struct fr_tuning {
   int coherent_threshold; /* packets known to be coherent drop to single rays at this many active
                              rays, 0..16 (default 2): FR_TRACE_AUTO's coherent groups, and
                              FR_TRACE_HYBRID16's packets whose rays share a direction octant */
-  int hybrid_tune;        /* 1 (default): FR_TRACE_HYBRID16's and fr_intersect16's packets of several
-                             octants switch at hybrid_threshold or at once, whichever each thread has
-                             measured cheaper on this scene; 0: always at hybrid_threshold. Which of
-                             two triangles at the same t, and the last bits of u and v, may depend on
-                             the choice */
   int occluder_cache;     /* 1 (default): FR_TRACE_SINGLE's shadow streams first test the four
                              triangles that occluded the stream's last occluded ray; 0: never */
   int anyhit_order;       /* FR_TRACE_SINGLE's shadow streams: -1 (default) the child order each

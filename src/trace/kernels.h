@@ -48,8 +48,6 @@ typedef struct fr_stream_fns {
 typedef struct fr_packet_opts {
   int hybrid_threshold;   /* trace a popped subtree ray by ray when at most this many rays are active; 0: never */
   int uniform_threshold;  /* the same for packets whose rays share a direction octant */
-  int tune;               /* packets of several octants choose hybrid_threshold or 16 by measured cost
-                             (trace/hybrid_tune.h) */
   int mailbox;            /* inverse mailboxing: skip triangles this packet tested already */
   int axis_aligned;       /* Shevtsov's fast path for axis-aligned triangles */
   int ia_cull;            /* cull nodes for the whole packet by interval arithmetic first */

@@ -273,7 +273,6 @@ static int kernel_options(const cli_args *a, bench_opts *o) {
       (rc = cli_arg_int(a, F_PACKET_WIDTH, 4, 8, &t->packet_bvh_width)) ||
       (rc = cli_arg_onoff(a, F_MAILBOX, &t->mailbox)) || (rc = cli_arg_onoff(a, F_AXIS_ALIGNED, &t->axis_aligned)) ||
       (rc = cli_arg_onoff(a, F_IA, &t->ia_cull)) || (rc = cli_arg_onoff(a, F_QUAD, &t->quad_leaves)) ||
-      (rc = cli_arg_onoff(a, F_HYBRID_TUNE, &t->hybrid_tune)) ||
       (rc = cli_arg_onoff(a, F_OCCLUDER_CACHE, &t->occluder_cache)) ||
       (rc = cli_arg_float(a, F_STREAM_SPREAD, 0.0f, 2.0f, &t->stream_spread)) ||
       (rc = cli_arg_choice(a, F_PREFETCH, prefetch, 3, &pf)) || (rc = cli_arg_choice(a, F_ANYHIT_ORDER, order, 3, &ao)) ||

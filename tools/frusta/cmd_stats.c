@@ -45,7 +45,6 @@ static int table5(const char *path, const cli_view *v, int threads, const char *
   fr_tuning_default(&o);
   o.mode = FR_TRACE_HYBRID16;
   o.hybrid_threshold = threshold;
-  o.hybrid_tune = 0; /* the paper's table is for one threshold */
   if (coherent >= 0) o.coherent_threshold = coherent;
   o.packet_bvh_width = width;
   fr_scene_set_tuning(s, &o);

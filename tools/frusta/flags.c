@@ -102,8 +102,6 @@ const cli_flag cli_flags[F_COUNT] = {
     [F_AXIS_ALIGNED] = {"--axis-aligned", "on|off", B, "packets: Shevtsov's axis-aligned path (default on)"},
     [F_IA] = {"--ia", "on|off", B, "packets: interval-arithmetic culling (default on)"},
     [F_QUAD] = {"--quad", "on|off", B, "packets: leaves reached by few rays tested four by four (default on)"},
-    [F_HYBRID_TUNE] = {"--hybrid-tune", "on|off", B,
-                       "hybrid16: each thread picks the threshold or single rays by measured cost (default on)"},
     [F_STREAM_SPREAD] = {"--stream-spread", "S", B,
                          "auto: groups of 16 whose directions lie within S of the first go as packets, 0..2 (default 0.1)"},
     [F_PREFETCH] = {"--prefetch", "on|off|auto", B, "prefetch deferred children (default auto: trees over 32 MB)"},

@@ -7,12 +7,11 @@
  *
  * A probe chunk traces its rays alternately by either order and times each
  * ray: neighbouring rays of a stream cost about the same, so the two sums
- * compare like with like. Timing whole chunks of one order instead, as the
- * hybrid's tuner does (trace/hybrid_tune.h), compared the rare chunks of the
- * other order with whatever their place in the stream made them cost: on
- * the hairball's point-light shadows, whose chunks range from rays that
- * leave the hair at once to rays that cross it, that sent chunks the worse
- * way. The other chunks take
+ * compare like with like. Timing whole chunks of one order instead
+ * compared the rare chunks of the other order with whatever their place in
+ * the stream made them cost: on the hairball's point-light shadows, whose
+ * chunks range from rays that leave the hair at once to rays that cross
+ * it, that sent chunks the worse way. The other chunks take
  * nearest first only where it measured FR_ANYHIT_TUNE_MARGIN of the rank's
  * cost or less, so that the two coming close does not toggle it.
  */

@@ -6,10 +6,6 @@
  */
 #include "trace/wide/packet_common.h"
 
-/* Per thread and kernel: the hybrid's threshold for any-hit packets of
- * several direction octants (trace/wide/hybrid_tune.h). */
-static _Thread_local fr_hybrid_tune tune_any;
-
 /* The rays of `active` against leaf ref; returns those occluded. */
 static unsigned quad_occluded(const fr_bvhn *b, uint32_t ref, const quad_rays *q, const packet *pk, unsigned active) {
   const fr_tri4 *tr = &b->tris[FR_BVHN_LEAF_FIRST(ref)];
@@ -55,11 +51,10 @@ static unsigned planes_occluded(const fr_plane_occluders *planes, const packet *
   return occ;
 }
 
-static unsigned occluded_walk(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in,
-                              tune_arm *ta) {
+static unsigned occluded_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in) {
   packet pk;
   valid = packet_setup(&pk, valid, in);
-  const int threshold = packet_threshold(b, o, &pk, valid, &tune_any, ta);
+  const int threshold = packet_threshold(o, &pk);
   FR_COUNT(packets, 1);
   FR_COUNT(rays, __builtin_popcount(valid));
   pregs R;
@@ -140,15 +135,6 @@ static unsigned occluded_walk(const fr_bvhn *b, const fr_packet_opts *o, unsigne
   next:
     if (occ == valid) break;
   }
-  return occ;
-}
-
-static unsigned occluded_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in) {
-  tune_arm ta = {-1, 0};
-  const int due = o->tune && fr_hybrid_tune_due(&tune_any);
-  const uint64_t t0 = due ? fr_cycles() : 0;
-  const unsigned occ = occluded_walk(b, o, valid, in, &ta);
-  if (due && ta.arm >= 0) fr_hybrid_tune_record(&tune_any, ta.arm, fr_cycles() - t0, ta.rays);
   return occ;
 }
 

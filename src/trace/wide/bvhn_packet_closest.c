@@ -28,10 +28,6 @@
  */
 #include "trace/wide/packet_common.h"
 
-/* Per thread and kernel: the hybrid's threshold for closest-hit packets of
- * several direction octants (trace/wide/hybrid_tune.h). */
-static _Thread_local fr_hybrid_tune tune_closest;
-
 /* The answers of fr_hit_finish, for all lanes at once: the hit triangles'
  * vertices gathered lane by lane, the double-precision t of
  * fr_tri_refine_lane in one loop the compiler vectorizes, the normal as
@@ -172,11 +168,10 @@ static void quad_closest(const fr_bvhn *b, uint32_t ref, const quad_rays *q, con
   }
 }
 
-static void intersect_walk(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in, hit_regs *out,
-                           tune_arm *ta) {
+static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in, hit_regs *out) {
   packet pk;
   valid = packet_setup(&pk, valid, in);
-  const int threshold = packet_threshold(b, o, &pk, valid, &tune_closest, ta);
+  const int threshold = packet_threshold(o, &pk);
   FR_COUNT(packets, 1);
   FR_COUNT(rays, __builtin_popcount(valid));
   /* Each lane's best triangle (4 * block + lane) as the bits of a float, in
@@ -316,15 +311,6 @@ static void intersect_walk(const fr_bvhn *b, const fr_packet_opts *o, unsigned v
   lane_ids B;
   vp_store(B.f, best);
   finish(b, &pk, B.u, tfar, out);
-}
-
-static void intersect_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const rays_in *in, hit_regs *out) {
-  tune_arm ta = {-1, 0};
-  /* the clock read only before a packet the tuner will time */
-  const int due = o->tune && fr_hybrid_tune_due(&tune_closest);
-  const uint64_t t0 = due ? fr_cycles() : 0;
-  intersect_walk(b, o, valid, in, out, &ta);
-  if (due && ta.arm >= 0) fr_hybrid_tune_record(&tune_closest, ta.arm, fr_cycles() - t0, ta.rays);
 }
 
 void PK_FN(intersect_packet)(const fr_bvhn *b, const fr_packet_opts *o, unsigned valid, const fr_ray16 *in,

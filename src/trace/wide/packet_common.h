@@ -12,10 +12,8 @@
 #include <string.h>
 #include "base/simd.h"
 #include "base/simd_packet.h"
-#include "base/timer.h"
 #include "trace/wide/bvhn_node.h"
 #include "trace/counters.h"
-#include "trace/wide/hybrid_tune.h"
 #include "trace/kernels.h"
 #include "trace/plane_test.h"
 #include "trace/wide/tri4_quad.h"
@@ -327,19 +325,12 @@ FR_INLINE int quad_wanted(const fr_packet_opts *o, int most, quad_rays *q, const
 }
 
 
-/* What a packet's timing goes to: the tuner's arm (-1: not tuned) and the
- * packet's rays. */
-typedef struct tune_arm { int arm; unsigned rays; } tune_arm;
-
-/* The packet's switch threshold, from the tuner where o->tune asks for it. */
-FR_INLINE int packet_threshold(const fr_bvhn *b, const fr_packet_opts *o, const packet *pk, unsigned valid,
-                            fr_hybrid_tune *t, tune_arm *ta) {
-  if (pk->uniform) return o->uniform_threshold;
-  if (!o->tune || !o->hybrid_threshold || !valid) return o->hybrid_threshold;
-  int timed;
-  const int arm = fr_hybrid_tune_pick(t, b, &timed);
-  if (timed) ta->arm = arm, ta->rays = (unsigned)__builtin_popcount(valid);
-  return arm ? P : o->hybrid_threshold;
+/* The packet's switch threshold: fixed per kind of packet, so that which
+ * phase finds a ray's hit, and so which of two triangles at one t it
+ * reports, depends on the packet's rays alone, never on what the thread
+ * traced before. */
+FR_INLINE int packet_threshold(const fr_packet_opts *o, const packet *pk) {
+  return pk->uniform ? o->uniform_threshold : o->hybrid_threshold;
 }
 
 
