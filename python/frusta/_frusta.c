@@ -44,6 +44,10 @@ typedef struct {
   PyObject_HEAD
   fr_scene *scene;
   int busy; /* calls tracing it now (changed with the GIL held) */
+  /* the arrays a scene made from numpy arrays reads in place (the
+   * vertices as given where they are C-contiguous float32, the triangles
+   * as given or as a uint32 copy); held until the scene is released */
+  PyObject *shared_vertices, *shared_triangles;
 } SceneObject;
 
 static PyTypeObject SceneType;
@@ -74,6 +78,14 @@ static PyObject *wrap_scene(PyTypeObject *type, fr_scene *sc, float smooth) {
   return (PyObject *)o;
 }
 
+/* The scene, then the arrays it read in place. */
+static void scene_release(SceneObject *s) {
+  if (s->scene) fr_scene_release(s->scene);
+  s->scene = NULL;
+  Py_CLEAR(s->shared_vertices);
+  Py_CLEAR(s->shared_triangles);
+}
+
 /* A float array of shape (..., 3) as C-contiguous float32 (in place if it
  * is one). */
 static PyArrayObject *vec3_array(PyObject *obj, const char *name) {
@@ -99,6 +111,37 @@ static PyArrayObject *vec3_array(PyObject *obj, const char *name) {
   return f;
 }
 
+/* Triangles as a C-contiguous uint32 (n, 3) array, every index below nv:
+ * the array itself where it is int32 or uint32 and C-contiguous, else a
+ * copy. */
+static PyArrayObject *triangle_array(PyObject *obj, size_t nv) {
+  PyArrayObject *ta = (PyArrayObject *)PyArray_FROM_O(obj);
+  if (!ta) return NULL;
+  if (!PyArray_ISINTEGER(ta) || PyArray_NDIM(ta) != 2 || PyArray_DIM(ta, 1) != 3) {
+    PyErr_SetString(PyExc_ValueError, "triangles: expected an integer array of shape (n, 3)");
+    Py_DECREF(ta);
+    return NULL;
+  }
+  const int type = PyArray_TYPE(ta);
+  const int in_place = (type == NPY_INT32 || type == NPY_UINT32) && PyArray_IS_C_CONTIGUOUS(ta) && PyArray_ISALIGNED(ta);
+  PyArrayObject *t = (PyArrayObject *)PyArray_FROM_OTF((PyObject *)ta, NPY_INT64, NPY_ARRAY_IN_ARRAY);
+  if (!t) { Py_DECREF(ta); return NULL; }
+  const size_t n = (size_t)PyArray_SIZE(t);
+  const int64_t *ti = PyArray_DATA(t);
+  for (size_t i = 0; i < n; i++)
+    if (ti[i] < 0 || (uint64_t)ti[i] >= nv) {
+      PyErr_Format(PyExc_ValueError, "triangles: triangle %zu names vertex %lld of %zu", i / 3, (long long)ti[i], nv);
+      Py_DECREF(t);
+      Py_DECREF(ta);
+      return NULL;
+    }
+  Py_DECREF(t);
+  if (in_place) return ta; /* int32 indices in range are their uint32 selves */
+  PyArrayObject *u = (PyArrayObject *)PyArray_FROM_OTF((PyObject *)ta, NPY_UINT32, NPY_ARRAY_IN_ARRAY | NPY_ARRAY_FORCECAST);
+  Py_DECREF(ta);
+  return u;
+}
+
 static PyObject *scene_new(PyTypeObject *type, PyObject *args, PyObject *kw) {
   static char *names[] = {"vertices", "triangles", "smooth", NULL};
   PyObject *vo, *to;
@@ -106,43 +149,33 @@ static PyObject *scene_new(PyTypeObject *type, PyObject *args, PyObject *kw) {
   if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|f", names, &vo, &to, &smooth)) return NULL;
   PyArrayObject *v = vec3_array(vo, "vertices");
   if (!v) return NULL;
-  PyArrayObject *ta = (PyArrayObject *)PyArray_FROM_O(to);
-  if (!ta) { Py_DECREF(v); return NULL; }
-  if (!PyArray_ISINTEGER(ta) || PyArray_NDIM(ta) != 2 || PyArray_DIM(ta, 1) != 3) {
-    PyErr_SetString(PyExc_ValueError, "triangles: expected an integer array of shape (n, 3)");
-    Py_DECREF(v); Py_DECREF(ta);
-    return NULL;
-  }
-  PyArrayObject *t = (PyArrayObject *)PyArray_FROM_OTF((PyObject *)ta, NPY_INT64, NPY_ARRAY_IN_ARRAY);
-  Py_DECREF(ta);
+  const size_t nv = (size_t)(PyArray_SIZE(v) / 3);
+  PyArrayObject *t = triangle_array(to, nv);
   if (!t) { Py_DECREF(v); return NULL; }
-  size_t nv = (size_t)(PyArray_SIZE(v) / 3), nt = (size_t)PyArray_DIM(t, 0);
+  const size_t nt = (size_t)PyArray_DIM(t, 0);
   const float *pos = PyArray_DATA(v);
-  const int64_t *ti = PyArray_DATA(t);
-  PyObject *result = NULL;
-  uint32_t *idx = NULL;
   for (size_t i = 0; i < 3 * nv; i++)
     if (!isfinite(pos[i])) {
-      PyErr_Format(PyExc_ValueError, "vertices: vertex %zu is not finite", i / 3);
-      goto done;
+      Py_DECREF(v);
+      Py_DECREF(t);
+      return PyErr_Format(PyExc_ValueError, "vertices: vertex %zu is not finite", i / 3);
     }
-  idx = malloc((nt ? 3 * nt : 1) * sizeof *idx);
-  if (!idx) { PyErr_NoMemory(); goto done; }
-  for (size_t i = 0; i < 3 * nt; i++) {
-    if (ti[i] < 0 || (uint64_t)ti[i] >= nv) {
-      PyErr_Format(PyExc_ValueError, "triangles: triangle %zu names vertex %lld of %zu", i / 3, (long long)ti[i], nv);
-      goto done;
-    }
-    idx[i] = (uint32_t)ti[i];
-  }
+  /* Both arrays are read in place: the scene keeps them */
   fr_scene *sc;
-  fr_error e = fr_scene_from_arrays(pos, nv, idx, nt, &sc);
-  if (e != FR_OK) { raise_fr(e, fr_last_error()); goto done; }
-  result = wrap_scene(type, sc, smooth);
-done:
-  free(idx);
-  Py_DECREF(v);
-  Py_DECREF(t);
+  fr_error e = fr_scene_from_buffers(pos, nv, 0, PyArray_DATA(t), nt, 0, FR_SHARE_BUFFERS, &sc);
+  if (e != FR_OK) {
+    Py_DECREF(v);
+    Py_DECREF(t);
+    return raise_fr(e, fr_last_error());
+  }
+  PyObject *result = wrap_scene(type, sc, smooth);
+  if (!result) {
+    Py_DECREF(v);
+    Py_DECREF(t);
+    return NULL;
+  }
+  ((SceneObject *)result)->shared_vertices = (PyObject *)v;
+  ((SceneObject *)result)->shared_triangles = (PyObject *)t;
   return result;
 }
 
@@ -176,7 +209,7 @@ static PyObject *scene_builtin(PyObject *cls, PyObject *args, PyObject *kw) {
 }
 
 static void scene_dealloc(SceneObject *s) {
-  if (s->scene) fr_scene_release(s->scene);
+  scene_release(s);
   Py_TYPE(s)->tp_free((PyObject *)s);
 }
 
@@ -186,8 +219,7 @@ static PyObject *scene_close(SceneObject *s, PyObject *unused) {
     PyErr_SetString(PyExc_RuntimeError, "close: the scene is being traced by another thread");
     return NULL;
   }
-  if (s->scene) fr_scene_release(s->scene);
-  s->scene = NULL;
+  scene_release(s);
   Py_RETURN_NONE;
 }
 
