@@ -1,6 +1,6 @@
-/* frusta's renderers from a program: the built-in scene, path traced, as a
- * PPM image (the file named by the first argument, or none) of display
- * values, written as they are (no sRGB encoding: a quick look). */
+/* frusta's renderers from a program: the built-in scene, path traced, and
+ * saved (PNG, EXR or PFM by the first argument's extension, if given) as
+ * display values. */
 #include <stdio.h>
 #include <stdlib.h>
 #include "frusta.h"
@@ -25,14 +25,10 @@ int main(int argc, char **argv) {
   double mean = 0.0;
   for (int i = 0; i < W * H * 3; i++) mean += rgb[i] / (W * H * 3);
   printf("path traced %dx%d, %d spp in %d passes, mean %.3f\n", W, H, fr_renderer_spp(r), passes, mean);
-  FILE *f = argc > 1 ? fopen(argv[1], "wb") : NULL;
-  if (f) {
-    fprintf(f, "P6\n%d %d\n255\n", W, H);
-    for (int i = 0; i < W * H * 3; i++) fputc((int)(rgb[i] * 255.0f + 0.5f), f);
-    fclose(f);
-  }
+  const int saved = argc < 2 || fr_image_save(argv[1], W, H, rgb) == FR_OK;
+  if (!saved) fprintf(stderr, "frusta: %s\n", fr_last_error());
   fr_renderer_release(r);
   fr_scene_release(s);
   free(rgb);
-  return mean > 0.05 ? 0 : 1;
+  return saved && mean > 0.05 ? 0 : 1;
 }

@@ -386,6 +386,15 @@ fr_error fr_renderer_set_camera(fr_renderer *r, const fr_pinhole *camera);
  * renderer serves one thread at a time. */
 fr_error fr_renderer_image(fr_renderer *r, int display, float *rgb, float *albedo, float *normal, float *depth);
 
+/* ---- images ------------------------------------------------------------------------
+ * Writes width * height RGB floats (row 0 at the top) by path's extension:
+ * .png 8-bit sRGB of the values clamped to [0, 1] (display values, as
+ * fr_renderer_image gives with display 1); .exr linear half floats; .pfm
+ * linear floats. The file appears whole or not at all. May be called from
+ * several threads at once. Errors: FR_ERR_ARG (NULL, an empty image, an
+ * unknown extension), FR_ERR_IO, FR_ERR_NOMEM. */
+fr_error fr_image_save(const char *path, int width, int height, const float *rgb);
+
 #ifdef __cplusplus
 }
 #endif

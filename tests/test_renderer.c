@@ -3,10 +3,13 @@
  * to finite, non-black images with guides; one-pass shades are done at
  * once, progressive ones after spp / 16 (or spp / 8 for path) passes and
  * equal to the mean of their passes; the same description renders the
- * same bits twice and on 1 and 3 threads; a new camera restarts; errors.
+ * same bits twice and on 1 and 3 threads; a new camera restarts; errors;
+ * fr_image_save writes what the readers read back.
  * That it renders what `frusta render` does is checked from Python
  * (tests/python), byte for byte against the command.
  */
+#include <unistd.h>
+#include "io/image_read.h"
 #include "test_util.h"
 
 #define W 64
@@ -114,10 +117,60 @@ static void passes_camera_and_errors(void **state) {
   fr_scene_release(s);
 }
 
+/* fr_image_save writes what the image readers read back (EXR to half
+ * precision, PNG to a step of 8-bit sRGB) and PFM's floats exactly; bad
+ * arguments are refused and write nothing. */
+static void images_save(void **state) {
+  (void)state;
+  float img[W * H * 3];
+  for (int i = 0; i < W * H * 3; i++) img[i] = (float)(i % 97) / 96.0f;
+  char dir[] = "/tmp/frusta_image_save_XXXXXX";
+  assert_non_null(mkdtemp(dir));
+  char pfm[256], exr[256], png[256], bad[256];
+  snprintf(pfm, sizeof pfm, "%s/a.pfm", dir);
+  snprintf(exr, sizeof exr, "%s/a.exr", dir);
+  snprintf(png, sizeof png, "%s/a.png", dir);
+  snprintf(bad, sizeof bad, "%s/a.bmp", dir);
+  assert_int_equal(fr_image_save(pfm, W, H, img), FR_OK);
+  assert_int_equal(fr_image_save(exr, W, H, img), FR_OK);
+  assert_int_equal(fr_image_save(png, W, H, img), FR_OK);
+  int w, h;
+  float *back;
+  assert_int_equal(fr_image_read(exr, &w, &h, &back), FR_OK);
+  assert_int_equal(w, W);
+  assert_int_equal(h, H);
+  for (int i = 0; i < W * H * 3; i++) assert_true(fabsf(back[i] - img[i]) <= 1e-3f);
+  free(back);
+  assert_int_equal(fr_image_read_ldr(png, &w, &h, &back), FR_OK); /* 8-bit sRGB: within a step */
+  for (int i = 0; i < W * H * 3; i++) assert_true(fabsf(back[i] - img[i]) <= 0.01f);
+  free(back);
+  FILE *f = fopen(pfm, "rb"); /* a header, then the floats, bottom row first */
+  assert_non_null(f);
+  fseek(f, 0, SEEK_END);
+  const long size = ftell(f);
+  assert_true(size > W * H * 12 && size < W * H * 12 + 64);
+  float last[3];
+  fseek(f, size - 12, SEEK_SET);
+  assert_int_equal(fread(last, sizeof(float), 3, f), 3);
+  fclose(f);
+  assert_memory_equal(last, img + 3 * (W - 1), sizeof last); /* the top row's last pixel */
+  assert_int_equal(fr_image_save(bad, W, H, img), FR_ERR_ARG);
+  assert_int_equal(access(bad, F_OK), -1);
+  assert_int_equal(fr_image_save(png, 0, H, img), FR_ERR_ARG);
+  assert_int_equal(fr_image_save(NULL, W, H, img), FR_ERR_ARG);
+  assert_int_equal(fr_image_save(png, W, H, NULL), FR_ERR_ARG);
+  char missing[300];
+  snprintf(missing, sizeof missing, "%s/no/such/dir/a.png", dir);
+  assert_int_equal(fr_image_save(missing, W, H, img), FR_ERR_IO);
+  remove(pfm), remove(exr), remove(png);
+  rmdir(dir);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(every_shade),
       cmocka_unit_test(passes_camera_and_errors),
+      cmocka_unit_test(images_save),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

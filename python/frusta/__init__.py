@@ -14,11 +14,11 @@ direction raises ValueError. Calls release the GIL and trace on all cores
 """
 from collections import namedtuple
 
-from ._frusta import INVALID_ID, VERSION_MAJOR, VERSION_MINOR, get_threads, isa, set_threads
+from ._frusta import INVALID_ID, VERSION_MAJOR, VERSION_MINOR, get_threads, isa, save_image, set_threads
 from ._frusta import Scene as _Scene
 
 __version__ = f"{VERSION_MAJOR}.{VERSION_MINOR}"
-__all__ = ["Scene", "Hits", "AllHits", "Image", "INVALID_ID", "set_threads", "get_threads", "isa", "to_srgb8"]
+__all__ = ["Scene", "Hits", "AllHits", "Image", "INVALID_ID", "set_threads", "get_threads", "isa", "to_srgb8", "save_image"]
 
 Hits = namedtuple("Hits", "t prim u v normal")
 Hits.__doc__ = """Closest hits: t (float32, inf on a miss), prim (uint32 triangle number,

@@ -13,6 +13,7 @@
 #include <Python.h>
 #define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
 #include <numpy/arrayobject.h>
+#include <limits.h>
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
@@ -870,7 +871,34 @@ static PyObject *isa(PyObject *m, PyObject *unused) {
   return PyUnicode_FromString(fr_isa_name(fr_get_isa()));
 }
 
+/* save_image(path, rgb): an (h, w, 3) float image through fr_image_save. */
+static PyObject *save_image(PyObject *m, PyObject *args) {
+  (void)m;
+  PyObject *path, *img;
+  if (!PyArg_ParseTuple(args, "O&O", PyUnicode_FSConverter, &path, &img)) return NULL;
+  PyArrayObject *a = vec3_array(img, "rgb");
+  if (!a) { Py_DECREF(path); return NULL; }
+  if (PyArray_NDIM(a) != 3 || PyArray_DIM(a, 0) < 1 || PyArray_DIM(a, 1) < 1 || PyArray_DIM(a, 0) > INT_MAX ||
+      PyArray_DIM(a, 1) > INT_MAX) {
+    Py_DECREF(path);
+    Py_DECREF(a);
+    return PyErr_Format(PyExc_ValueError, "rgb: expected shape (height, width, 3)");
+  }
+  const int h = (int)PyArray_DIM(a, 0), w = (int)PyArray_DIM(a, 1);
+  fr_error e;
+  Py_BEGIN_ALLOW_THREADS
+  e = fr_image_save(PyBytes_AS_STRING(path), w, h, PyArray_DATA(a));
+  Py_END_ALLOW_THREADS
+  Py_DECREF(path);
+  Py_DECREF(a);
+  if (e != FR_OK) return raise_fr(e, fr_last_error());
+  Py_RETURN_NONE;
+}
+
 static PyMethodDef module_methods[] = {
+    {"save_image", save_image, METH_VARARGS,
+     "save_image(path, rgb): writes an (h, w, 3) float image by the extension: .png (8-bit sRGB of display "
+     "values in [0, 1]), .exr, .pfm (linear)"},
     {"set_threads", set_threads, METH_VARARGS, "set_threads(n): threads per call (0: all cores)"},
     {"get_threads", get_threads, METH_NOARGS, "threads a call uses"},
     {"isa", isa, METH_NOARGS, "the instruction set the kernels use"},

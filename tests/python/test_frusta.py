@@ -555,6 +555,22 @@ def test_render_equals_the_command(tmp_path, shade, spp):
     assert got.spp == {"eyelight": 1, "normals": 1, "shadows": 1, "whitted": 1}.get(shade, spp)
 
 
+def test_save_image(tmp_path):
+    rgb = np.random.default_rng(3).random((12, 20, 3)).astype(np.float32)
+    for ext in ("png", "exr", "pfm"):
+        frusta.save_image(str(tmp_path / f"a.{ext}"), rgb)
+        assert (tmp_path / f"a.{ext}").stat().st_size > 0
+    raw = (tmp_path / "a.pfm").read_bytes()  # a header, then the rows bottom first
+    assert np.array_equal(np.frombuffer(raw[-20 * 3 * 4:], "<f4").reshape(20, 3), rgb[0])
+    with pytest.raises(ValueError):
+        frusta.save_image(str(tmp_path / "a.bmp"), rgb)
+    with pytest.raises(ValueError):
+        frusta.save_image(str(tmp_path / "b.png"), rgb[:, :, :2])
+    with pytest.raises(OSError):
+        frusta.save_image(str(tmp_path / "no" / "dir.png"), rgb)
+    assert not (tmp_path / "a.bmp").exists()
+
+
 def test_render_options_and_errors():
     scene = frusta.Scene.builtin()
     a = scene.render(48, 32, "eyelight", eye=(0, 3, 9), at=(0, 0.5, 0), fov=40)
