@@ -8,7 +8,8 @@
  *   - sobol: the first two Sobol dimensions, Owen-scrambled and shuffled by
  *     hashing (Burley, "Practical Hash-based Owen Scrambling", 2020).
  * Points depend on (seed, pixel, i, n, d) only: the same for any thread,
- * tile order or trace mode.
+ * tile order or trace mode. fr_sample2d is inline: a path takes three or
+ * four points per bounce, and inlined their hash chains overlap.
  */
 #ifndef FR_RENDER_SAMPLER_H
 #define FR_RENDER_SAMPLER_H
@@ -16,9 +17,89 @@
 
 typedef enum fr_sampler_kind { FR_SAMPLER_HAMMERSLEY, FR_SAMPLER_SOBOL, FR_SAMPLER_COUNT } fr_sampler_kind;
 
-/* A pixel's key, made once per pixel from the seed. */
-uint32_t fr_sampler_pixel_key(uint32_t seed, uint32_t pixel);
-void fr_sample2d(fr_sampler_kind k, uint32_t pixel_key, uint32_t i, uint32_t n, uint32_t d, float *u1, float *u2);
 const char *fr_sampler_name(fr_sampler_kind k);
 int fr_sampler_parse(const char *name, fr_sampler_kind *k);
+
+static inline uint32_t fr_sampler_mix(uint32_t h) {
+  h ^= h >> 16; h *= 0x21f0aaadu; h ^= h >> 15; h *= 0x735a2d97u; h ^= h >> 15;
+  return h;
+}
+
+/* A pixel's key, made once per pixel from the seed. */
+static inline uint32_t fr_sampler_pixel_key(uint32_t seed, uint32_t pixel) {
+  return fr_sampler_mix(seed ^ fr_sampler_mix(pixel + 0x9e3779b9u));
+}
+
+static inline uint32_t fr_sampler_reverse(uint32_t x) {
+  x = __builtin_bswap32(x); /* the bytes, then the bits within each */
+  x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
+  x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
+  return ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
+}
+
+static inline float fr_sampler_unit(uint32_t x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
+
+/* A bijection of [0, n) keyed by key: a bijection of the enclosing power of
+ * two (xor, odd multiply and xorshift, each invertible modulo it), walked
+ * until it lands below n. */
+static inline uint32_t fr_sampler_permute(uint32_t i, uint32_t n, uint32_t key) {
+  if (n <= 1) return 0;
+  const unsigned bits = 32u - (unsigned)__builtin_clz(n - 1);
+  const uint32_t mask = bits >= 32 ? 0xffffffffu : (1u << bits) - 1u;
+  const unsigned sh = bits / 2u + 1u;
+  do {
+    i = (i ^ key) & mask;
+    i = (i * 0x2c1b3c6du) & mask;
+    i ^= i >> sh;
+    i = (i * 0x297a2d39u) & mask;
+    i ^= (i >> 3) & mask;
+    i = (i + (key >> 7)) & mask;
+  } while (i >= n);
+  return i;
+}
+
+/* Owen scrambling of a base-2 fraction by a Laine-Karras style hash
+ * (bit k's flip depends on the bits above it only), of x given with its
+ * bits reversed: owen(x) = reverse(fr_sampler_owen_reversed(reverse(x))). */
+static inline uint32_t fr_sampler_owen_reversed(uint32_t x, uint32_t seed) {
+  x += seed;
+  x ^= x * 0x6c50b47cu;
+  x ^= x * 0xb82f1e52u;
+  x ^= x * 0xc7afe638u;
+  x ^= x * 0x8d22f6e6u;
+  return x;
+}
+
+/* Sobol's second dimension is linear in the index's bits, and so is its
+ * bit reversal, which the Owen scramble takes: byte tables (sampler.c)
+ * give reverse(sobol1(j)) from the bytes of jr = reverse(j), the shuffled
+ * index as it comes, so neither is reversed on the way. */
+extern uint32_t fr_sampler_rsobol1_bytes[4][256];
+static inline uint32_t fr_sampler_rsobol1(uint32_t jr) {
+  return fr_sampler_rsobol1_bytes[0][jr & 255u] ^ fr_sampler_rsobol1_bytes[1][(jr >> 8) & 255u] ^
+         fr_sampler_rsobol1_bytes[2][(jr >> 16) & 255u] ^ fr_sampler_rsobol1_bytes[3][jr >> 24];
+}
+
+static inline void fr_sample2d(fr_sampler_kind k, uint32_t pixel_key, uint32_t i, uint32_t n, uint32_t d, float *u1,
+                               float *u2) {
+  const uint32_t key = fr_sampler_mix(pixel_key + d * 0x51ed2705u);
+  if (k == FR_SAMPLER_SOBOL) {
+    /* the shuffled index j = owen(i, key), as its reversal jr */
+    const uint32_t jr = fr_sampler_owen_reversed(fr_sampler_reverse(i), key);
+    /* owen(reverse(j)) and owen(sobol1(j)) */
+    *u1 = fr_sampler_unit(fr_sampler_reverse(
+        fr_sampler_owen_reversed(fr_sampler_reverse(jr), fr_sampler_mix(key ^ 0x68e31da4u))));
+    *u2 = fr_sampler_unit(
+        fr_sampler_reverse(fr_sampler_owen_reversed(fr_sampler_rsobol1(jr), fr_sampler_mix(key ^ 0xb5297a4du))));
+    return;
+  }
+  const uint32_t j = fr_sampler_permute(i, n, key);
+  /* (j + r) / n with one random offset r per pattern, and the radical
+   * inverse with its bits flipped by a random mask: both keep the
+   * pattern's strata */
+  const float r = fr_sampler_unit(fr_sampler_mix(key ^ 0x1b56c4e9u));
+  float x = ((float)j + r) / (float)n;
+  *u1 = x < 1.0f ? x : 0.99999994f;
+  *u2 = fr_sampler_unit(fr_sampler_reverse(j) ^ fr_sampler_mix(key ^ 0x7f4a7c15u));
+}
 #endif
