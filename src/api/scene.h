@@ -69,6 +69,13 @@ int fr_scene_shading_normal(const fr_scene *s, uint32_t prim, float u, float v, 
 /* The texture coordinates of triangle prim at barycentrics (u, v); 0
  * where it has none. */
 int fr_scene_texcoord(const fr_scene *s, uint32_t prim, float u, float v, float st[2]);
+/* Starts loading what the two calls above read of triangle prim (its
+ * corners' normal and texture indices), for a shader a few hits ahead. */
+static inline void fr_scene_prefetch_shading(const fr_scene *s, uint32_t prim) {
+  if (prim >= s->mesh.ntris) return;
+  if (s->mesh.nrm.idx) __builtin_prefetch(s->mesh.nrm.idx + 3 * (size_t)prim);
+  if (s->mesh.uv.idx) __builtin_prefetch(s->mesh.uv.idx + 3 * (size_t)prim);
+}
 /* Triangle prim's unnormalized normal (v1 - v0) x (v2 - v0) made in double
  * and rounded once, the bits the kernels report (fr_tri_normal_lane). */
 static inline void fr_scene_triangle_normal(const fr_scene *s, uint32_t prim, float ng[3]) {

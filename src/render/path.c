@@ -18,6 +18,9 @@
 #include "render/tile.h"
 
 #define WAVE (TILE_PIX * FR_PATH_CHUNK)
+/* The shader loads a hit's surface record and corner indices this many
+ * hits ahead: they are scattered over the scene's arrays. */
+#define PREFETCH_AHEAD 8
 
 typedef struct path_state {
   vec3 weight;     /* throughput: what the radiance found next is multiplied by */
@@ -191,6 +194,13 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
       S->stage[depth ? FR_STAGE_SECONDARY : FR_STAGE_CAMERA] += t2 - t1;
       size_t nn = 0, ns = 0;
       for (size_t k = 0; k < n; k++) {
+        if (k + PREFETCH_AHEAD < n) {
+          const uint32_t ahead = S->hit[k + PREFETCH_AHEAD].prim;
+          if (ahead < P->nsurf) {
+            __builtin_prefetch(&P->surf[ahead]);
+            fr_scene_prefetch_shading(w->scene, ahead);
+          }
+        }
         path_state st = S->st[k];
         const fr_ray r = S->ray[k];
         const fr_hit h = S->hit[k];
