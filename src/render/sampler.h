@@ -80,8 +80,8 @@ static inline uint32_t fr_sampler_rsobol1(uint32_t jr) {
          fr_sampler_rsobol1_bytes[2][(jr >> 16) & 255u] ^ fr_sampler_rsobol1_bytes[3][jr >> 24];
 }
 
-static inline void fr_sample2d(fr_sampler_kind k, uint32_t pixel_key, uint32_t i, uint32_t n, uint32_t d, float *u1,
-                               float *u2) {
+static inline __attribute__((always_inline)) void fr_sample2d(fr_sampler_kind k, uint32_t pixel_key, uint32_t i,
+                                                             uint32_t n, uint32_t d, float *u1, float *u2) {
   const uint32_t key = fr_sampler_mix(pixel_key + d * 0x51ed2705u);
   if (k == FR_SAMPLER_SOBOL) {
     /* the shuffled index j = owen(i, key), as its reversal jr */
