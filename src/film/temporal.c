@@ -58,78 +58,116 @@ float fr_temporal_worth(const fr_temporal *t) { return t->mean_worth; }
 /* fr_camera is four vec3 of floats and two ints: no padding */
 static int same_camera(const fr_camera *a, const fr_camera *b) { return memcmp(a, b, sizeof *a) == 0; }
 
-/* Where direction d from c's eye meets c's image, in pixels (centres at
- * integers); 0 when it points away from the image plane. */
-static int project(const fr_camera *c, vec3 d, float *px, float *py) {
-  const float f = v3_dot(d, c->fwd);
-  if (!(f > 1e-6f * v3_len(d))) return 0;
-  const float sx = v3_dot(d, c->right) / (v3_dot(c->right, c->right) * f);
-  const float sy = v3_dot(d, c->up) / (v3_dot(c->up, c->up) * f);
-  *px = (sx + 1.0f) * 0.5f * (float)c->width - 0.5f;
-  *py = (1.0f - sy) * 0.5f * (float)c->height - 0.5f;
-  return isfinite(*px) && isfinite(*py);
-}
+/* The last frame's camera as reprojection uses it: a point's offset d
+ * from its eye meets its image at sx = (d . rs) / (d . fwd), sy the same
+ * with us (rs, us: right and up over their squared lengths). */
+typedef struct projector { vec3 eye, fwd, rs, us; float w, h; } projector;
 
-static vec3 unit_or_zero(vec3 v) {
-  const float l = v3_len(v);
-  return l > 0.0f ? v3_scale(v, 1.0f / l) : v3(0, 0, 0);
+static projector projector_of(const fr_camera *c) {
+  return (projector){c->eye, c->fwd, v3_scale(c->right, 1.0f / v3_dot(c->right, c->right)),
+                     v3_scale(c->up, 1.0f / v3_dot(c->up, c->up)), (float)c->width, (float)c->height};
 }
 
 /* The last frame shown, carried to cam: hist and hist_worth per pixel
- * (worth 0 where no earlier pixel is the same surface). */
+ * (worth 0 where no earlier pixel is the same surface). Row by row, first
+ * where each pixel's point falls in the last image (the directions made
+ * as remember() makes them, one root and one division each), then the
+ * four earlier pixels around it, each taken where it is the same surface
+ * (the normal and plane tests squared: no roots). */
 static void reproject(fr_temporal *t, const fr_camera *cam, const float *depth, const float *normal, int threads) {
   const int W = t->w, H = t->h;
-  const fr_camera *pc = &t->cam;
-  int reused = 0;
-#pragma omp parallel for schedule(static) num_threads(threads) reduction(+ : reused)
-  for (int y = 0; y < H; y++)
-    for (int x = 0; x < W; x++) {
-      const size_t i = (size_t)y * (size_t)W + (size_t)x;
-      float *hc = t->hist + 3 * i;
-      hc[0] = hc[1] = hc[2] = 0.0f;
-      t->hist_worth[i] = 0.0f;
-      const fr_ray r = fr_camera_ray(cam, x, y);
-      const int miss = !(depth[i] < MISS);
-      const vec3 dir = v3_load(r.dir);
-      /* the point seen, from the last camera: for the background, the same direction */
-      const vec3 p = v3_add(cam->eye, v3_scale(dir, depth[i]));
-      const vec3 d = miss ? dir : v3_sub(p, pc->eye);
-      const float dist = miss ? 0.0f : v3_len(d);
-      const vec3 n = unit_or_zero(v3_load(normal + 3 * i));
-      float fx, fy;
-      if (!project(pc, d, &fx, &fy) || fx < -0.5f || fy < -0.5f || fx > (float)W - 0.5f || fy > (float)H - 0.5f) continue;
-      /* bilinear over the four pixels around it, each only if the same surface */
-      const int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
-      const float ax = fx - (float)x0, ay = fy - (float)y0;
-      float sum = 0.0f, c[3] = {0, 0, 0}, worth = 0.0f;
-      for (int k = 0; k < 4; k++) {
-        const int qx = x0 + (k & 1), qy = y0 + (k >> 1);
-        if (qx < 0 || qy < 0 || qx >= W || qy >= H) continue;
-        const size_t q = (size_t)qy * (size_t)W + (size_t)qx;
-        const int qmiss = !(t->depth[q] < MISS);
-        if (qmiss != miss) continue;
-        /* the same surface: as far from the eye, facing alike, and the
-         * earlier point on this one's tangent plane (at grazing angles a
-         * neighbouring pixel of another surface can be as far away) */
-        if (!miss) {
-          const vec3 nq = v3_load(t->normal + 3 * q);
-          const float cn = v3_dot(nq, n); /* n is unit, nq need not be */
-          if (!(fabsf(t->depth[q] - dist) <= FR_TEMPORAL_DEPTH_TOL * dist) ||
-              !(cn > 0.0f && cn * cn >= FR_TEMPORAL_NORMAL_COS * FR_TEMPORAL_NORMAL_COS * v3_dot(nq, nq)) ||
-              !(fabsf(v3_dot(v3_sub(v3_load(t->pos + 3 * q), p), n)) <= FR_TEMPORAL_PLANE_TOL * dist))
-            continue;
-        }
-        const float wk = ((k & 1) ? ax : 1.0f - ax) * ((k >> 1) ? ay : 1.0f - ay);
-        sum += wk;
-        worth += wk * t->worth[q];
-        for (int ch = 0; ch < 3; ch++) c[ch] += wk * t->out[3 * q + ch];
+  const projector pc = projector_of(&t->cam);
+  const vec3 e = cam->eye, f = cam->fwd, r = cam->right, u = cam->up;
+  const float ff = v3_dot(f, f), rr = v3_dot(r, r), uu = v3_dot(u, u);
+  const float cos2 = FR_TEMPORAL_NORMAL_COS * FR_TEMPORAL_NORMAL_COS, plane2 = FR_TEMPORAL_PLANE_TOL * FR_TEMPORAL_PLANE_TOL;
+  const float hw = 0.5f * pc.w, hh = 0.5f * pc.h, xmax = pc.w - 0.5f, ymax = pc.h - 0.5f;
+  int reused = 0, failed = 0;
+#pragma omp parallel num_threads(threads) reduction(+ : reused, failed)
+  {
+    /* per row: the point seen (p), its distance from the last eye and its
+     * place in the last image (fx, fy; NaN where it has none) */
+    float *row = malloc((size_t)W * 6 * sizeof(float));
+    float *px = row, *py = px + W, *pz = py + W, *dist = pz + W, *fxs = dist + W, *fys = fxs + W;
+    if (!row) failed = 1;
+#pragma omp for schedule(static)
+    for (int y = 0; y < H; y++) {
+      const size_t i0 = (size_t)y * (size_t)W;
+      for (int x = 0; x < W; x++) {
+        float *hc = t->hist + 3 * (i0 + (size_t)x);
+        hc[0] = hc[1] = hc[2] = 0.0f;
+        t->hist_worth[i0 + (size_t)x] = 0.0f;
       }
-      if (!(sum > 1e-3f)) continue;
-      for (int ch = 0; ch < 3; ch++) hc[ch] = c[ch] / sum;
-      t->hist_worth[i] = worth / sum;
-      reused++;
+      if (!row) continue;
+      const float sy = 1.0f - 2.0f * ((float)y + 0.5f) / (float)H;
+      const float bx = f.x + u.x * sy, by = f.y + u.y * sy, bz = f.z + u.z * sy, b2 = ff + uu * sy * sy;
+      const float *dep = depth + i0;
+      for (int x = 0; x < W; x++) {
+        const float sx = 2.0f * ((float)x + 0.5f) / (float)W - 1.0f;
+        const float k = 1.0f / sqrtf(b2 + rr * sx * sx);
+        const float dx = (bx + r.x * sx) * k, dy = (by + r.y * sx) * k, dz = (bz + r.z * sx) * k; /* unit */
+        const float dv = dep[x];
+        const int hit = dv < MISS;
+        const float z = hit ? dv : 0.0f;
+        const float qx = e.x + dx * z, qy = e.y + dy * z, qz = e.z + dz * z;
+        px[x] = qx, py[x] = qy, pz[x] = qz;
+        /* the background: the same direction */
+        const vec3 o = hit ? v3(qx - pc.eye.x, qy - pc.eye.y, qz - pc.eye.z) : v3(dx, dy, dz);
+        const float len = v3_len(o);
+        dist[x] = len;
+        const float fw = v3_dot(o, pc.fwd), inv = 1.0f / fw;
+        const float fx = (v3_dot(o, pc.rs) * inv + 1.0f) * hw - 0.5f;
+        const float fy = (1.0f - v3_dot(o, pc.us) * inv) * hh - 0.5f;
+        const int in = (fw > 1e-6f * len) & (fx >= -0.5f) & (fy >= -0.5f) & (fx <= xmax) & (fy <= ymax);
+        fxs[x] = in ? fx : NAN;
+        fys[x] = fy;
+      }
+      for (int x = 0; x < W; x++) {
+        const float fx = fxs[x], fy = fys[x];
+        if (!(fx == fx)) continue;
+        const size_t i = i0 + (size_t)x;
+        const int miss = !(dep[x] < MISS);
+        const vec3 p = v3(px[x], py[x], pz[x]);
+        const float dd = dist[x];
+        const vec3 n = v3_load(normal + 3 * i); /* not unit */
+        const float nn = v3_dot(n, n);
+        /* bilinear over the four pixels around it (fx, fy >= -0.5: the
+         * truncations of fx + 1 and fy + 1 are their floors plus 1) */
+        const int x0 = (int)(fx + 1.0f) - 1, y0 = (int)(fy + 1.0f) - 1;
+        const float ax = fx - (float)x0, ay = fy - (float)y0;
+        float sum = 0.0f, c[3] = {0, 0, 0}, worth = 0.0f;
+        for (int k = 0; k < 4; k++) {
+          const int qx = x0 + (k & 1), qy = y0 + (k >> 1);
+          if (qx < 0 || qy < 0 || qx >= W || qy >= H) continue;
+          const size_t q = (size_t)qy * (size_t)W + (size_t)qx;
+          const int qmiss = !(t->depth[q] < MISS);
+          if (qmiss != miss) continue;
+          /* the same surface: as far from the eye, facing alike, and the
+           * earlier point on this one's tangent plane (at grazing angles a
+           * neighbouring pixel of another surface can be as far away) */
+          if (!miss) {
+            const vec3 nq = v3_load(t->normal + 3 * q);
+            const float cn = v3_dot(nq, n), pl = v3_dot(v3_sub(v3_load(t->pos + 3 * q), p), n);
+            if (!(fabsf(t->depth[q] - dd) <= FR_TEMPORAL_DEPTH_TOL * dd) ||
+                !(cn > 0.0f && cn * cn >= cos2 * v3_dot(nq, nq) * nn) || !(pl * pl <= plane2 * dd * dd * nn))
+              continue;
+          }
+          const float wk = ((k & 1) ? ax : 1.0f - ax) * ((k >> 1) ? ay : 1.0f - ay);
+          sum += wk;
+          worth += wk * t->worth[q];
+          for (int ch = 0; ch < 3; ch++) c[ch] += wk * t->out[3 * q + ch];
+        }
+        if (!(sum > 1e-3f)) continue;
+        const float inv = 1.0f / sum;
+        float *hc = t->hist + 3 * i;
+        for (int ch = 0; ch < 3; ch++) hc[ch] = c[ch] * inv;
+        t->hist_worth[i] = worth * inv;
+        reused++;
+      }
     }
-  t->reused = (float)reused / (float)((size_t)W * (size_t)H);
+    free(row);
+  }
+  /* without scratch no pixel carries over: the frame starts afresh */
+  t->reused = failed ? 0.0f : (float)reused / (float)((size_t)W * (size_t)H);
 }
 
 /* Keeps the frame shown (rgb, its guides and the points seen) for the
@@ -140,18 +178,18 @@ static void reproject(fr_temporal *t, const fr_camera *cam, const float *depth, 
 static void remember(fr_temporal *t, const fr_camera *cam, const float *rgb, const float *depth, const float *normal,
                      int threads) {
   const int W = t->w, H = t->h;
-  const size_t np = (size_t)W * (size_t)H;
-  memcpy(t->out, rgb, np * 3 * sizeof(float));
-  memcpy(t->depth, depth, np * sizeof(float));
-  memcpy(t->normal, normal, np * 3 * sizeof(float));
   const vec3 e = cam->eye, f = cam->fwd, r = cam->right, u = cam->up;
   const float ff = v3_dot(f, f), rr = v3_dot(r, r), uu = v3_dot(u, u);
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (int y = 0; y < H; y++) {
     const float sy = 1.0f - 2.0f * ((float)y + 0.5f) / (float)H;
     const float bx = f.x + u.x * sy, by = f.y + u.y * sy, bz = f.z + u.z * sy, b2 = ff + uu * sy * sy;
-    const float *dep = depth + (size_t)y * (size_t)W;
-    float *pos = t->pos + 3 * (size_t)y * (size_t)W;
+    const size_t row = (size_t)y * (size_t)W;
+    memcpy(t->out + 3 * row, rgb + 3 * row, (size_t)W * 3 * sizeof(float));
+    memcpy(t->depth + row, depth + row, (size_t)W * sizeof(float));
+    memcpy(t->normal + 3 * row, normal + 3 * row, (size_t)W * 3 * sizeof(float));
+    const float *dep = depth + row;
+    float *pos = t->pos + 3 * row;
     for (int x = 0; x < W; x++) {
       const float sx = 2.0f * ((float)x + 0.5f) / (float)W - 1.0f;
       const float k = dep[x] / sqrtf(b2 + rr * sx * sx);
@@ -194,8 +232,10 @@ void fr_temporal_apply(fr_temporal *t, const fr_camera *cam, int passes, const f
     }
   }
   double wsum = 0.0;
-  if (t->have_hist && fade > 0.0f)
+  if (t->have_hist && fade > 0.0f) {
+#pragma omp parallel for schedule(static) num_threads(threads) reduction(+ : wsum)
     for (size_t i = 0; i < np; i++) wsum += t->hist_worth[i] * fade;
+  }
   t->mean_worth = (float)(wsum / (double)np / k);
   remember(t, cam, rgb, depth, normal, threads);
 }
