@@ -74,7 +74,8 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
   fr_mft_sets_camera(&sets[1], &w->cam);
   run.light_sets = &sets[0];
   run.camera_set = &sets[1];
-  const int whitted = w->kind == FR_WL_WHITTED, tile = whitted ? FR_WHITTED_TILE : TILE;
+  const int whitted = w->kind == FR_WL_WHITTED;
+  const int tile = whitted ? FR_WHITTED_TILE : w->kind == FR_WL_PATH ? FR_PATH_TILE : TILE;
   const int tiles_x = (w->cam.width + tile - 1) / tile, tiles_y = (w->cam.height + tile - 1) / tile;
   const int ntiles = tiles_x * tiles_y;
   uint64_t total = 0;

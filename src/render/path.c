@@ -17,7 +17,9 @@
 #include "render/surfaces.h"
 #include "render/tile.h"
 
-#define WAVE (TILE_PIX * FR_PATH_CHUNK)
+#define TILE_PATHS (FR_PATH_TILE * FR_PATH_TILE)
+#define WAVE_SPP 2 /* samples per pixel in one wave */
+#define WAVE (TILE_PATHS * WAVE_SPP)
 /* The shader loads a hit's surface record and corner indices this many
  * hits ahead: they are scattered over the scene's arrays. */
 #define PREFETCH_AHEAD 8
@@ -27,7 +29,7 @@ typedef struct path_state {
   float pdf;       /* solid-angle pdf of the BSDF sample that made the ray (for MIS at an emitter it hits) */
   uint32_t sample; /* sample index within the pixel */
   uint32_t key;    /* the pixel's sampler key */
-  uint16_t slot;   /* (sample - first sample of the wave) * TILE_PIX + pixel within the tile */
+  uint16_t slot;   /* (sample - first sample of the wave) * the tile's pixels + pixel within the tile */
   uint8_t delta;   /* the ray left a delta lobe (or the camera): emitters it hits count whole */
   uint8_t depth;   /* segments before this one */
 } path_state;
@@ -136,11 +138,12 @@ static int nonzero(vec3 c) { return c.x > 0.0f || c.y > 0.0f || c.z > 0.0f; }
 
 static void add3(float *dst, vec3 v) { dst[0] += v.x, dst[1] += v.y, dst[2] += v.z; }
 
-/* Pixel i of a tile, in blocks of 4x4 (consecutive 16 are coherent). */
-static void tile_pixel(int i, int *x, int *y) {
-  const int b = i / 16, k = i % 16;
-  *x = 4 * (b % 4) + k % 4;
-  *y = 4 * (b / 4) + k / 4;
+/* Pixel i of a tile of the given side, in blocks of 4x4 (consecutive 16
+ * are coherent). */
+static void tile_pixel(int i, int side, int *x, int *y) {
+  const int b = i / 16, k = i % 16, per_row = side / 4;
+  *x = 4 * (b % per_row) + k % 4;
+  *y = 4 * (b / per_row) + k / 4;
 }
 
 uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch *S, int tx, int ty) {
@@ -153,19 +156,20 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
   const int nlights = light_count(L);
   uint64_t rays = 0;
   const vec3 ru = v3_norm(c->right), uu = v3_norm(c->up);
-  for (int s0 = P->spp_begin; s0 < P->spp_end; s0 += FR_PATH_CHUNK) {
-    const int s1 = s0 + FR_PATH_CHUNK < P->spp_end ? s0 + FR_PATH_CHUNK : P->spp_end;
+  const int side = FR_PATH_TILE, npix = TILE_PATHS;
+  for (int s0 = P->spp_begin; s0 < P->spp_end; s0 += WAVE_SPP) {
+    const int s1 = s0 + WAVE_SPP < P->spp_end ? s0 + WAVE_SPP : P->spp_end;
     double t0 = fr_seconds();
-    const size_t nslot = (size_t)(s1 - s0) * TILE_PIX;
+    const size_t nslot = (size_t)(s1 - s0) * (size_t)npix;
     memset(S->acc, 0, nslot * sizeof S->acc[0]);
     memset(S->alb, 0, nslot * sizeof S->alb[0]);
     memset(S->nrm, 0, nslot * sizeof S->nrm[0]);
     for (size_t k = 0; k < nslot; k++) S->dep[k] = FR_PATH_DEPTH_MISS;
     size_t n = 0;
     for (int s = s0; s < s1; s++)
-      for (int i = 0; i < TILE_PIX; i++) {
+      for (int i = 0; i < npix; i++) {
         int x, y;
-        tile_pixel(i, &x, &y);
+        tile_pixel(i, side, &x, &y);
         x += tx, y += ty;
         if (x >= W || y >= H) continue;
         const uint32_t key = fr_sampler_pixel_key(seed, (uint32_t)y * (uint32_t)W + (uint32_t)x);
@@ -182,7 +186,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
           d = v3_sub(focus, o);
         }
         S->ray[n] = make_ray(o, v3_norm(d), 0.0f, INFINITY);
-        S->st[n] = (path_state){v3(1, 1, 1), 0.0f, (uint32_t)s, key, (uint16_t)((s - s0) * TILE_PIX + i), 1, 0};
+        S->st[n] = (path_state){v3(1, 1, 1), 0.0f, (uint32_t)s, key, (uint16_t)((s - s0) * npix + i), 1, 0};
         n++;
       }
     for (int depth = 0; n; depth++) {
@@ -324,14 +328,14 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
       S->stage[FR_STAGE_SHADOW] += t0 - t3;
       n = nn;
     }
-    for (int i = 0; i < TILE_PIX; i++) {
+    for (int i = 0; i < npix; i++) {
       int x, y;
-      tile_pixel(i, &x, &y);
+      tile_pixel(i, side, &x, &y);
       x += tx, y += ty;
       if (x >= W || y >= H) continue;
       const size_t px = (size_t)y * (size_t)W + (size_t)x, o = 3 * px;
       for (int s = 0; s < s1 - s0; s++) {
-        const size_t k = (size_t)s * TILE_PIX + (size_t)i;
+        const size_t k = (size_t)s * (size_t)npix + (size_t)i;
         if (w->image) add3(w->image + o, S->acc[k]);
         if (w->gbuf_albedo) add3(w->gbuf_albedo + o, S->alb[k]);
         if (w->gbuf_normal) add3(w->gbuf_normal + o, S->nrm[k]);
