@@ -62,6 +62,11 @@ static void finish_tile(tile_queue *q, int slot) {
   omp_unset_lock(&q->lock);
 }
 
+int fr_workload_tile_side(const fr_workload *w) {
+  if (w->kind == FR_WL_WHITTED) return FR_WHITTED_TILE;
+  return w->kind == FR_WL_PATH && w->path ? fr_path_tile_side(w->path) : TILE;
+}
+
 fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
   fr_workload_result res = {0, 0.0, {0}, 0, 0};
   /* the ray sets of this frame, shared by every tile */
@@ -75,7 +80,7 @@ fr_workload_result fr_workload_run(const fr_workload *w0, const fr_tracer *t) {
   run.light_sets = &sets[0];
   run.camera_set = &sets[1];
   const int whitted = w->kind == FR_WL_WHITTED;
-  const int tile = whitted ? FR_WHITTED_TILE : w->kind == FR_WL_PATH ? FR_PATH_TILE : TILE;
+  const int tile = fr_workload_tile_side(w);
   const int tiles_x = (w->cam.width + tile - 1) / tile, tiles_y = (w->cam.height + tile - 1) / tile;
   const int ntiles = tiles_x * tiles_y;
   uint64_t total = 0;

@@ -17,9 +17,10 @@
 #include "render/surfaces.h"
 #include "render/tile.h"
 
-#define TILE_PATHS (FR_PATH_TILE * FR_PATH_TILE)
-#define WAVE_SPP 2 /* samples per pixel in one wave */
-#define WAVE (TILE_PATHS * WAVE_SPP)
+/* A wave: a tile's paths for up to FR_PATH_CHUNK samples per pixel, or a
+ * wide tile's for FR_PATH_WIDE_SPP */
+#define WAVE (TILE_PIX * FR_PATH_CHUNK)
+_Static_assert(FR_PATH_WIDE_TILE * FR_PATH_WIDE_TILE * FR_PATH_WIDE_SPP == WAVE, "a wide tile's wave is as large");
 /* The shader loads a hit's surface record and corner indices this many
  * hits ahead: they are scattered over the scene's arrays. */
 #define PREFETCH_AHEAD 8
@@ -146,6 +147,10 @@ static void tile_pixel(int i, int side, int *x, int *y) {
   *y = 4 * (b / per_row) + k / 4;
 }
 
+int fr_path_tile_side(const fr_path_setup *P) {
+  return P->spp_end - P->spp_begin <= FR_PATH_WIDE_SPP ? FR_PATH_WIDE_TILE : TILE;
+}
+
 uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch *S, int tx, int ty) {
   const fr_path_setup *P = w->path;
   const fr_path_lights *L = &P->lights;
@@ -156,9 +161,9 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
   const int nlights = light_count(L);
   uint64_t rays = 0;
   const vec3 ru = v3_norm(c->right), uu = v3_norm(c->up);
-  const int side = FR_PATH_TILE, npix = TILE_PATHS;
-  for (int s0 = P->spp_begin; s0 < P->spp_end; s0 += WAVE_SPP) {
-    const int s1 = s0 + WAVE_SPP < P->spp_end ? s0 + WAVE_SPP : P->spp_end;
+  const int side = fr_path_tile_side(P), npix = side * side, chunk = WAVE / npix;
+  for (int s0 = P->spp_begin; s0 < P->spp_end; s0 += chunk) {
+    const int s1 = s0 + chunk < P->spp_end ? s0 + chunk : P->spp_end;
     double t0 = fr_seconds();
     const size_t nslot = (size_t)(s1 - s0) * (size_t)npix;
     memset(S->acc, 0, nslot * sizeof S->acc[0]);

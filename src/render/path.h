@@ -20,12 +20,14 @@
 #include "render/sampler.h"
 
 #define FR_PATH_CHUNK 8          /* samples per pixel in one pass of frusta render and fr_renderer */
-/* The path tracer's tiles are FR_PATH_TILE pixels square: a pass of one
- * sample per pixel still sends a thousand paths a wave (16x16 tiles sent
- * 256, 7% slower at 1 spp; at 4 and 16 spp the two are level). One size
- * for every pass, so that an image's rays meet the tracer in the same
- * groups however its samples are split into passes. */
-#define FR_PATH_TILE 32
+/* A pass of at most FR_PATH_WIDE_SPP samples per pixel (a viewer frame)
+ * takes tiles of FR_PATH_WIDE_TILE pixels square, so that its waves still
+ * hold a thousand paths (16x16 tiles sent 256: 7% slower at 1 spp); longer
+ * passes take TILE, as the other workloads: at 4 and 16 spp the two are
+ * level, and small tiles keep a cluster's last tile of a long frame short
+ * (docs/scaling.md). */
+#define FR_PATH_WIDE_SPP 2
+#define FR_PATH_WIDE_TILE 32
 #define FR_PATH_RR_WEIGHT 0.15f
 #define FR_PATH_MAX_DEPTH 64
 #define FR_PATH_DEPTH_MISS 1e30f /* the depth AOV of a sample that sees the environment */
@@ -77,4 +79,6 @@ void fr_path_scratch_stages(const fr_path_scratch *s, double *stage);
  * Each pixel's samples are added one by one in sample order, so a run of
  * samples split into calls any way sums to the same bits. */
 uint64_t fr_path_tile(const struct fr_workload *w, const struct fr_tracer *t, fr_path_scratch *s, int tx, int ty);
+/* The side of the tiles a pass of P takes (see FR_PATH_WIDE_TILE). */
+int fr_path_tile_side(const fr_path_setup *P);
 #endif

@@ -108,6 +108,9 @@ typedef struct fr_workload_result {
 } fr_workload_result;
 
 fr_workload_result fr_workload_run(const fr_workload *w, const fr_tracer *t);
+/* The side of the square tiles fr_workload_run cuts w's frame into: 16,
+ * 32 for Whitted and for path passes of few samples (render/path.h). */
+int fr_workload_tile_side(const fr_workload *w);
 
 /* Camera rays of the full 16x16 tile at (tx, ty) by multi-frusta tracing
  * (t->intersect_frusta): ray and hit 16 f + k are pixel (tx + 4 (f % 4) +

@@ -113,7 +113,7 @@ static void report(const fr_workload *w0, const bench_run *r, const char *scene,
   if (r->tile_ms[0] > 0)
     printf("tiles tracer=%s mode=%s workload=%s tile=%d count=%.0f mean_ms=%.4f sd_ms=%.4f median_ms=%.4f p99_ms=%.4f "
            "max_ms=%.4f\n",
-           r->tracer, r->name, fr_workload_name(w0->kind), w0->kind == FR_WL_WHITTED ? FR_WHITTED_TILE : 16,
+           r->tracer, r->name, fr_workload_name(w0->kind), fr_workload_tile_side(w0),
            r->tile_ms[0], r->tile_ms[1], r->tile_ms[2], r->tile_ms[3], r->tile_ms[4], r->tile_ms[5]);
   printf("scene=%s tris=%zu workload=%s tracer=%s mode=%s threads=%d rays=%llu seconds=%.4f mrays=%.2f median_seconds=%.4f median_mrays=%.2f%s\n",
          scene, tris, fr_workload_name(w0->kind), tracer, mode, w0->threads, (unsigned long long)rays, best,
