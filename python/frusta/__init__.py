@@ -52,11 +52,11 @@ class Scene(_Scene):
     """Scene(vertices, triangles, smooth=0): a triangle mesh, ready to trace.
 
     vertices: (n, 3) floats; triangles: (m, 3) integer vertex indices.
-    C-contiguous float32 vertices and int32 or uint32 triangles are read in
-    place: the scene holds those arrays until it is closed, and they must
-    not change meanwhile (the tree is built on them); anything else is
-    converted once. Degenerate triangles are kept in the numbering but
-    never hit.
+    C-contiguous float32 vertices are read in place: the scene holds the
+    array until it is closed, and its values must not change meanwhile
+    (the tree is built on them); other vertices are converted once, and
+    the triangles are always copied and checked. Degenerate triangles are
+    kept in the numbering but never hit.
     Scene.load(path, smooth=30) reads PLY, OBJ and the formats Assimp reads
     (also .zst-compressed); Scene.builtin() is frusta's built-in scene.
     smooth: the crease angle in degrees of the shading normals render()

@@ -46,8 +46,9 @@ typedef struct {
   fr_scene *scene;
   int busy; /* calls tracing it now (changed with the GIL held) */
   /* the arrays a scene made from numpy arrays reads in place (the
-   * vertices as given where they are C-contiguous float32, the triangles
-   * as given or as a uint32 copy); held until the scene is released */
+   * vertices as given where they are C-contiguous float32, else a copy;
+   * the triangles always its own checked copy); held until the scene is
+   * released */
   PyObject *shared_vertices, *shared_triangles;
 } SceneObject;
 
@@ -112,9 +113,10 @@ static PyArrayObject *vec3_array(PyObject *obj, const char *name) {
   return f;
 }
 
-/* Triangles as a C-contiguous uint32 (n, 3) array, every index below nv:
- * the array itself where it is int32 or uint32 and C-contiguous, else a
- * copy. */
+/* Triangles as the scene's own C-contiguous uint32 (n, 3) array, every
+ * index checked to be below nv. Always a copy: a caller who changed an
+ * index afterwards would otherwise send the scene's lookups out of its
+ * vertex array. */
 static PyArrayObject *triangle_array(PyObject *obj, size_t nv) {
   PyArrayObject *ta = (PyArrayObject *)PyArray_FROM_O(obj);
   if (!ta) return NULL;
@@ -123,8 +125,7 @@ static PyArrayObject *triangle_array(PyObject *obj, size_t nv) {
     Py_DECREF(ta);
     return NULL;
   }
-  const int type = PyArray_TYPE(ta);
-  const int in_place = (type == NPY_INT32 || type == NPY_UINT32) && PyArray_IS_C_CONTIGUOUS(ta) && PyArray_ISALIGNED(ta);
+  /* checked at their own width (as int64), so no value wraps into range */
   PyArrayObject *t = (PyArrayObject *)PyArray_FROM_OTF((PyObject *)ta, NPY_INT64, NPY_ARRAY_IN_ARRAY);
   if (!t) { Py_DECREF(ta); return NULL; }
   const size_t n = (size_t)PyArray_SIZE(t);
@@ -136,9 +137,9 @@ static PyArrayObject *triangle_array(PyObject *obj, size_t nv) {
       Py_DECREF(ta);
       return NULL;
     }
+  PyArrayObject *u = (PyArrayObject *)PyArray_FROM_OTF((PyObject *)t, NPY_UINT32,
+                                                       NPY_ARRAY_IN_ARRAY | NPY_ARRAY_FORCECAST | NPY_ARRAY_ENSURECOPY);
   Py_DECREF(t);
-  if (in_place) return ta; /* int32 indices in range are their uint32 selves */
-  PyArrayObject *u = (PyArrayObject *)PyArray_FROM_OTF((PyObject *)ta, NPY_UINT32, NPY_ARRAY_IN_ARRAY | NPY_ARRAY_FORCECAST);
   Py_DECREF(ta);
   return u;
 }
@@ -161,7 +162,7 @@ static PyObject *scene_new(PyTypeObject *type, PyObject *args, PyObject *kw) {
       Py_DECREF(t);
       return PyErr_Format(PyExc_ValueError, "vertices: vertex %zu is not finite", i / 3);
     }
-  /* Both arrays are read in place: the scene keeps them */
+  /* the scene reads both arrays in place and keeps them */
   fr_scene *sc;
   fr_error e = fr_scene_from_buffers(pos, nv, 0, PyArray_DATA(t), nt, 0, FR_SHARE_BUFFERS, &sc);
   if (e != FR_OK) {
