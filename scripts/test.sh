@@ -66,7 +66,7 @@ if [ "${FRUSTA_TSAN_TESTS:-1}" != 0 ]; then
   [ "$vstatus" -eq 0 ] || { echo "ThreadSanitizer: the viewer exited $vstatus"; exit 1; }
   rm -rf "$out"
   unset TSAN_OPTIONS OMP_TOOL_LIBRARIES
-  echo "ThreadSanitizer: threads, hybrid tuning, render, bench and view on 4 threads (built without MPI): no report"
+  echo "ThreadSanitizer: threads, same answers, render, bench and view on 4 threads (built without MPI): no report"
 fi
 FUZZ_SECONDS="${FRUSTA_FUZZ_SECONDS:-60}"
 if [ "$FUZZ_SECONDS" != 0 ]; then
