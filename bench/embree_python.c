@@ -76,10 +76,9 @@ static void pack16(struct RTCRay16 *r, int valid[16], const float *o, const floa
   }
 }
 
-/* tnear and tfar: one per ray, or NULL for 0 and inf. */
-
 /* Closest hits: t (inf on a miss) and prim (0xFFFFFFFF on a miss), u, v.
- * packet16: rtcIntersect16 on consecutive rays instead of rtcIntersect1M. */
+ * tnear and tfar: one per ray, or NULL for 0 and inf. packet16:
+ * rtcIntersect16 on consecutive rays instead of rtcIntersect1M. */
 void ebp_intersect(const ebp_scene *s, const float *o, const float *d, size_t n, const float *tnear, const float *tfar,
                    float *t, uint32_t *prim, float *u, float *v, int coherent, int packet16, int threads) {
   size_t chunks = (n + CHUNK - 1) / CHUNK;

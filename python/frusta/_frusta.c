@@ -795,23 +795,23 @@ static PyObject *scene_bounds(SceneObject *s, void *c) {
   return (PyObject *)b;
 }
 
-/* Copies of the scene's arrays (after loading: fan-triangulated, in file order). */
+/* Copies of the scene's arrays (after loading: fan-triangulated, in file
+ * order): an (n, 3) array of type from src's n rows of three 4-byte values. */
+static PyObject *rows_copy(size_t n, int type, const void *src) {
+  npy_intp dims[2] = {(npy_intp)n, 3};
+  PyArrayObject *a = (PyArrayObject *)PyArray_SimpleNew(2, dims, type);
+  if (a && n) memcpy(PyArray_DATA(a), src, n * 3 * 4);
+  return (PyObject *)a;
+}
+
 static PyObject *scene_vertices(SceneObject *s, void *c) {
   (void)c;
-  if (!scene_open(s)) return NULL;
-  npy_intp dims[2] = {(npy_intp)fr_scene_vertex_count(s->scene), 3};
-  PyArrayObject *a = (PyArrayObject *)PyArray_SimpleNew(2, dims, NPY_FLOAT32);
-  if (a && dims[0]) memcpy(PyArray_DATA(a), fr_scene_vertices(s->scene), (size_t)dims[0] * 3 * sizeof(float));
-  return (PyObject *)a;
+  return scene_open(s) ? rows_copy(fr_scene_vertex_count(s->scene), NPY_FLOAT32, fr_scene_vertices(s->scene)) : NULL;
 }
 
 static PyObject *scene_triangles(SceneObject *s, void *c) {
   (void)c;
-  if (!scene_open(s)) return NULL;
-  npy_intp dims[2] = {(npy_intp)fr_scene_triangle_count(s->scene), 3};
-  PyArrayObject *a = (PyArrayObject *)PyArray_SimpleNew(2, dims, NPY_UINT32);
-  if (a && dims[0]) memcpy(PyArray_DATA(a), fr_scene_indices(s->scene), (size_t)dims[0] * 3 * sizeof(uint32_t));
-  return (PyObject *)a;
+  return scene_open(s) ? rows_copy(fr_scene_triangle_count(s->scene), NPY_UINT32, fr_scene_indices(s->scene)) : NULL;
 }
 
 static PyMethodDef scene_methods[] = {

@@ -58,6 +58,18 @@ float fr_temporal_worth(const fr_temporal *t) { return t->mean_worth; }
 /* fr_camera is four vec3 of floats and two ints: no padding */
 static int same_camera(const fr_camera *a, const fr_camera *b) { return memcmp(a, b, sizeof *a) == 0; }
 
+/* The ray of c through pixel (x, y) is b + right sx, b = fwd + up sy, of
+ * squared length b2 + rr sx^2 (the basis is orthogonal): a row's b and b2
+ * are made once, and its directions take one root a pixel. */
+typedef struct camera_row { float bx, by, bz, b2; } camera_row;
+
+static camera_row camera_row_of(const fr_camera *c, int y) {
+  const vec3 f = c->fwd, u = c->up;
+  const float sy = 1.0f - 2.0f * ((float)y + 0.5f) / (float)c->height;
+  return (camera_row){f.x + u.x * sy, f.y + u.y * sy, f.z + u.z * sy, v3_dot(f, f) + v3_dot(u, u) * sy * sy};
+}
+static float pixel_sx(const fr_camera *c, int x) { return 2.0f * ((float)x + 0.5f) / (float)c->width - 1.0f; }
+
 /* The last frame's camera as reprojection uses it: a point's offset d
  * from its eye meets its image at sx = (d . rs) / (d . fwd), sy the same
  * with us (rs, us: right and up over their squared lengths). */
@@ -77,8 +89,8 @@ static projector projector_of(const fr_camera *c) {
 static void reproject(fr_temporal *t, const fr_camera *cam, const float *depth, const float *normal, int threads) {
   const int W = t->w, H = t->h;
   const projector pc = projector_of(&t->cam);
-  const vec3 e = cam->eye, f = cam->fwd, r = cam->right, u = cam->up;
-  const float ff = v3_dot(f, f), rr = v3_dot(r, r), uu = v3_dot(u, u);
+  const vec3 e = cam->eye, r = cam->right;
+  const float rr = v3_dot(r, r);
   const float cos2 = FR_TEMPORAL_NORMAL_COS * FR_TEMPORAL_NORMAL_COS, plane2 = FR_TEMPORAL_PLANE_TOL * FR_TEMPORAL_PLANE_TOL;
   const float hw = 0.5f * pc.w, hh = 0.5f * pc.h, xmax = pc.w - 0.5f, ymax = pc.h - 0.5f;
   int reused = 0, failed = 0;
@@ -98,13 +110,12 @@ static void reproject(fr_temporal *t, const fr_camera *cam, const float *depth, 
         t->hist_worth[i0 + (size_t)x] = 0.0f;
       }
       if (!row) continue;
-      const float sy = 1.0f - 2.0f * ((float)y + 0.5f) / (float)H;
-      const float bx = f.x + u.x * sy, by = f.y + u.y * sy, bz = f.z + u.z * sy, b2 = ff + uu * sy * sy;
+      const camera_row cr = camera_row_of(cam, y);
       const float *dep = depth + i0;
       for (int x = 0; x < W; x++) {
-        const float sx = 2.0f * ((float)x + 0.5f) / (float)W - 1.0f;
-        const float k = 1.0f / sqrtf(b2 + rr * sx * sx);
-        const float dx = (bx + r.x * sx) * k, dy = (by + r.y * sx) * k, dz = (bz + r.z * sx) * k; /* unit */
+        const float sx = pixel_sx(cam, x);
+        const float k = 1.0f / sqrtf(cr.b2 + rr * sx * sx);
+        const float dx = (cr.bx + r.x * sx) * k, dy = (cr.by + r.y * sx) * k, dz = (cr.bz + r.z * sx) * k; /* unit */
         const float dv = dep[x];
         const int hit = dv < MISS;
         const float z = hit ? dv : 0.0f;
@@ -171,19 +182,16 @@ static void reproject(fr_temporal *t, const fr_camera *cam, const float *depth, 
 }
 
 /* Keeps the frame shown (rgb, its guides and the points seen) for the
- * next camera move. The points are made along fr_camera_ray's directions,
- * written out so that the loop vectorizes: the camera's basis is
- * orthogonal, so a direction's squared length is a sum of a row's and a
- * column's terms. */
+ * next camera move, the points made along the camera's rays row by row
+ * (camera_row). */
 static void remember(fr_temporal *t, const fr_camera *cam, const float *rgb, const float *depth, const float *normal,
                      int threads) {
   const int W = t->w, H = t->h;
-  const vec3 e = cam->eye, f = cam->fwd, r = cam->right, u = cam->up;
-  const float ff = v3_dot(f, f), rr = v3_dot(r, r), uu = v3_dot(u, u);
+  const vec3 e = cam->eye, r = cam->right;
+  const float rr = v3_dot(r, r);
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (int y = 0; y < H; y++) {
-    const float sy = 1.0f - 2.0f * ((float)y + 0.5f) / (float)H;
-    const float bx = f.x + u.x * sy, by = f.y + u.y * sy, bz = f.z + u.z * sy, b2 = ff + uu * sy * sy;
+    const camera_row cr = camera_row_of(cam, y);
     const size_t row = (size_t)y * (size_t)W;
     memcpy(t->out + 3 * row, rgb + 3 * row, (size_t)W * 3 * sizeof(float));
     memcpy(t->depth + row, depth + row, (size_t)W * sizeof(float));
@@ -191,11 +199,11 @@ static void remember(fr_temporal *t, const fr_camera *cam, const float *rgb, con
     const float *dep = depth + row;
     float *pos = t->pos + 3 * row;
     for (int x = 0; x < W; x++) {
-      const float sx = 2.0f * ((float)x + 0.5f) / (float)W - 1.0f;
-      const float k = dep[x] / sqrtf(b2 + rr * sx * sx);
-      pos[3 * x] = e.x + (bx + r.x * sx) * k;
-      pos[3 * x + 1] = e.y + (by + r.y * sx) * k;
-      pos[3 * x + 2] = e.z + (bz + r.z * sx) * k;
+      const float sx = pixel_sx(cam, x);
+      const float k = dep[x] / sqrtf(cr.b2 + rr * sx * sx);
+      pos[3 * x] = e.x + (cr.bx + r.x * sx) * k;
+      pos[3 * x + 1] = e.y + (cr.by + r.y * sx) * k;
+      pos[3 * x + 2] = e.z + (cr.bz + r.z * sx) * k;
     }
   }
   t->cam = *cam;
