@@ -8,6 +8,8 @@
  *     mean as uniform sampling, and states the pdf it samples by;
  *   - the samplers stratify: n points of a pixel's pattern fall one per
  *     stratum of 1/n in each coordinate;
+ *   - points made many at a time (Sobol's as vector code, on every ISA)
+ *     are the bits fr_sample2d makes one at a time;
  *   - the image is the same bits on 1 and 3 threads and in every trace mode
  *     (up to rays that graze an edge: none on these spheres), and equals
  *     the one traced through Embree with the same seed but for a few
@@ -203,6 +205,30 @@ static void samplers_stratify(void **st) {
         }
 }
 
+static void batch_points_alike(void **st) {
+  (void)st;
+  enum { N = 203 }; /* not a multiple of any vector's lanes */
+  uint32_t keys[N], idx[N];
+  for (uint32_t i = 0; i < N; i++) keys[i] = fr_sampler_pixel_key(11, i * 7919u), idx[i] = (i * 37u) % 64u;
+  const fr_isa best = fr_get_isa();
+  for (int k = 0; k < FR_SAMPLER_COUNT; k++)
+    for (int isa = FR_ISA_SCALAR; isa <= (int)best; isa++) {
+      assert_int_equal(fr_set_isa((fr_isa)isa), FR_OK);
+      for (uint32_t d = 0; d < 40; d += 3)
+        for (size_t n = 0; n <= N; n += n < 20 ? 1 : 61) {
+          float u1[N], u2[N];
+          fr_sample2d_batch((fr_sampler_kind)k, keys, idx, 64, d, n, u1, u2);
+          for (size_t i = 0; i < n; i++) {
+            float v1, v2;
+            fr_sample2d((fr_sampler_kind)k, keys[i], idx[i], 64, d, &v1, &v2);
+            assert_memory_equal(&u1[i], &v1, sizeof v1);
+            assert_memory_equal(&u2[i], &v2, sizeof v2);
+          }
+        }
+    }
+  fr_set_isa(best);
+}
+
 /* The built-in materials scene set up for path tracing: a constant sky,
  * the scene's lamp and point light, 8 samples of the given sampler. */
 typedef struct materials_scene {
@@ -338,6 +364,7 @@ int main(void) {
       cmocka_unit_test(environment_sampling),
       cmocka_unit_test(radiance_hdr),
       cmocka_unit_test(samplers_stratify),
+      cmocka_unit_test(batch_points_alike),
       cmocka_unit_test(same_image_everywhere),
       cmocka_unit_test(passes_split_anyhow),
   };

@@ -5,6 +5,7 @@
 #include "base/alloc.h"
 #include "base/bilinear.h"
 #include "base/error.h"
+#include "base/sincos.h"
 #include "io/image_read.h"
 
 #define PI_F 3.14159265358979323846f
@@ -88,8 +89,10 @@ vec3 fr_env_eval(const fr_env *e, vec3 dir) {
 vec3 fr_env_sample(const fr_env *e, float u1, float u2, vec3 *dir, float *pdf) {
   if (e->black) { *pdf = 0.0f; return v3(0, 0, 0); }
   if (!e->rgb) { /* uniform over the sphere */
-    const float z = 1.0f - 2.0f * u1, r = sqrtf(fr_maxf(0.0f, 1.0f - z * z)), phi = 2.0f * PI_F * u2;
-    *dir = v3(r * cosf(phi), r * sinf(phi), z);
+    const float z = 1.0f - 2.0f * u1, r = sqrtf(fr_maxf(0.0f, 1.0f - z * z));
+    float s, c;
+    fr_sincos_turns(u2, &s, &c);
+    *dir = v3(r * c, r * s, z);
     *pdf = 1.0f / (4.0f * PI_F);
     return v3_scale(e->color, e->intensity);
   }

@@ -1,6 +1,7 @@
 /* The material kinds' own sample / eval / pdf (internal to src/material). */
 #ifndef FR_MATERIAL_BSDF_KINDS_H
 #define FR_MATERIAL_BSDF_KINDS_H
+#include "base/sincos.h"
 #include "material/bsdf.h"
 
 #define FR_DECLARE_BSDF(kind)                                                                                      \
@@ -18,8 +19,9 @@ FR_DECLARE_BSDF(carpaint)
 
 /* Cosine-weighted direction about +z from u1, u2 (pdf cos/pi). */
 static inline vec3 fr_sample_cosine(float u1, float u2) {
-  float r = sqrtf(u1), phi = 2.0f * FR_PI * u2;
-  return v3(r * cosf(phi), r * sinf(phi), sqrtf(fr_maxf(0.0f, 1.0f - u1)));
+  float r = sqrtf(u1), s, c;
+  fr_sincos_turns(u2, &s, &c);
+  return v3(r * c, r * s, sqrtf(fr_maxf(0.0f, 1.0f - u1)));
 }
 static inline vec3 fr_reflect_z(vec3 w) { return v3(-w.x, -w.y, w.z); }
 static inline float fr_lum(vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }

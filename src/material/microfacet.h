@@ -8,6 +8,7 @@
 #define FR_MATERIAL_MICROFACET_H
 #include <math.h>
 #include "base/vec3.h"
+#include "base/sincos.h"
 
 static inline float fr_ggx_d(vec3 h, float a) {
   if (h.z <= 0.0f) return 0.0f;
@@ -29,9 +30,10 @@ static inline vec3 fr_ggx_sample_vndf(vec3 wo, float a, float u1, float u2) {
   const float l2 = vh.x * vh.x + vh.y * vh.y;
   const vec3 t1 = l2 > 0.0f ? v3_scale(v3(-vh.y, vh.x, 0.0f), 1.0f / sqrtf(l2)) : v3(1.0f, 0.0f, 0.0f);
   const vec3 t2 = v3_cross(vh, t1);
-  const float r = sqrtf(u1), phi = 6.28318530717958647692f * u2;
-  const float p1 = r * cosf(phi), s = 0.5f * (1.0f + vh.z);
-  const float p2 = (1.0f - s) * sqrtf(fr_maxf(0.0f, 1.0f - p1 * p1)) + s * r * sinf(phi);
+  float sp, cp;
+  fr_sincos_turns(u2, &sp, &cp);
+  const float r = sqrtf(u1), p1 = r * cp, s = 0.5f * (1.0f + vh.z);
+  const float p2 = (1.0f - s) * sqrtf(fr_maxf(0.0f, 1.0f - p1 * p1)) + s * r * sp;
   const vec3 nh = v3_add(v3_add(v3_scale(t1, p1), v3_scale(t2, p2)),
                          v3_scale(vh, sqrtf(fr_maxf(0.0f, 1.0f - p1 * p1 - p2 * p2))));
   return v3_norm(v3(a * nh.x, a * nh.y, fr_maxf(1e-6f, nh.z)));

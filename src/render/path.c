@@ -12,18 +12,21 @@
 #include <string.h>
 #include "base/alloc.h"
 #include "base/error.h"
+#include "base/sincos.h"
 #include "base/timer.h"
 #include "material/texture.h"
 #include "render/surfaces.h"
 #include "render/tile.h"
 
-/* A wave: a tile's paths for up to FR_PATH_CHUNK samples per pixel, or a
- * wide tile's for FR_PATH_WIDE_SPP */
-#define WAVE (TILE_PIX * FR_PATH_CHUNK)
-_Static_assert(FR_PATH_WIDE_TILE * FR_PATH_WIDE_TILE * FR_PATH_WIDE_SPP == WAVE, "a wide tile's wave is as large");
+/* A wave: a tile's paths for as many samples per pixel as fill it */
+#define WAVE FR_PATH_WAVE
+_Static_assert(WAVE >= TILE_PIX * FR_PATH_CHUNK && WAVE % (64 * 64) == 0, "a tile of any side holds a whole sample");
+_Static_assert(WAVE <= 65536, "path_state.slot is 16 bits");
 /* The shader loads a hit's surface record and corner indices this many
  * hits ahead: they are scattered over the scene's arrays. */
 #define PREFETCH_AHEAD 8
+/* Sobol points are made for this many paths at a time, as vector code */
+#define POINT_BLOCK 64
 
 typedef struct path_state {
   vec3 weight;     /* throughput: what the radiance found next is multiplied by */
@@ -70,30 +73,42 @@ static float power_heuristic(float a, float b) {
 /* The number of lights next-event estimation chooses among, uniformly. */
 static int light_count(const fr_path_lights *L) { return !L->env->black + L->area + L->point; }
 
+/* The area light as the shader tests it, made once per tile: its normal
+ * n = e1 x e2 (not unit) and the vectors that give a point x's place on
+ * it, s = (x - c) . ds and u = (x - c) . du (ds = (e2 x n) / n.n,
+ * du = (n x e1) / n.n: the triple products of its edges, precomputed). */
+typedef struct quad_light { vec3 c, e1, e2, n, ds, du, radiance; } quad_light;
+
+static quad_light quad_light_of(const fr_path_lights *L) {
+  const vec3 n = v3_cross(L->area_e1, L->area_e2);
+  const float n2 = v3_dot(n, n), k = n2 > 0.0f ? 1.0f / n2 : 0.0f;
+  return (quad_light){L->area_c, L->area_e1, L->area_e2, n, v3_scale(v3_cross(L->area_e2, n), k),
+                      v3_scale(v3_cross(n, L->area_e1), k), L->area_radiance};
+}
+
 /* t of the ray (o, d) through the area light within (tnear, tfar), or 0. */
-static float area_hit(const fr_path_lights *L, vec3 o, vec3 d, float tnear, float tfar) {
-  const vec3 nq = v3_cross(L->area_e1, L->area_e2);
-  const float den = v3_dot(d, nq), n2 = v3_dot(nq, nq);
-  if (den == 0.0f || !(n2 > 0.0f)) return 0.0f;
-  const float t = v3_dot(v3_sub(L->area_c, o), nq) / den;
+static float area_hit(const quad_light *q, vec3 o, vec3 d, float tnear, float tfar) {
+  const float den = v3_dot(d, q->n);
+  if (den == 0.0f) return 0.0f;
+  const float t = v3_dot(v3_sub(q->c, o), q->n) / den;
   if (!(t > tnear && t < tfar)) return 0.0f;
-  const vec3 x = v3_sub(v3_add(o, v3_scale(d, t)), L->area_c);
-  const float s = v3_dot(v3_cross(x, L->area_e2), nq) / n2, u = v3_dot(v3_cross(L->area_e1, x), nq) / n2;
+  const vec3 x = v3_sub(v3_add(o, v3_scale(d, t)), q->c);
+  const float s = v3_dot(x, q->ds), u = v3_dot(x, q->du);
   return s >= 0.0f && s <= 1.0f && u >= 0.0f && u <= 1.0f ? t : 0.0f;
 }
 
-/* Solid-angle pdf of sampling the area light's point at distance dist along unit d. */
-static float area_pdf(const fr_path_lights *L, vec3 d, float dist) {
-  const vec3 nq = v3_cross(L->area_e1, L->area_e2);
-  const float a = v3_len(nq), c = fabsf(v3_dot(nq, d)) / a;
-  return c > 0.0f ? dist * dist / (a * c) : 0.0f;
+/* Solid-angle pdf of sampling the area light's point at distance dist
+ * along unit d: dist^2 / (area cos) = dist^2 / |d . n|. */
+static float area_pdf(const quad_light *q, vec3 d, float dist) {
+  const float c = fabsf(v3_dot(q->n, d));
+  return c > 0.0f ? dist * dist / c : 0.0f;
 }
 
 /* One light sample from p: direction, distance (INFINITY for the
  * environment), radiance arriving, solid-angle pdf including the choice
  * of light, and whether it is a delta light. 0 when none. */
-static int sample_light(const fr_path_lights *L, vec3 p, float uc, float u1, float u2, vec3 *wi, float *dist, vec3 *le,
-                        float *pdf, int *delta) {
+static int sample_light(const fr_path_lights *L, const quad_light *q, vec3 p, float uc, float u1, float u2, vec3 *wi,
+                        float *dist, vec3 *le, float *pdf, int *delta) {
   const int n = light_count(L);
   if (!n) return 0;
   int k = (int)(uc * (float)n);
@@ -107,14 +122,14 @@ static int sample_light(const fr_path_lights *L, vec3 p, float uc, float u1, flo
     return pe > 0.0f;
   }
   if (L->area && k-- == 0) {
-    const vec3 x = v3_add(L->area_c, v3_add(v3_scale(L->area_e1, u1), v3_scale(L->area_e2, u2)));
+    const vec3 x = v3_add(q->c, v3_add(v3_scale(q->e1, u1), v3_scale(q->e2, u2)));
     const vec3 to = v3_sub(x, p);
     const float d = v3_len(to);
-    if (!(d > 0.0f) || v3_dot(to, v3_cross(L->area_e1, L->area_e2)) >= 0.0f) return 0; /* behind the lamp */
+    if (!(d > 0.0f) || v3_dot(to, q->n) >= 0.0f) return 0; /* behind the lamp */
     *wi = v3_scale(to, 1.0f / d);
     *dist = d;
-    *le = L->area_radiance;
-    *pdf = area_pdf(L, *wi, d) / (float)n;
+    *le = q->radiance;
+    *pdf = area_pdf(q, *wi, d) / (float)n;
     return *pdf > 0.0f;
   }
   const vec3 to = v3_sub(L->point_pos, p);
@@ -139,6 +154,25 @@ static int nonzero(vec3 c) { return c.x > 0.0f || c.y > 0.0f || c.z > 0.0f; }
 
 static void add3(float *dst, vec3 v) { dst[0] += v.x, dst[1] += v.y, dst[2] += v.z; }
 
+/* The sample points of dimension pairs d .. d + npairs - 1 for the paths
+ * st[0..m) (m <= POINT_BLOCK): pair q's in pts[2q] and pts[2q + 1]. */
+static void block_points(const fr_path_setup *P, const path_state *st, size_t m, uint32_t d, int npairs,
+                         float pts[][POINT_BLOCK]) {
+  uint32_t key[POINT_BLOCK], idx[POINT_BLOCK];
+  for (size_t j = 0; j < m; j++) key[j] = st[j].key, idx[j] = st[j].sample;
+  for (int q = 0; q < npairs; q++)
+    fr_sample2d_batch(P->sampler, key, idx, (uint32_t)P->spp, d + (uint32_t)q, m, pts[2 * q], pts[2 * q + 1]);
+}
+
+/* Pair d + q of path st, the b-th of its block: from the block's points
+ * (pts, for Sobol), or made here (NULL: Hammersley's, whose shuffle does
+ * not vectorize, made only where a path needs them). */
+static inline void path_point(const fr_path_setup *P, const float (*pts)[POINT_BLOCK], size_t b, const path_state *st,
+                              uint32_t d, int q, float *u1, float *u2) {
+  if (pts) *u1 = pts[2 * q][b], *u2 = pts[2 * q + 1][b];
+  else fr_sample2d(P->sampler, st->key, st->sample, (uint32_t)P->spp, d + (uint32_t)q, u1, u2);
+}
+
 /* Pixel i of a tile of the given side, in blocks of 4x4 (consecutive 16
  * are coherent). */
 static void tile_pixel(int i, int side, int *x, int *y) {
@@ -148,7 +182,8 @@ static void tile_pixel(int i, int side, int *x, int *y) {
 }
 
 int fr_path_tile_side(const fr_path_setup *P) {
-  return P->spp_end - P->spp_begin <= FR_PATH_WIDE_SPP ? FR_PATH_WIDE_TILE : TILE;
+  const int spp = P->spp_end - P->spp_begin;
+  return spp <= 1 ? 64 : spp <= 2 ? 32 : TILE;
 }
 
 uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch *S, int tx, int ty) {
@@ -156,12 +191,15 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
   const fr_path_lights *L = &P->lights;
   const fr_camera *c = &w->cam;
   const int W = c->width, H = c->height;
-  const uint32_t n_spp = (uint32_t)P->spp, seed = P->seed;
+  const uint32_t seed = P->seed;
   const float eps = w->eps;
   const int nlights = light_count(L);
+  const quad_light quad = quad_light_of(L);
   uint64_t rays = 0;
   const vec3 ru = v3_norm(c->right), uu = v3_norm(c->up);
   const int side = fr_path_tile_side(P), npix = side * side, chunk = WAVE / npix;
+  float block[8][POINT_BLOCK];
+  const float(*pts)[POINT_BLOCK] = P->sampler == FR_SAMPLER_SOBOL ? (const float(*)[POINT_BLOCK])block : NULL;
   for (int s0 = P->spp_begin; s0 < P->spp_end; s0 += chunk) {
     const int s1 = s0 + chunk < P->spp_end ? s0 + chunk : P->spp_end;
     double t0 = fr_seconds();
@@ -178,22 +216,32 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         x += tx, y += ty;
         if (x >= W || y >= H) continue;
         const uint32_t key = fr_sampler_pixel_key(seed, (uint32_t)y * (uint32_t)W + (uint32_t)x);
-        float jx, jy, lx, ly;
-        fr_sample2d(P->sampler, key, (uint32_t)s, n_spp, 0, &jx, &jy);
-        const float sx = 2.0f * ((float)x + jx) / (float)W - 1.0f, sy = 1.0f - 2.0f * ((float)y + jy) / (float)H;
-        vec3 d = v3_add(c->fwd, v3_add(v3_scale(c->right, sx), v3_scale(c->up, sy)));
-        vec3 o = c->eye;
-        if (P->aperture > 0.0f) {
-          fr_sample2d(P->sampler, key, (uint32_t)s, n_spp, 1, &lx, &ly);
-          const float r = P->aperture * sqrtf(lx), phi = 6.28318530718f * ly;
-          const vec3 focus = v3_add(c->eye, v3_scale(d, P->focus)); /* the image plane lies at distance 1 along fwd */
-          o = v3_add(o, v3_add(v3_scale(ru, r * cosf(phi)), v3_scale(uu, r * sinf(phi))));
-          d = v3_sub(focus, o);
-        }
-        S->ray[n] = make_ray(o, v3_norm(d), 0.0f, INFINITY);
-        S->st[n] = (path_state){v3(1, 1, 1), 0.0f, (uint32_t)s, key, (uint16_t)((s - s0) * npix + i), 1, 0};
-        n++;
+        S->st[n++] = (path_state){v3(1, 1, 1), 0.0f, (uint32_t)s, key, (uint16_t)((s - s0) * npix + i), 1, 0};
       }
+    /* the camera rays: pair 0 places the sample in its pixel, pair 1 on the lens */
+    const int lens = P->aperture > 0.0f;
+    for (size_t k = 0; k < n; k++) {
+      const size_t b = k % POINT_BLOCK;
+      if (pts && !b) block_points(P, S->st + k, n - k < POINT_BLOCK ? n - k : POINT_BLOCK, 0, 1 + lens, block);
+      int x, y;
+      tile_pixel(S->st[k].slot % npix, side, &x, &y);
+      x += tx, y += ty;
+      float jx, jy;
+      path_point(P, pts, b, &S->st[k], 0, 0, &jx, &jy);
+      const float sx = 2.0f * ((float)x + jx) / (float)W - 1.0f, sy = 1.0f - 2.0f * ((float)y + jy) / (float)H;
+      vec3 d = v3_add(c->fwd, v3_add(v3_scale(c->right, sx), v3_scale(c->up, sy)));
+      vec3 o = c->eye;
+      if (lens) {
+        float lx, ly, sn, cs;
+        path_point(P, pts, b, &S->st[k], 0, 1, &lx, &ly);
+        fr_sincos_turns(ly, &sn, &cs);
+        const float r = P->aperture * sqrtf(lx);
+        const vec3 focus = v3_add(c->eye, v3_scale(d, P->focus)); /* the image plane lies at distance 1 along fwd */
+        o = v3_add(o, v3_add(v3_scale(ru, r * cs), v3_scale(uu, r * sn)));
+        d = v3_sub(focus, o);
+      }
+      S->ray[k] = make_ray(o, v3_norm(d), 0.0f, INFINITY);
+    }
     for (int depth = 0; n; depth++) {
       double t1 = fr_seconds();
       S->stage[FR_STAGE_SHADE] += t1 - t0;
@@ -202,7 +250,10 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
       double t2 = fr_seconds();
       S->stage[depth ? FR_STAGE_SECONDARY : FR_STAGE_CAMERA] += t2 - t1;
       size_t nn = 0, ns = 0;
+      const uint32_t dim = 2u + 4u * (uint32_t)depth;
       for (size_t k = 0; k < n; k++) {
+        const size_t b = k % POINT_BLOCK;
+        if (pts && !b) block_points(P, S->st + k, n - k < POINT_BLOCK ? n - k : POINT_BLOCK, dim, 4, block);
         if (k + PREFETCH_AHEAD < n) {
           const uint32_t ahead = S->hit[k + PREFETCH_AHEAD].prim;
           if (ahead < P->nsurf) {
@@ -217,12 +268,12 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         const int hit = h.prim != FR_INVALID_ID;
         const float tmax = hit ? h.t : INFINITY;
         /* the area light, which is not in the scene's geometry, in front of the hit */
-        const float ta = L->area ? area_hit(L, o, d, r.tnear, tmax) : 0.0f;
+        const float ta = L->area ? area_hit(&quad, o, d, r.tnear, tmax) : 0.0f;
         if (ta > 0.0f) { /* the lamp: it emits from its front, its back is dark */
           if (depth == 0) S->dep[st.slot] = ta;
-          if (v3_dot(d, v3_cross(L->area_e1, L->area_e2)) < 0.0f) {
-            const float w_mis = st.delta ? 1.0f : power_heuristic(st.pdf, area_pdf(L, d, ta) / (float)nlights);
-            S->acc[st.slot] = v3_add(S->acc[st.slot], v3_scale(v3_mul(st.weight, L->area_radiance), w_mis));
+          if (v3_dot(d, quad.n) < 0.0f) {
+            const float w_mis = st.delta ? 1.0f : power_heuristic(st.pdf, area_pdf(&quad, d, ta) / (float)nlights);
+            S->acc[st.slot] = v3_add(S->acc[st.slot], v3_scale(v3_mul(st.weight, quad.radiance), w_mis));
           }
           continue;
         }
@@ -281,16 +332,15 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
           S->alb[st.slot] = v3_add(S->alb[st.slot], fr_bsdf_albedo(m));
           S->nrm[st.slot] = v3_add(S->nrm[st.slot], v3_dot(n, d) < 0.0f ? n : v3_scale(n, -1.0f)); /* facing the camera */
         }
-        const uint32_t dim = 2u + 4u * (uint32_t)depth;
         float uc, ul, u1, u2, v1, v2, ur, unused;
-        fr_sample2d(P->sampler, st.key, st.sample, n_spp, dim, &uc, &ul);
+        path_point(P, pts, b, &st, dim, 0, &uc, &ul);
         /* next-event estimation */
         if (nlights && fr_bsdf_has_smooth(m, &sp)) {
-          fr_sample2d(P->sampler, st.key, st.sample, n_spp, dim + 1, &u1, &u2);
+          path_point(P, pts, b, &st, dim, 1, &u1, &u2);
           vec3 wi, le;
           float dist, pl;
           int delta;
-          if (sample_light(L, p, uc, u1, u2, &wi, &dist, &le, &pl, &delta) && same_side(wi, n, ngo)) {
+          if (sample_light(L, &quad, p, uc, u1, u2, &wi, &dist, &le, &pl, &delta) && same_side(wi, n, ngo)) {
             float pb;
             const vec3 f = fr_bsdf_eval(m, &sp, wo, to_local(wi, tb, bb, n), &pb);
             if (nonzero(f) && nonzero(le)) {
@@ -303,7 +353,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         }
         /* the next segment */
         if (depth + 1 >= P->max_depth) continue;
-        fr_sample2d(P->sampler, st.key, st.sample, n_spp, dim + 2, &v1, &v2);
+        path_point(P, pts, b, &st, dim, 2, &v1, &v2);
         fr_bsdf_sample bs;
         if (!fr_bsdf_sample_dir(m, &sp, wo, ul, v1, v2, &bs)) continue;
         const vec3 wi = to_world(bs.wi, tb, bb, n);
@@ -311,7 +361,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         st.weight = v3_mul(st.weight, bs.weight);
         const float q = fr_maxf(st.weight.x, fr_maxf(st.weight.y, st.weight.z)) / FR_PATH_RR_WEIGHT;
         if (q < 1.0f) {
-          fr_sample2d(P->sampler, st.key, st.sample, n_spp, dim + 3, &ur, &unused);
+          path_point(P, pts, b, &st, dim, 3, &ur, &unused);
           if (!(ur < q)) continue;
           st.weight = v3_scale(st.weight, 1.0f / q);
         }

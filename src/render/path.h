@@ -20,14 +20,13 @@
 #include "render/sampler.h"
 
 #define FR_PATH_CHUNK 8          /* samples per pixel in one pass of frusta render and fr_renderer */
-/* A pass of at most FR_PATH_WIDE_SPP samples per pixel (a viewer frame)
- * takes tiles of FR_PATH_WIDE_TILE pixels square, so that its waves still
- * hold a thousand paths (16x16 tiles sent 256: 7% slower at 1 spp); longer
- * passes take TILE, as the other workloads: at 4 and 16 spp the two are
- * level, and small tiles keep a cluster's last tile of a long frame short
- * (docs/scaling.md). */
-#define FR_PATH_WIDE_SPP 2
-#define FR_PATH_WIDE_TILE 32
+/* Paths traced together: the tiles of a pass of one sample per pixel (a
+ * viewer frame) are 64 pixels square and of two samples 32, so that their
+ * waves still hold thousands of paths (16x16 tiles sent 256: 7% slower at
+ * 1 spp than 1,024, which were 2% slower than 4,096); longer passes take
+ * TILE, as the other workloads, level with larger tiles from 4 spp on and
+ * short enough for a cluster's last tile of a long frame (docs/scaling.md). */
+#define FR_PATH_WAVE 4096
 #define FR_PATH_RR_WEIGHT 0.15f
 #define FR_PATH_MAX_DEPTH 64
 #define FR_PATH_DEPTH_MISS 1e30f /* the depth AOV of a sample that sees the environment */
@@ -73,12 +72,12 @@ fr_path_scratch *fr_path_scratch_new(void);
 void fr_path_scratch_free(fr_path_scratch *s);
 /* Adds what s's tiles spent tracing (camera, shadow, bounce rays) and shading to stage[]. */
 void fr_path_scratch_stages(const fr_path_scratch *s, double *stage);
-/* One 16x16 tile: adds the samples' radiance to w->image (sums, not
+/* One tile (fr_path_tile_side pixels square): adds the samples' radiance to w->image (sums, not
  * means) and, where set, first-hit albedo, normal and distance to
  * w->gbuf_albedo, gbuf_normal and gbuf_depth; returns the rays traced.
  * Each pixel's samples are added one by one in sample order, so a run of
  * samples split into calls any way sums to the same bits. */
 uint64_t fr_path_tile(const struct fr_workload *w, const struct fr_tracer *t, fr_path_scratch *s, int tx, int ty);
-/* The side of the tiles a pass of P takes (see FR_PATH_WIDE_TILE). */
+/* The side of the tiles a pass of P takes (see FR_PATH_WAVE). */
 int fr_path_tile_side(const fr_path_setup *P);
 #endif

@@ -1,5 +1,6 @@
 #include "render/sampler.h"
 #include <string.h>
+#include "frusta.h"
 
 static const char *const names[FR_SAMPLER_COUNT] = {"hammersley", "sobol"};
 const char *fr_sampler_name(fr_sampler_kind k) { return k < FR_SAMPLER_COUNT ? names[k] : "?"; }
@@ -26,4 +27,17 @@ __attribute__((constructor)) static void sobol1_tables(void) {
         if ((x >> t) & 1) r ^= fr_sampler_reverse(v[31 - 8 * b - t]);
       fr_sampler_rsobol1_bytes[b][x] = r;
     }
+}
+
+void fr_sample2d_batch(fr_sampler_kind k, const uint32_t *keys, const uint32_t *index, uint32_t n_spp, uint32_t d,
+                       size_t n, float *u1, float *u2) {
+  if (k != FR_SAMPLER_SOBOL) { /* Hammersley's shuffle walks a loop per point: no vectors */
+    for (size_t i = 0; i < n; i++) fr_sample2d(k, keys[i], index[i], n_spp, d, &u1[i], &u2[i]);
+    return;
+  }
+  switch (fr_get_isa()) {
+  case FR_ISA_AVX512: fr_sobol2d_batch_avx512(keys, index, d, n, u1, u2); break;
+  case FR_ISA_AVX2: fr_sobol2d_batch_avx2(keys, index, d, n, u1, u2); break;
+  default: fr_sobol2d_batch_scalar(keys, index, d, n, u1, u2); break;
+  }
 }

@@ -13,6 +13,7 @@
  */
 #ifndef FR_RENDER_SAMPLER_H
 #define FR_RENDER_SAMPLER_H
+#include <stddef.h>
 #include <stdint.h>
 
 typedef enum fr_sampler_kind { FR_SAMPLER_HAMMERSLEY, FR_SAMPLER_SOBOL, FR_SAMPLER_COUNT } fr_sampler_kind;
@@ -102,4 +103,12 @@ static inline __attribute__((always_inline)) void fr_sample2d(fr_sampler_kind k,
   *u1 = x < 1.0f ? x : 0.99999994f;
   *u2 = fr_sampler_unit(fr_sampler_reverse(j) ^ fr_sampler_mix(key ^ 0x7f4a7c15u));
 }
+/* fr_sample2d for n paths of one dimension pair d: path i's pixel key
+ * keys[i] and sample index[i] (of n_spp) give (u1[i], u2[i]), the same
+ * bits; Sobol's run as vector code (render/sampler_batch.c). */
+void fr_sample2d_batch(fr_sampler_kind k, const uint32_t *keys, const uint32_t *index, uint32_t n_spp, uint32_t d,
+                       size_t n, float *u1, float *u2);
+void fr_sobol2d_batch_scalar(const uint32_t *keys, const uint32_t *index, uint32_t d, size_t n, float *u1, float *u2);
+void fr_sobol2d_batch_avx2(const uint32_t *keys, const uint32_t *index, uint32_t d, size_t n, float *u1, float *u2);
+void fr_sobol2d_batch_avx512(const uint32_t *keys, const uint32_t *index, uint32_t d, size_t n, float *u1, float *u2);
 #endif

@@ -5,7 +5,8 @@
  * skips its remaining tiles) and starts afresh, so input is acted on
  * within a tile's time. With --frames the window renders a fixed number of
  * frames in lockstep, one pass each, along a camera path or a turntable,
- * and exits: the same pictures every run, for scripts and tests.
+ * and exits: the same pictures every run, for scripts and tests. There too
+ * the worker renders the next frame while the main thread shows the last.
  */
 #include <SDL2/SDL.h>
 #include <math.h>
@@ -31,17 +32,23 @@ static const char *const keys_help =
 
 typedef struct view_shared {
   pthread_mutex_t lock;
-  pthread_cond_t wake;
+  pthread_cond_t wake;  /* for the worker: want changed, a screenshot, quit */
+  pthread_cond_t ready; /* for the main thread: a frame (lockstep), or the worker stopped */
   view_settings want;
   unsigned gen;         /* bumped on every change of want */
   int quit, error;
+  /* scripted frames: one pass for each gen, even where want stays the
+   * same, and each frame published; step_shot names its screenshot */
+  int lockstep;
+  char step_shot[4096];
+  float reused;
   int cancel;           /* set (atomically) to abandon the pass under way */
   uint8_t *frame;       /* the newest frame, BGRA */
   int fw, fh, spp;
   unsigned frame_id;
   double seconds, denoise_seconds;
   uint64_t rays;
-  int shot;             /* a screenshot is asked for */
+  int shot;             /* a screenshot is asked for (interactive) */
   char shot_name[64];
   /* how soon a change is answered: from the first change the worker has
    * not picked up (0: none) to the start of the new view's pass */
@@ -68,7 +75,7 @@ static void *worker(void *arg) {
   int have = 0;
   pthread_mutex_lock(&sh->lock);
   for (;;) {
-    while (!sh->quit && have && applied == sh->gen && view_renderer_done(&app->r) && !sh->shot)
+    while (!sh->quit && have && applied == sh->gen && (sh->lockstep || view_renderer_done(&app->r)) && !sh->shot)
       pthread_cond_wait(&sh->wake, &sh->lock);
     if (sh->quit) break;
     if (sh->shot) { /* written here, where the image lives */
@@ -82,6 +89,8 @@ static void *worker(void *arg) {
     }
     const view_settings want = sh->want;
     const unsigned gen = sh->gen;
+    char step_shot[sizeof sh->step_shot];
+    memcpy(step_shot, sh->step_shot, sizeof step_shot);
     __atomic_store_n(&sh->cancel, 0, __ATOMIC_RELAXED);
     pthread_mutex_unlock(&sh->lock);
     int rc = 0, fresh = 0;
@@ -95,9 +104,14 @@ static void *worker(void *arg) {
       pthread_mutex_unlock(&sh->lock);
     }
     if (!rc) fresh = view_renderer_pass(&app->r, &sh->cancel);
+    if (!rc && sh->lockstep) { /* every step shows a frame, the last one again when nothing was left to do */
+      fresh = 1;
+      if (!app->r.bgra) rc = cli_error(1, "view: nothing rendered");
+      else if (step_shot[0]) rc = view_renderer_screenshot(&app->r, step_shot);
+    }
     pthread_mutex_lock(&sh->lock);
     if (rc) { sh->error = rc, sh->quit = 1; break; }
-    if (fresh && gen == sh->gen) {
+    if (fresh && (gen == sh->gen || sh->lockstep)) {
       const size_t bytes = (size_t)want.width * (size_t)want.height * 4;
       if (want.width != sh->fw || want.height != sh->fh) {
         uint8_t *f = realloc(sh->frame, bytes);
@@ -108,8 +122,11 @@ static void *worker(void *arg) {
       sh->frame_id++;
       sh->spp = view_renderer_spp(&app->r);
       sh->seconds = app->r.seconds, sh->denoise_seconds = app->r.denoise_seconds, sh->rays = app->r.rays;
+      sh->reused = view_renderer_reused(&app->r);
+      pthread_cond_signal(&sh->ready);
     }
   }
+  pthread_cond_signal(&sh->ready);
   pthread_mutex_unlock(&sh->lock);
   SDL_Event ev = {.type = SDL_QUIT}; /* wake the main thread if it waits */
   SDL_PushEvent(&ev);
@@ -255,37 +272,81 @@ static void frame_name(const char *name, int i, char *out, size_t n) {
   else snprintf(out, n, "%.*s%04d%s", (int)(hash - name), name, i, hash + 1);
 }
 
-/* Scripted: frames in lockstep, one pass each; returns the exit code. */
+/* The settings of scripted frame i: along the camera path, or turned
+ * from the last frame's by the turntable's angle. */
+static void frame_settings(view_settings *s, int i, const view_camera *path, size_t npath, float turntable) {
+  if (npath) s->cam = path[(size_t)i < npath ? (size_t)i : npath - 1];
+  else if (i > 0 && turntable != 0.0f) view_camera_orbit(&s->cam, turntable * 3.14159265f / 180.0f, 0.0f);
+}
+
+/* Hands frame i's settings (and screenshot, if any) to the worker; under
+ * the lock. */
+static void frame_ask(view_app *app, const view_settings *s, int i, int frames, const char *screenshot) {
+  view_shared *sh = &app->sh;
+  if (app->record) view_camera_path_write(app->record, &s->cam);
+  sh->want = *s;
+  sh->gen++;
+  sh->step_shot[0] = 0;
+  if (screenshot && (strchr(screenshot, '#') || i == frames - 1)) frame_name(screenshot, i, sh->step_shot, sizeof sh->step_shot);
+  pthread_cond_signal(&sh->wake);
+}
+
+/* Scripted: frames in lockstep, one pass each, the worker rendering frame
+ * i + 1 while this thread shows frame i; a frame's time is from the last
+ * one shown to its own. Returns the exit code. */
 static int run_frames(view_app *app, view_settings s, int frames, const view_camera *path, size_t npath, float turntable,
                       const char *screenshot) {
-  double total = 0.0;
-  for (int i = 0; i < frames; i++) {
-    if (npath) s.cam = path[(size_t)i < npath ? (size_t)i : npath - 1];
-    else if (i > 0 && turntable != 0.0f) view_camera_orbit(&s.cam, turntable * 3.14159265f / 180.0f, 0.0f);
-    if (app->record) view_camera_path_write(app->record, &s.cam);
-    int rc = view_renderer_apply(&app->r, &s);
-    if (rc) return rc;
-    const double t0 = fr_seconds();
-    view_renderer_pass(&app->r, NULL);
-    if (!app->r.bgra) return cli_error(1, "view: nothing rendered");
-    if ((rc = show(app, app->r.bgra, s.width, s.height))) return rc;
-    const double dt = fr_seconds() - t0;
+  view_shared *sh = &app->sh;
+  const size_t bytes = (size_t)s.width * (size_t)s.height * 4;
+  uint8_t *shown = malloc(bytes);
+  if (!shown) return cli_error(1, "out of memory for a frame");
+  sh->lockstep = 1;
+  frame_settings(&s, 0, path, npath, turntable);
+  frame_ask(app, &s, 0, frames, screenshot);
+  pthread_t th;
+  if (pthread_create(&th, NULL, worker, app)) {
+    free(shown);
+    return cli_error(1, "view: cannot start the render thread");
+  }
+  double total = 0.0, last = fr_seconds();
+  int rc = 0, done = 0;
+  for (int i = 0; i < frames && !rc; i++) {
+    pthread_mutex_lock(&sh->lock);
+    while (sh->frame_id == (unsigned)i && !sh->quit) pthread_cond_wait(&sh->ready, &sh->lock);
+    if (sh->frame_id == (unsigned)i) { /* the worker stopped (its error is in sh->error) */
+      pthread_mutex_unlock(&sh->lock);
+      break;
+    }
+    memcpy(shown, sh->frame, bytes);
+    const double seconds = sh->seconds, denoise = sh->denoise_seconds, reused = sh->reused;
+    const uint64_t rays = sh->rays;
+    const int spp = sh->spp;
+    if (i + 1 < frames) {
+      frame_settings(&s, i + 1, path, npath, turntable);
+      frame_ask(app, &s, i + 1, frames, screenshot);
+    }
+    pthread_mutex_unlock(&sh->lock);
+    rc = show(app, shown, s.width, s.height);
+    const double now = fr_seconds(), dt = now - last;
+    last = now;
     total += dt;
     printf("frame %d: %.2f ms render %.2f ms denoise %.2f ms spp=%d mrays=%.2f reused=%.0f%%\n", i, dt * 1e3,
-           app->r.seconds * 1e3, app->r.denoise_seconds * 1e3, view_renderer_spp(&app->r),
-           app->r.rays / fmax(app->r.seconds, 1e-9) * 1e-6, 100.0 * view_renderer_reused(&app->r));
-    set_title(app, &s, 1.0 / dt, app->r.rays / fmax(app->r.seconds, 1e-9) * 1e-6, view_renderer_spp(&app->r));
-    if (screenshot && (strchr(screenshot, '#') || i == frames - 1)) {
-      char name[4096];
-      frame_name(screenshot, i, name, sizeof name);
-      if (view_renderer_screenshot(&app->r, name)) return 1;
-    }
+           seconds * 1e3, denoise * 1e3, spp, rays / fmax(seconds, 1e-9) * 1e-6, 100.0 * reused);
+    set_title(app, &s, 1.0 / dt, rays / fmax(seconds, 1e-9) * 1e-6, spp);
+    done = i + 1;
     SDL_Event ev;
     while (SDL_PollEvent(&ev))
-      if (ev.type == SDL_QUIT) return 0;
+      if (ev.type == SDL_QUIT) frames = done; /* closed: stop after this frame */
   }
+  pthread_mutex_lock(&sh->lock);
+  sh->quit = 1;
+  pthread_cond_signal(&sh->wake);
+  pthread_mutex_unlock(&sh->lock);
+  pthread_join(th, NULL);
+  free(shown);
+  if (rc || sh->error) return rc ? rc : sh->error;
   printf("view scene=%s shade=%s trace=%s size=%dx%d frames=%d seconds=%.3f fps=%.2f%s%s\n", app->scene_name,
-         fr_shade_mode_name(s.mode), view_trace_names[s.trace], s.width, s.height, frames, total, frames / total,
+         fr_shade_mode_name(s.mode), view_trace_names[s.trace], s.width, s.height, done, total, done / total,
          screenshot ? " -> " : "", screenshot ? screenshot : "");
   return 0;
 }
@@ -361,6 +422,7 @@ int cmd_view(int argc, char **argv) {
   view_renderer_init(&app.r, s, &w, &po, &wo, so);
   pthread_mutex_init(&app.sh.lock, NULL);
   pthread_cond_init(&app.sh.wake, NULL);
+  pthread_cond_init(&app.sh.ready, NULL);
   app.win = SDL_CreateWindow("frusta", SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED, v.width, v.height,
                              frames ? 0 : SDL_WINDOW_RESIZABLE);
   if (app.win) app.ren = SDL_CreateRenderer(app.win, -1, 0);

@@ -1,0 +1,13 @@
+/*
+ * Sobol points for many paths at once (render/sampler.h), compiled once per
+ * ISA: fr_sample2d's own arithmetic lane by lane, which the compiler turns
+ * into vector code (byte swaps as shuffles, the tables as gathers), so the
+ * points are the same bits as one at a time.
+ */
+#include "base/simd.h"
+#include "render/sampler.h"
+
+void FR_ISA_FN(fr_sobol2d_batch)(const uint32_t *restrict keys, const uint32_t *restrict index, uint32_t dim, size_t n,
+                                 float *restrict u1, float *restrict u2) {
+  for (size_t i = 0; i < n; i++) fr_sample2d(FR_SAMPLER_SOBOL, keys[i], index[i], 0, dim, &u1[i], &u2[i]);
+}
