@@ -20,7 +20,7 @@
 
 /* A wave: a tile's paths for as many samples per pixel as fill it */
 #define WAVE FR_PATH_WAVE
-_Static_assert(WAVE >= TILE_PIX * FR_PATH_CHUNK && WAVE % (64 * 64) == 0, "a tile of any side holds a whole sample");
+_Static_assert(WAVE >= TILE_PIX * FR_PATH_CHUNK && WAVE >= 32 * 32 * 2, "a pass's samples fill waves");
 _Static_assert(WAVE <= 65536, "path_state.slot is 16 bits");
 /* The shader loads a hit's surface record and corner indices this many
  * hits ahead: they are scattered over the scene's arrays. */
@@ -183,7 +183,7 @@ static void tile_pixel(int i, int side, int *x, int *y) {
 
 int fr_path_tile_side(const fr_path_setup *P) {
   const int spp = P->spp_end - P->spp_begin;
-  return spp <= 1 ? 64 : spp <= 2 ? 32 : TILE;
+  return spp <= 2 ? 32 : TILE;
 }
 
 uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch *S, int tx, int ty) {

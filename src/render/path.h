@@ -20,12 +20,14 @@
 #include "render/sampler.h"
 
 #define FR_PATH_CHUNK 8          /* samples per pixel in one pass of frusta render and fr_renderer */
-/* Paths traced together: the tiles of a pass of one sample per pixel (a
- * viewer frame) are 64 pixels square and of two samples 32, so that their
- * waves still hold thousands of paths (16x16 tiles sent 256: 7% slower at
- * 1 spp than 1,024, which were 2% slower than 4,096); longer passes take
- * TILE, as the other workloads, level with larger tiles from 4 spp on and
- * short enough for a cluster's last tile of a long frame (docs/scaling.md). */
+/* Paths traced together, at most: a tile's for as many samples per pixel
+ * as fill the wave. Passes of one or two samples (a viewer frame) take
+ * tiles 32 pixels square, so that their waves still hold 1,024 or 2,048
+ * paths (16x16 tiles sent 256: 7% slower at 1 spp; 64x64 tiles, waves of
+ * 4,096, are 2% faster but keep the viewer from answering input for up to
+ * 15 ms rather than 5); longer passes take TILE, as the other workloads,
+ * short enough for a cluster's last tile of a long frame (docs/scaling.md),
+ * and at 16 spp a tile is one wave (2% faster than two of 2,048). */
 #define FR_PATH_WAVE 4096
 #define FR_PATH_RR_WEIGHT 0.15f
 #define FR_PATH_MAX_DEPTH 64
