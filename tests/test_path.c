@@ -211,16 +211,20 @@ static void batch_points_alike(void **st) {
   uint32_t keys[N], idx[N];
   for (uint32_t i = 0; i < N; i++) keys[i] = fr_sampler_pixel_key(11, i * 7919u), idx[i] = (i * 37u) % 64u;
   const fr_isa best = fr_get_isa();
+  static const uint32_t spps[] = {1, 48, 64}; /* Hammersley's: one at a time, and vectors */
   for (int k = 0; k < FR_SAMPLER_COUNT; k++)
     for (int isa = FR_ISA_SCALAR; isa <= (int)best; isa++) {
       assert_int_equal(fr_set_isa((fr_isa)isa), FR_OK);
       for (uint32_t d = 0; d < 40; d += 3)
         for (size_t n = 0; n <= N; n += n < 20 ? 1 : 61) {
+          const uint32_t spp = spps[(d + n) % 3];
+          uint32_t ix[N];
           float u1[N], u2[N];
-          fr_sample2d_batch((fr_sampler_kind)k, keys, idx, 64, d, n, u1, u2);
+          for (size_t i = 0; i < n; i++) ix[i] = idx[i] % spp;
+          fr_sample2d_batch((fr_sampler_kind)k, keys, ix, spp, d, n, u1, u2);
           for (size_t i = 0; i < n; i++) {
             float v1, v2;
-            fr_sample2d((fr_sampler_kind)k, keys[i], idx[i], 64, d, &v1, &v2);
+            fr_sample2d((fr_sampler_kind)k, keys[i], ix[i], spp, d, &v1, &v2);
             assert_memory_equal(&u1[i], &v1, sizeof v1);
             assert_memory_equal(&u2[i], &v2, sizeof v2);
           }

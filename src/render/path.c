@@ -25,7 +25,7 @@ _Static_assert(WAVE <= 65536, "path_state.slot is 16 bits");
 /* The shader loads a hit's surface record and corner indices this many
  * hits ahead: they are scattered over the scene's arrays. */
 #define PREFETCH_AHEAD 8
-/* Sobol points are made for this many paths at a time, as vector code */
+/* Sample points are made for this many paths at a time, as vector code */
 #define POINT_BLOCK 64
 
 typedef struct path_state {
@@ -165,8 +165,8 @@ static void block_points(const fr_path_setup *P, const path_state *st, size_t m,
 }
 
 /* Pair d + q of path st, the b-th of its block: from the block's points
- * (pts, for Sobol), or made here (NULL: Hammersley's, whose shuffle does
- * not vectorize, made only where a path needs them). */
+ * (pts, where they are vector code), or made here (NULL: only where a path
+ * needs them). */
 static inline void path_point(const fr_path_setup *P, const float (*pts)[POINT_BLOCK], size_t b, const path_state *st,
                               uint32_t d, int q, float *u1, float *u2) {
   if (pts) *u1 = pts[2 * q][b], *u2 = pts[2 * q + 1][b];
@@ -199,7 +199,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
   const vec3 ru = v3_norm(c->right), uu = v3_norm(c->up);
   const int side = fr_path_tile_side(P), npix = side * side, chunk = WAVE / npix;
   float block[8][POINT_BLOCK];
-  const float(*pts)[POINT_BLOCK] = P->sampler == FR_SAMPLER_SOBOL ? (const float(*)[POINT_BLOCK])block : NULL;
+  const float(*pts)[POINT_BLOCK] = fr_sampler_batches(P->sampler, (uint32_t)P->spp) ? (const float(*)[POINT_BLOCK])block : NULL;
   for (int s0 = P->spp_begin; s0 < P->spp_end; s0 += chunk) {
     const int s1 = s0 + chunk < P->spp_end ? s0 + chunk : P->spp_end;
     double t0 = fr_seconds();

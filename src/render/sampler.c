@@ -31,13 +31,18 @@ __attribute__((constructor)) static void sobol1_tables(void) {
 
 void fr_sample2d_batch(fr_sampler_kind k, const uint32_t *keys, const uint32_t *index, uint32_t n_spp, uint32_t d,
                        size_t n, float *u1, float *u2) {
-  if (k != FR_SAMPLER_SOBOL) { /* Hammersley's shuffle walks a loop per point: no vectors */
+  if (!fr_sampler_batches(k, n_spp)) {
     for (size_t i = 0; i < n; i++) fr_sample2d(k, keys[i], index[i], n_spp, d, &u1[i], &u2[i]);
     return;
   }
-  switch (fr_get_isa()) {
-  case FR_ISA_AVX512: fr_sobol2d_batch_avx512(keys, index, d, n, u1, u2); break;
-  case FR_ISA_AVX2: fr_sobol2d_batch_avx2(keys, index, d, n, u1, u2); break;
-  default: fr_sobol2d_batch_scalar(keys, index, d, n, u1, u2); break;
+  const fr_isa isa = fr_get_isa();
+  if (k == FR_SAMPLER_SOBOL) {
+    if (isa == FR_ISA_AVX512) fr_sobol2d_batch_avx512(keys, index, d, n, u1, u2);
+    else if (isa == FR_ISA_AVX2) fr_sobol2d_batch_avx2(keys, index, d, n, u1, u2);
+    else fr_sobol2d_batch_scalar(keys, index, d, n, u1, u2);
+  } else {
+    if (isa == FR_ISA_AVX512) fr_hammersley2d_pow2_batch_avx512(keys, index, n_spp, d, n, u1, u2);
+    else if (isa == FR_ISA_AVX2) fr_hammersley2d_pow2_batch_avx2(keys, index, n_spp, d, n, u1, u2);
+    else fr_hammersley2d_pow2_batch_scalar(keys, index, n_spp, d, n, u1, u2);
   }
 }

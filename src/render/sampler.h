@@ -40,22 +40,26 @@ static inline uint32_t fr_sampler_reverse(uint32_t x) {
 
 static inline float fr_sampler_unit(uint32_t x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
 
-/* A bijection of [0, n) keyed by key: a bijection of the enclosing power of
- * two (xor, odd multiply and xorshift, each invertible modulo it), walked
- * until it lands below n. */
+/* One step of a bijection of [0, mask] (mask + 1 a power of two, sh =
+ * log2(mask + 1) / 2 + 1) keyed by key: xor, odd multiply and xorshift,
+ * each invertible modulo mask + 1. */
+static inline uint32_t fr_sampler_permute_step(uint32_t i, uint32_t mask, unsigned sh, uint32_t key) {
+  i = (i ^ key) & mask;
+  i = (i * 0x2c1b3c6du) & mask;
+  i ^= i >> sh;
+  i = (i * 0x297a2d39u) & mask;
+  i ^= (i >> 3) & mask;
+  return (i + (key >> 7)) & mask;
+}
+
+/* A bijection of [0, n) keyed by key: steps over the enclosing power of
+ * two, walked until one lands below n (one step when n is a power of two). */
 static inline uint32_t fr_sampler_permute(uint32_t i, uint32_t n, uint32_t key) {
   if (n <= 1) return 0;
   const unsigned bits = 32u - (unsigned)__builtin_clz(n - 1);
   const uint32_t mask = bits >= 32 ? 0xffffffffu : (1u << bits) - 1u;
-  const unsigned sh = bits / 2u + 1u;
-  do {
-    i = (i ^ key) & mask;
-    i = (i * 0x2c1b3c6du) & mask;
-    i ^= i >> sh;
-    i = (i * 0x297a2d39u) & mask;
-    i ^= (i >> 3) & mask;
-    i = (i + (key >> 7)) & mask;
-  } while (i >= n);
+  do i = fr_sampler_permute_step(i, mask, bits / 2u + 1u, key);
+  while (i >= n);
   return i;
 }
 
@@ -81,6 +85,16 @@ static inline uint32_t fr_sampler_rsobol1(uint32_t jr) {
          fr_sampler_rsobol1_bytes[2][(jr >> 16) & 255u] ^ fr_sampler_rsobol1_bytes[3][jr >> 24];
 }
 
+/* Point j of n of a scrambled Hammersley pattern keyed by key: (j + r) / n
+ * with one random offset r per pattern, and the radical inverse with its
+ * bits flipped by a random mask: both keep the pattern's strata. */
+static inline void fr_hammersley_point(uint32_t j, uint32_t n, uint32_t key, float *u1, float *u2) {
+  const float r = fr_sampler_unit(fr_sampler_mix(key ^ 0x1b56c4e9u));
+  float x = ((float)j + r) / (float)n;
+  *u1 = x < 1.0f ? x : 0.99999994f;
+  *u2 = fr_sampler_unit(fr_sampler_reverse(j) ^ fr_sampler_mix(key ^ 0x7f4a7c15u));
+}
+
 static inline __attribute__((always_inline)) void fr_sample2d(fr_sampler_kind k, uint32_t pixel_key, uint32_t i,
                                                              uint32_t n, uint32_t d, float *u1, float *u2) {
   const uint32_t key = fr_sampler_mix(pixel_key + d * 0x51ed2705u);
@@ -94,21 +108,27 @@ static inline __attribute__((always_inline)) void fr_sample2d(fr_sampler_kind k,
         fr_sampler_reverse(fr_sampler_owen_reversed(fr_sampler_rsobol1(jr), fr_sampler_mix(key ^ 0xb5297a4du))));
     return;
   }
-  const uint32_t j = fr_sampler_permute(i, n, key);
-  /* (j + r) / n with one random offset r per pattern, and the radical
-   * inverse with its bits flipped by a random mask: both keep the
-   * pattern's strata */
-  const float r = fr_sampler_unit(fr_sampler_mix(key ^ 0x1b56c4e9u));
-  float x = ((float)j + r) / (float)n;
-  *u1 = x < 1.0f ? x : 0.99999994f;
-  *u2 = fr_sampler_unit(fr_sampler_reverse(j) ^ fr_sampler_mix(key ^ 0x7f4a7c15u));
+  fr_hammersley_point(fr_sampler_permute(i, n, key), n, key, u1, u2);
 }
+
+/* Whether fr_sample2d_batch makes kind k's points of patterns of n_spp as
+ * vector code: Sobol's always, Hammersley's where n_spp is a power of two
+ * above 1 (its shuffle is then one step; otherwise it walks a loop per
+ * point). */
+static inline int fr_sampler_batches(fr_sampler_kind k, uint32_t n_spp) {
+  return k == FR_SAMPLER_SOBOL || (n_spp > 1 && (n_spp & (n_spp - 1)) == 0);
+}
+
 /* fr_sample2d for n paths of one dimension pair d: path i's pixel key
  * keys[i] and sample index[i] (of n_spp) give (u1[i], u2[i]), the same
- * bits; Sobol's run as vector code (render/sampler_batch.c). */
+ * bits; as vector code where fr_sampler_batches (render/sampler_batch.c). */
 void fr_sample2d_batch(fr_sampler_kind k, const uint32_t *keys, const uint32_t *index, uint32_t n_spp, uint32_t d,
                        size_t n, float *u1, float *u2);
-void fr_sobol2d_batch_scalar(const uint32_t *keys, const uint32_t *index, uint32_t d, size_t n, float *u1, float *u2);
-void fr_sobol2d_batch_avx2(const uint32_t *keys, const uint32_t *index, uint32_t d, size_t n, float *u1, float *u2);
-void fr_sobol2d_batch_avx512(const uint32_t *keys, const uint32_t *index, uint32_t d, size_t n, float *u1, float *u2);
+#define FR_SAMPLER_BATCH_FNS(isa)                                                                                    \
+  void fr_sobol2d_batch_##isa(const uint32_t *keys, const uint32_t *index, uint32_t d, size_t n, float *u1, float *u2); \
+  void fr_hammersley2d_pow2_batch_##isa(const uint32_t *keys, const uint32_t *index, uint32_t n_spp, uint32_t d, size_t n, \
+                                        float *u1, float *u2);
+FR_SAMPLER_BATCH_FNS(scalar)
+FR_SAMPLER_BATCH_FNS(avx2)
+FR_SAMPLER_BATCH_FNS(avx512)
 #endif
