@@ -26,8 +26,9 @@ if [ "${FRUSTA_SANITIZE_TESTS:-1}" != 0 ]; then
 fi
 if [ "${FRUSTA_TSAN_TESTS:-1}" != 0 ]; then
   # ThreadSanitizer over the threaded paths: many threads calling one
-  # scene, the hybrid's per-thread tuning, and the command's render and
-  # bench on worker threads; any report fails the run. Built with clang,
+  # scene, the same answers after different rays on every thread, and the
+  # command's render, bench and view on worker threads; any report fails
+  # the run. Built with clang,
   # whose OpenMP runtime tells the sanitizer of its barriers through the
   # Archer tool (GCC's libgomp does not, and its joins read as races).
   # This build leaves MPI out: the command must work without it.
@@ -62,8 +63,12 @@ if [ "${FRUSTA_TSAN_TESTS:-1}" != 0 ]; then
   for k in 2 w 7 m m 4 6 n 1 5; do DISPLAY=":$D" xdotool search --sync --name frusta key $k >/dev/null 2>&1; sleep 0.3; done
   kill -TERM $VP
   vstatus=0; wait $VP || vstatus=$?
+  [ "$vstatus" -eq 0 ] || { kill $XPID; echo "ThreadSanitizer: the viewer exited $vstatus"; exit 1; }
+  # scripted frames: the worker renders the next frame while the main thread shows one
+  DISPLAY=":$D" XDG_RUNTIME_DIR="$out/xdg" "$TSAN/frusta" view --builtin --size 96x64 --threads 4 --shade path \
+    --frames 4 --turntable 5 --screenshot "$out/frame_#.png" >/dev/null || vstatus=$?
   kill $XPID
-  [ "$vstatus" -eq 0 ] || { echo "ThreadSanitizer: the viewer exited $vstatus"; exit 1; }
+  [ "$vstatus" -eq 0 ] || { echo "ThreadSanitizer: the scripted viewer exited $vstatus"; exit 1; }
   rm -rf "$out"
   unset TSAN_OPTIONS OMP_TOOL_LIBRARIES
   echo "ThreadSanitizer: threads, same answers, render, bench and view on 4 threads (built without MPI): no report"
