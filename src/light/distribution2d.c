@@ -66,7 +66,7 @@ static int find(const float *cdf, const uint32_t *guide, int n, float u) {
   return i;
 }
 
-float fr_dist2d_sample(const fr_dist2d *d, float u1, float u2, float *u, float *v, int *x, int *y) {
+void fr_dist2d_sample(const fr_dist2d *d, float u1, float u2, float *u, float *v, int *x, int *y) {
   const int yy = find(d->cdf_marg, d->guide_marg, d->h, u2);
   const float *c = d->cdf_row + (size_t)yy * ((size_t)d->w + 1);
   const int xx = find(c, d->guide_row + (size_t)yy * d->w, d->w, u1);
@@ -77,7 +77,6 @@ float fr_dist2d_sample(const fr_dist2d *d, float u1, float u2, float *u, float *
   if (*u >= 1.0f) *u = 0.99999994f;
   if (*v >= 1.0f) *v = 0.99999994f;
   *x = xx, *y = yy;
-  return fr_dist2d_pdf(d, xx, yy);
 }
 
 float fr_dist2d_pdf(const fr_dist2d *d, int x, int y) {

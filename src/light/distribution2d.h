@@ -25,8 +25,9 @@ typedef struct fr_dist2d {
 /* FR_ERR_ARG when every weight is 0 (nothing to sample). */
 fr_error fr_dist2d_build(fr_dist2d *d, const float *weight, int w, int h);
 void fr_dist2d_free(fr_dist2d *d);
-/* A point (u, v) in [0, 1)^2 from u1 (column) and u2 (row), its cell in
- * *x, *y, and the density over the unit square, w h weight / total. */
-float fr_dist2d_sample(const fr_dist2d *d, float u1, float u2, float *u, float *v, int *x, int *y);
+/* A point (u, v) in [0, 1)^2 from u1 (column) and u2 (row), and its cell
+ * in *x, *y. */
+void fr_dist2d_sample(const fr_dist2d *d, float u1, float u2, float *u, float *v, int *x, int *y);
+/* The density over the unit square in cell (x, y), w h weight / total. */
 float fr_dist2d_pdf(const fr_dist2d *d, int x, int y);
 #endif

@@ -5,7 +5,7 @@
 #include "base/alloc.h"
 #include "base/bilinear.h"
 #include "base/error.h"
-#include "base/sincos.h"
+#include "base/trig.h"
 #include "io/image_read.h"
 
 #define PI_F 3.14159265358979323846f
@@ -32,7 +32,15 @@ fr_error fr_env_from_image(fr_env *e, float *rgb, int w, int h) {
   fr_error err = fr_dist2d_build(&e->dist, weight, w, h);
   free(weight);
   if (err == FR_ERR_ARG) e->black = 1, err = FR_OK; /* an all-black image lights nothing */
+  if (!err && !(e->texels = malloc(fr_mul_size(fr_mul_size((size_t)w, (size_t)h), 4 * sizeof(float)))))
+    err = fr_fail(FR_ERR_NOMEM, "out of memory for the environment's texels");
   if (err) { fr_env_free(e); return err; }
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      const size_t i = (size_t)y * w + x;
+      memcpy(e->texels + 4 * i, rgb + 3 * i, 3 * sizeof(float));
+      e->texels[4 * i + 3] = e->black ? 0.0f : fr_dist2d_pdf(&e->dist, x, y);
+    }
   fr_env_orient(e, v3(0, 1, 0), 0.0f, 1.0f);
   return FR_OK;
 }
@@ -55,35 +63,41 @@ void fr_env_orient(fr_env *e, vec3 up, float rotate_deg, float intensity) {
 
 void fr_env_free(fr_env *e) {
   free(e->rgb);
+  free(e->texels);
   fr_dist2d_free(&e->dist);
   memset(e, 0, sizeof *e);
 }
 
-/* dir to image coordinates (u, v) in [0, 1)^2 and sin(theta) */
-static void to_uv(const fr_env *e, vec3 d, float *u, float *v, float *sin_t) {
-  const float z = fr_maxf(-1.0f, fr_minf(1.0f, v3_dot(d, e->az)));
-  const float theta = acosf(z);
-  float phi = atan2f(v3_dot(d, e->ay), v3_dot(d, e->ax)) - e->rotate;
-  float uu = phi * (0.5f / PI_F);
-  uu -= floorf(uu);
-  *u = uu < 1.0f ? uu : 0.0f;
-  *v = fr_minf(theta / PI_F, 0.99999994f);
-  *sin_t = sqrtf(fr_maxf(0.0f, 1.0f - z * z));
+/* The map's rotation in turns, in [0, 1). */
+static float rotate_turns(const fr_env *e) {
+  const float r = e->rotate * (0.5f / PI_F);
+  return r - floorf(r);
 }
 
-static vec3 texel(const fr_env *e, float u, float v, int *x, int *y) {
-  *x = (int)(u * (float)e->w), *y = (int)(v * (float)e->h);
-  if (*x >= e->w) *x = e->w - 1;
-  if (*y >= e->h) *y = e->h - 1;
-  return v3_load(e->rgb + 3 * ((size_t)*y * e->w + *x));
+/* dir to image coordinates (u, v) in [0, 1)^2 and sin(theta): theta =
+ * acos(z) is atan2(sin theta, z), both angles in turns (base/trig.h) */
+static void to_uv(const fr_env *e, vec3 d, float *u, float *v, float *sin_t) {
+  const float z = fr_maxf(-1.0f, fr_minf(1.0f, v3_dot(d, e->az))), st = sqrtf(fr_maxf(0.0f, 1.0f - z * z));
+  float uu = fr_atan2_turns(v3_dot(d, e->ay), v3_dot(d, e->ax)) - rotate_turns(e);
+  uu -= floorf(uu);
+  *u = uu < 1.0f ? uu : 0.0f;
+  *v = fr_minf(2.0f * fr_atan2_turns(st, z), 0.99999994f);
+  *sin_t = st;
+}
+
+/* The texel at (u, v): its r, g, b and density */
+static const float *texel(const fr_env *e, float u, float v) {
+  int x = (int)(u * (float)e->w), y = (int)(v * (float)e->h);
+  if (x >= e->w) x = e->w - 1;
+  if (y >= e->h) y = e->h - 1;
+  return e->texels + 4 * ((size_t)y * e->w + x);
 }
 
 vec3 fr_env_eval(const fr_env *e, vec3 dir) {
   if (!e->rgb) return v3_scale(e->color, e->intensity);
   float u, v, s;
-  int x, y;
   to_uv(e, dir, &u, &v, &s);
-  return v3_scale(texel(e, u, v, &x, &y), e->intensity);
+  return v3_scale(v3_load(texel(e, u, v)), e->intensity);
 }
 
 vec3 fr_env_sample(const fr_env *e, float u1, float u2, vec3 *dir, float *pdf) {
@@ -98,13 +112,17 @@ vec3 fr_env_sample(const fr_env *e, float u1, float u2, vec3 *dir, float *pdf) {
   }
   float u, v;
   int x, y;
-  const float puv = fr_dist2d_sample(&e->dist, u1, u2, &u, &v, &x, &y);
-  const float theta = v * PI_F, phi = u * 2.0f * PI_F + e->rotate, st = sinf(theta);
+  fr_dist2d_sample(&e->dist, u1, u2, &u, &v, &x, &y);
+  const float *t = e->texels + 4 * ((size_t)y * e->w + x), puv = t[3];
+  /* theta = pi v, phi = 2 pi u + rotate: both in turns */
+  float st, ct, sp, cp, turns = u + rotate_turns(e);
+  fr_sincos_turns(0.5f * v, &st, &ct);
+  fr_sincos_turns(turns < 1.0f ? turns : turns - 1.0f, &sp, &cp);
   if (!(puv > 0.0f) || !(st > 0.0f)) { *pdf = 0.0f; return v3(0, 0, 0); }
-  const vec3 l = v3(st * cosf(phi), st * sinf(phi), cosf(theta));
+  const vec3 l = v3(st * cp, st * sp, ct);
   *dir = v3_add(v3_add(v3_scale(e->ax, l.x), v3_scale(e->ay, l.y)), v3_scale(e->az, l.z));
   *pdf = puv / (2.0f * PI_F * PI_F * st);
-  return v3_scale(v3_load(e->rgb + 3 * ((size_t)y * e->w + x)), e->intensity);
+  return v3_scale(v3_load(t), e->intensity);
 }
 
 float fr_env_pdf(const fr_env *e, vec3 dir) {
@@ -119,11 +137,10 @@ vec3 fr_env_eval_pdf(const fr_env *e, vec3 dir, float *pdf) {
     return v3_scale(e->color, e->intensity);
   }
   float u, v, s;
-  int x, y;
   to_uv(e, dir, &u, &v, &s);
-  const vec3 c = texel(e, u, v, &x, &y);
-  *pdf = e->black || !(s > 0.0f) ? 0.0f : fr_dist2d_pdf(&e->dist, x, y) / (2.0f * PI_F * PI_F * s);
-  return v3_scale(c, e->intensity);
+  const float *t = texel(e, u, v);
+  *pdf = !(s > 0.0f) ? 0.0f : t[3] / (2.0f * PI_F * PI_F * s); /* 0 where black */
+  return v3_scale(v3_load(t), e->intensity);
 }
 
 vec3 fr_env_eval_smooth(const fr_env *e, vec3 dir) {

@@ -15,6 +15,9 @@ typedef struct fr_env {
   vec3 color;       /* the constant environment (no image) */
   int w, h;
   float *rgb;       /* the image, or NULL */
+  float *texels;    /* per texel its r, g, b and the distribution's density there, so that a
+                       lookup of both takes one cache line (the image's own array serves the
+                       bilinear background) */
   fr_dist2d dist;
   vec3 ax, ay, az;  /* world frame: az the zenith */
   float intensity;

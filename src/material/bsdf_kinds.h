@@ -1,7 +1,7 @@
 /* The material kinds' own sample / eval / pdf (internal to src/material). */
 #ifndef FR_MATERIAL_BSDF_KINDS_H
 #define FR_MATERIAL_BSDF_KINDS_H
-#include "base/sincos.h"
+#include "base/trig.h"
 #include "material/bsdf.h"
 
 #define FR_DECLARE_BSDF(kind)                                                                                      \

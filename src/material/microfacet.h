@@ -8,7 +8,7 @@
 #define FR_MATERIAL_MICROFACET_H
 #include <math.h>
 #include "base/vec3.h"
-#include "base/sincos.h"
+#include "base/trig.h"
 
 static inline float fr_ggx_d(vec3 h, float a) {
   if (h.z <= 0.0f) return 0.0f;

@@ -12,7 +12,7 @@
 #include <string.h>
 #include "base/alloc.h"
 #include "base/error.h"
-#include "base/sincos.h"
+#include "base/trig.h"
 #include "base/timer.h"
 #include "material/texture.h"
 #include "render/surfaces.h"
