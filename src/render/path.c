@@ -199,7 +199,8 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
   const vec3 ru = v3_norm(c->right), uu = v3_norm(c->up);
   const int side = fr_path_tile_side(P), npix = side * side, chunk = WAVE / npix;
   float block[8][POINT_BLOCK];
-  const float(*pts)[POINT_BLOCK] = fr_sampler_batches(P->sampler, (uint32_t)P->spp) ? (const float(*)[POINT_BLOCK])block : NULL;
+  const int batches = fr_sampler_batches(P->sampler, (uint32_t)P->spp);
+  const float(*pts)[POINT_BLOCK] = batches ? (const float(*)[POINT_BLOCK])block : NULL;
   for (int s0 = P->spp_begin; s0 < P->spp_end; s0 += chunk) {
     const int s1 = s0 + chunk < P->spp_end ? s0 + chunk : P->spp_end;
     double t0 = fr_seconds();

@@ -74,9 +74,10 @@ fr_path_scratch *fr_path_scratch_new(void);
 void fr_path_scratch_free(fr_path_scratch *s);
 /* Adds what s's tiles spent tracing (camera, shadow, bounce rays) and shading to stage[]. */
 void fr_path_scratch_stages(const fr_path_scratch *s, double *stage);
-/* One tile (fr_path_tile_side pixels square): adds the samples' radiance to w->image (sums, not
- * means) and, where set, first-hit albedo, normal and distance to
- * w->gbuf_albedo, gbuf_normal and gbuf_depth; returns the rays traced.
+/* One tile (fr_path_tile_side pixels square): adds the samples' radiance
+ * to w->image (sums, not means) and, where set, first-hit albedo, normal
+ * and distance to w->gbuf_albedo, gbuf_normal and gbuf_depth; returns the
+ * rays traced.
  * Each pixel's samples are added one by one in sample order, so a run of
  * samples split into calls any way sums to the same bits. */
 uint64_t fr_path_tile(const struct fr_workload *w, const struct fr_tracer *t, fr_path_scratch *s, int tx, int ty);

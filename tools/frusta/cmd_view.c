@@ -104,7 +104,9 @@ static void *worker(void *arg) {
       pthread_mutex_unlock(&sh->lock);
     }
     if (!rc) fresh = view_renderer_pass(&app->r, &sh->cancel);
-    if (!rc && sh->lockstep) { /* every step shows a frame, the last one again when nothing was left to do */
+    /* every step shows a frame, the last one again when nothing was left to
+     * do; a step abandoned (the window closed) shows and writes nothing */
+    if (!rc && sh->lockstep && !__atomic_load_n(&sh->cancel, __ATOMIC_RELAXED)) {
       fresh = 1;
       if (!app->r.bgra) rc = cli_error(1, "view: nothing rendered");
       else if (step_shot[0]) rc = view_renderer_screenshot(&app->r, step_shot);
@@ -287,7 +289,8 @@ static void frame_ask(view_app *app, const view_settings *s, int i, int frames, 
   sh->want = *s;
   sh->gen++;
   sh->step_shot[0] = 0;
-  if (screenshot && (strchr(screenshot, '#') || i == frames - 1)) frame_name(screenshot, i, sh->step_shot, sizeof sh->step_shot);
+  if (screenshot && (strchr(screenshot, '#') || i == frames - 1))
+    frame_name(screenshot, i, sh->step_shot, sizeof sh->step_shot);
   pthread_cond_signal(&sh->wake);
 }
 
@@ -340,6 +343,7 @@ static int run_frames(view_app *app, view_settings s, int frames, const view_cam
   }
   pthread_mutex_lock(&sh->lock);
   sh->quit = 1;
+  __atomic_store_n(&sh->cancel, 1, __ATOMIC_RELAXED); /* a frame asked for and no longer wanted */
   pthread_cond_signal(&sh->wake);
   pthread_mutex_unlock(&sh->lock);
   pthread_join(th, NULL);
