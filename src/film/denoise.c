@@ -6,10 +6,11 @@
 #include "base/alloc.h"
 #include "base/error.h"
 #include "film/atrous.h"
+#include "film/denoise_planes.h"
 #include "render/progressive.h"
 
 #define MISS FR_DEPTH_MISS
-#define ALBEDO_MIN 0.01f /* dividing by less would amplify noise on black surfaces */
+_Static_assert(FR_DENOISE_MISS == FR_DEPTH_MISS, "the planes' background depth is the guides'");
 
 /* max and min as compares (fmaxf and fminf are calls at this ISA level) */
 static inline float maxf(float a, float b) { return a > b ? a : b; }
@@ -72,32 +73,23 @@ static size_t at(const fr_denoiser *d, int x, int y) {
   return (size_t)(y + FR_ATROUS_PAD) * d->stride + (size_t)(x + FR_ATROUS_PAD);
 }
 
-/* Row y of the image into the planes: illumination (colour over albedo;
- * non-finite colour as 0), unit normals, depth (MISS for background,
- * whose colour is kept as it is). */
+/* Row y of the image into the planes (film/denoise_planes.h, vector code
+ * per ISA), and its summed illumination where it sees geometry. */
 static void split_row(fr_denoiser *d, const float *rgb, const float *albedo, const float *normal, const float *depth,
                       int y) {
+  const size_t o = at(d, 0, y);
+  float *const *p = d->p;
+  float *in0 = p[P_IN0] + o, *in1 = p[P_IN1] + o, *in2 = p[P_IN2] + o, *z = p[P_Z] + o;
+  float *n0 = p[P_N0] + o, *n1 = p[P_N1] + o, *n2 = p[P_N2] + o;
+  switch (fr_get_isa()) {
+  case FR_ISA_AVX512: fr_denoise_split_avx512(rgb, albedo, normal, depth, d->width, in0, in1, in2, n0, n1, n2, z); break;
+  case FR_ISA_AVX2: fr_denoise_split_avx2(rgb, albedo, normal, depth, d->width, in0, in1, in2, n0, n1, n2, z); break;
+  default: fr_denoise_split_scalar(rgb, albedo, normal, depth, d->width, in0, in1, in2, n0, n1, n2, z); break;
+  }
   double lum = 0.0;
   int hits = 0;
-  const size_t o = at(d, 0, y);
-  float *in0 = d->p[P_IN0] + o, *in1 = d->p[P_IN1] + o, *in2 = d->p[P_IN2] + o;
-  float *n0 = d->p[P_N0] + o, *n1 = d->p[P_N1] + o, *n2 = d->p[P_N2] + o, *z = d->p[P_Z] + o;
-  for (int x = 0; x < d->width; x++) {
-    const float *c = rgb + 3 * x, *a = albedo + 3 * x, *n = normal + 3 * x;
-    const float zz = depth[x];
-    const int hit = zz < 1e29f; /* NaN: background */
-    const float len2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-    const float inv = hit && len2 > 0.0f ? 1.0f / sqrtf(len2) : 0.0f;
-    float v[3];
-    for (int k = 0; k < 3; k++) {
-      const float ck = c[k] - c[k] == 0.0f ? c[k] : 0.0f; /* inf and NaN: 0 */
-      v[k] = hit ? ck / maxf(a[k], ALBEDO_MIN) : c[k];
-    }
-    in0[x] = v[0], in1[x] = v[1], in2[x] = v[2];
-    if (hit) lum += 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2], hits++;
-    n0[x] = n[0] * inv, n1[x] = n[1] * inv, n2[x] = n[2] * inv;
-    z[x] = hit ? zz : MISS;
-  }
+  for (int x = 0; x < d->width; x++)
+    if (z[x] < 1e29f) lum += 0.2126 * in0[x] + 0.7152 * in1[x] + 0.0722 * in2[x], hits++;
   d->row_lum[y] = lum, d->row_hits[y] = hits;
 }
 
@@ -147,10 +139,12 @@ void fr_denoise(fr_denoiser *d, const float *rgb, const float *albedo, const flo
     for (int c = 0; c < 3; c++) { float *t = src[c]; src[c] = dst[c]; dst[c] = t; }
   }
 #pragma omp parallel for num_threads(threads) schedule(static)
-  for (int y = 0; y < H; y++)
-    for (int x = 0; x < W; x++) {
-      const size_t i = (size_t)y * W + x, o = at(d, x, y);
-      const int hit = p[P_Z][o] < 1e29f;
-      for (int c = 0; c < 3; c++) out[3 * i + c] = hit ? src[c][o] * maxf(albedo[3 * i + c], ALBEDO_MIN) : src[c][o];
+  for (int y = 0; y < H; y++) {
+    const size_t o = at(d, 0, y), i = 3 * (size_t)y * W;
+    switch (fr_get_isa()) {
+    case FR_ISA_AVX512: fr_denoise_merge_avx512(src[0] + o, src[1] + o, src[2] + o, p[P_Z] + o, albedo + i, W, out + i); break;
+    case FR_ISA_AVX2: fr_denoise_merge_avx2(src[0] + o, src[1] + o, src[2] + o, p[P_Z] + o, albedo + i, W, out + i); break;
+    default: fr_denoise_merge_scalar(src[0] + o, src[1] + o, src[2] + o, p[P_Z] + o, albedo + i, W, out + i); break;
     }
+  }
 }
