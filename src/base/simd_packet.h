@@ -40,6 +40,12 @@ FR_INLINE vpf vp(float a) { vpf r = {FR_VP_OP(set1_ps)(a)}; return r; }
 FR_INLINE vpf vp_load(const float *p) { vpf r = {FR_VP_OP(load_ps)(p)}; return r; }
 FR_INLINE vpf vp_loadu(const float *p) { vpf r = {FR_VP_OP(loadu_ps)(p)}; return r; }
 FR_INLINE void vp_store(float *p, vpf a) { FR_VP_OP(store_ps)(p, a.v); }
+/* P 16-bit integers as floats (exact) */
+#if P == 16
+FR_INLINE vpf vp_loadu_i16(const int16_t *p) { vpf r = {_mm512_cvtepi32_ps(_mm512_cvtepi16_epi32(_mm256_loadu_si256((const __m256i *)p)))}; return r; }
+#else
+FR_INLINE vpf vp_loadu_i16(const int16_t *p) { vpf r = {_mm256_cvtepi32_ps(_mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)p)))}; return r; }
+#endif
 #define FR_VP_BIN(name, op) FR_INLINE vpf name(vpf a, vpf b) { vpf r = {FR_VP_OP(op)(a.v, b.v)}; return r; }
 FR_VP_BIN(vp_add, add_ps) FR_VP_BIN(vp_sub, sub_ps) FR_VP_BIN(vp_mul, mul_ps)
 FR_VP_BIN(vp_div, div_ps) FR_VP_BIN(vp_min, min_ps) FR_VP_BIN(vp_max, max_ps)
@@ -91,6 +97,11 @@ FR_INLINE vpf vp_select(vpm m, vpf t, vpf f) { vpf r; for (int h = 0; h < FR_VP_
 FR_INLINE vpm vpm_and(vpm a, vpm b) { vpm r; for (int h = 0; h < FR_VP_HALVES; h++) r.m[h] = _mm256_and_ps(a.m[h], b.m[h]); return r; }
 FR_VP_BIN(vp_and, _mm256_and_ps) FR_VP_BIN(vp_or, _mm256_or_ps) FR_VP_BIN(vp_xor, _mm256_xor_ps)
 FR_INLINE vpf vp_loadu(const float *p) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_loadu_ps(p + 8 * h); return r; }
+FR_INLINE vpf vp_loadu_i16(const int16_t *p) {
+  vpf r;
+  for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_cvtepi32_ps(_mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)(p + 8 * h))));
+  return r;
+}
 FR_INLINE vpf vp_sqrt(vpf a) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_sqrt_ps(a.v[h]); return r; }
 #define FR_VP_IBIN(name, op) \
   FR_INLINE vpf name(vpf a, vpf b) { vpf r; for (int h = 0; h < FR_VP_HALVES; h++) r.v[h] = _mm256_castsi256_ps(op(_mm256_castps_si256(a.v[h]), _mm256_castps_si256(b.v[h]))); return r; }
@@ -135,6 +146,7 @@ FR_INLINE float fr_vp_bits_xor(float a, float b) {
 FR_VP_BIN(vp_and, fr_vp_bits_and(a.f[i], b.f[i])) FR_VP_BIN(vp_or, fr_vp_bits_or(a.f[i], b.f[i]))
 FR_VP_BIN(vp_xor, fr_vp_bits_xor(a.f[i], b.f[i]))
 FR_INLINE vpf vp_loadu(const float *p) FR_VP_LANES(p[i])
+FR_INLINE vpf vp_loadu_i16(const int16_t *p) FR_VP_LANES((float)p[i])
 FR_INLINE vpf vp_sqrt(vpf a) FR_VP_LANES(sqrtf(a.f[i]))
 FR_VP_BIN(vp_imin, fr_f2i(a.f[i]) < fr_f2i(b.f[i]) ? a.f[i] : b.f[i])
 FR_VP_BIN(vp_imax, fr_f2i(a.f[i]) > fr_f2i(b.f[i]) ? a.f[i] : b.f[i])

@@ -23,11 +23,12 @@ void FR_ISA_FN(fr_atrous_rows)(const fr_atrous_level *L, int y0, int y1) {
   static const float kern[3] = {0.25f, 0.5f, 0.25f};
   const ptrdiff_t st = (ptrdiff_t)L->stride, s = L->step;
   const vpf zero = vp(0.0f), one = vp(1.0f), miss = vp(1e29f);
+  const vpf unit2 = vp(1.0f / (FR_ATROUS_NORMAL_ONE * FR_ATROUS_NORMAL_ONE)); /* the normals' dot product to cosines */
   for (int y = y0; y < y1; y++)
     for (int x = 0; x < L->width; x += FR_ATROUS_LANES) {
       const ptrdiff_t o = (ptrdiff_t)(y + FR_ATROUS_PAD) * st + x + FR_ATROUS_PAD;
       const vpf zp = vp_load(L->z + o), gp = vp_load(L->zgrad + o);
-      const vpf npx = vp_load(L->nrm[0] + o), npy = vp_load(L->nrm[1] + o), npz = vp_load(L->nrm[2] + o);
+      const vpf npx = vp_loadu_i16(L->nrm[0] + o), npy = vp_loadu_i16(L->nrm[1] + o), npz = vp_loadu_i16(L->nrm[2] + o);
       const vpf cr = vp_load(L->in[0] + o), cg = vp_load(L->in[1] + o), cb = vp_load(L->in[2] + o);
       const vpf lp = luminance(cr, cg, cb);
       const vpf inv_l = vp_div(one, vp_add(vp_mul(vp(2.0f * L->sigma_l), vp_add(lp, vp(L->lum_floor))), vp(1e-4f)));
@@ -40,9 +41,9 @@ void FR_ISA_FN(fr_atrous_rows)(const fr_atrous_level *L, int y0, int y1) {
           const ptrdiff_t q = o + j * s * st + i * s;
           const vpf zq = vp_loadu(L->z + q);
           const vpf qr = vp_loadu(L->in[0] + q), qg = vp_loadu(L->in[1] + q), qb = vp_loadu(L->in[2] + q);
-          vpf dn = vp_add(vp_add(vp_mul(npx, vp_loadu(L->nrm[0] + q)), vp_mul(npy, vp_loadu(L->nrm[1] + q))),
-                          vp_mul(npz, vp_loadu(L->nrm[2] + q)));
-          dn = vp_max(zero, dn);
+          vpf dn = vp_add(vp_add(vp_mul(npx, vp_loadu_i16(L->nrm[0] + q)), vp_mul(npy, vp_loadu_i16(L->nrm[1] + q))),
+                          vp_mul(npz, vp_loadu_i16(L->nrm[2] + q)));
+          dn = vp_mul(vp_max(zero, dn), unit2);
           dn = vp_mul(dn, dn), dn = vp_mul(dn, dn), dn = vp_mul(dn, dn), dn = vp_mul(dn, dn);
           const vpf wz = vp_max(zero, vp_sub(one, vp_mul(vp_abs(vp_sub(zp, zq)), inv_z[(i != 0) + (j != 0)])));
           const vpf wl = vp_max(zero, vp_sub(one, vp_mul(vp_abs(vp_sub(lp, luminance(qr, qg, qb))), inv_l)));

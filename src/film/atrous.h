@@ -6,16 +6,19 @@
 #ifndef FR_FILM_ATROUS_H
 #define FR_FILM_ATROUS_H
 #include <stddef.h>
+#include <stdint.h>
 
 #define FR_ATROUS_PAD 16   /* border of every plane: the widest step, so taps never leave the plane */
 #define FR_ATROUS_LANES 16 /* pixels per vector; a row's length is padded to a multiple */
+#define FR_ATROUS_NORMAL_ONE 32767.0f /* a unit normal's component of 1 in the 16-bit normal planes */
 
 typedef struct fr_atrous_level {
   /* planes of the same padded layout: element (x, y) of the image at
    * plane[(y + PAD) * stride + x + PAD] */
   const float *in[3];  /* illumination (colour divided by albedo) */
   float *out[3];
-  const float *nrm[3]; /* unit normals; 0 in the border */
+  const int16_t *nrm[3]; /* unit normals times FR_ATROUS_NORMAL_ONE; 0 in the border (16 bits: the
+                           filter's levels are bound by memory traffic) */
   const float *z;      /* depth; FR_DEPTH_MISS where the camera sees the background and in the border */
   const float *zgrad;  /* depth change per pixel step */
   size_t stride;       /* a multiple of FR_ATROUS_LANES; planes 64-byte aligned, so each row's vectors are */

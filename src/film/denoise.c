@@ -17,13 +17,14 @@ static inline float maxf(float a, float b) { return a > b ? a : b; }
 static inline float minf(float a, float b) { return a < b ? a : b; }
 static inline float absf(float a) { return a < 0.0f ? -a : a; }
 
-enum { P_IN0, P_IN1, P_IN2, P_TMP0, P_TMP1, P_TMP2, P_N0, P_N1, P_N2, P_Z, P_ZG, P_COUNT };
+enum { P_IN0, P_IN1, P_IN2, P_TMP0, P_TMP1, P_TMP2, P_Z, P_ZG, P_COUNT };
 
 struct fr_denoiser {
   int width, height, row; /* row: pixels filtered per row (width rounded up to the lanes) */
   size_t stride, plane;   /* floats per padded row and per plane */
   float *mem;
   float *p[P_COUNT];
+  int16_t *nrm[3];        /* the normal planes, 16 bits (film/atrous.h) */
   double *row_lum;        /* per row: the summed luminance of the illumination where it sees geometry */
   int *row_hits;          /* ... and how many pixels that is */
 };
@@ -46,7 +47,7 @@ fr_error fr_denoiser_new(int width, int height, fr_denoiser **out) {
   d->row = (width + FR_ATROUS_LANES - 1) / FR_ATROUS_LANES * FR_ATROUS_LANES;
   d->stride = (size_t)d->row + 2 * FR_ATROUS_PAD;
   d->plane = d->stride * ((size_t)height + 2 * FR_ATROUS_PAD);
-  d->mem = fr_alloc_aligned(d->plane * P_COUNT * sizeof(float), 64);
+  d->mem = fr_alloc_aligned(d->plane * P_COUNT * sizeof(float) + 3 * d->plane * sizeof(int16_t), 64);
   d->row_lum = malloc((size_t)height * sizeof *d->row_lum);
   d->row_hits = malloc((size_t)height * sizeof *d->row_hits);
   if (!d->mem || !d->row_lum || !d->row_hits) {
@@ -54,8 +55,9 @@ fr_error fr_denoiser_new(int width, int height, fr_denoiser **out) {
     return fr_fail(FR_ERR_NOMEM, "out of memory for the denoiser");
   }
   for (int k = 0; k < P_COUNT; k++) d->p[k] = d->mem + (size_t)k * d->plane;
+  for (int k = 0; k < 3; k++) d->nrm[k] = (int16_t *)(d->mem + (size_t)P_COUNT * d->plane) + (size_t)k * d->plane;
   /* the border: background, which no pixel blends with */
-  memset(d->mem, 0, d->plane * P_COUNT * sizeof(float));
+  memset(d->mem, 0, d->plane * P_COUNT * sizeof(float) + 3 * d->plane * sizeof(int16_t));
   for (size_t i = 0; i < d->plane; i++) d->p[P_Z][i] = MISS;
   *out = d;
   return FR_OK;
@@ -80,7 +82,7 @@ static void split_row(fr_denoiser *d, const float *rgb, const float *albedo, con
   const size_t o = at(d, 0, y);
   float *const *p = d->p;
   float *in0 = p[P_IN0] + o, *in1 = p[P_IN1] + o, *in2 = p[P_IN2] + o, *z = p[P_Z] + o;
-  float *n0 = p[P_N0] + o, *n1 = p[P_N1] + o, *n2 = p[P_N2] + o;
+  int16_t *n0 = d->nrm[0] + o, *n1 = d->nrm[1] + o, *n2 = d->nrm[2] + o;
   switch (fr_get_isa()) {
   case FR_ISA_AVX512: fr_denoise_split_avx512(rgb, albedo, normal, depth, d->width, in0, in1, in2, n0, n1, n2, z); break;
   case FR_ISA_AVX2: fr_denoise_split_avx2(rgb, albedo, normal, depth, d->width, in0, in1, in2, n0, n1, n2, z); break;
@@ -131,7 +133,7 @@ void fr_denoise(fr_denoiser *d, const float *rgb, const float *albedo, const flo
   const float lum_floor = mean / (float)(spp > 1 ? spp : 1);
   float *src[3] = {p[P_IN0], p[P_IN1], p[P_IN2]}, *dst[3] = {p[P_TMP0], p[P_TMP1], p[P_TMP2]};
   for (int level = 0; level < FR_DENOISE_LEVELS; level++) {
-    fr_atrous_level L = {{src[0], src[1], src[2]}, {dst[0], dst[1], dst[2]}, {p[P_N0], p[P_N1], p[P_N2]}, p[P_Z], p[P_ZG],
+    fr_atrous_level L = {{src[0], src[1], src[2]}, {dst[0], dst[1], dst[2]}, {d->nrm[0], d->nrm[1], d->nrm[2]}, p[P_Z], p[P_ZG],
                          d->stride, d->row, 1 << level, sigma_l0 / (float)(1 << level), 2.0f, lum_floor};
     const int chunk = 8;
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)

@@ -2,13 +2,21 @@
 #include "film/denoise_planes.h"
 #include <math.h>
 #include "base/simd.h"
+#include "film/atrous.h"
 
 static inline float maxf(float a, float b) { return a > b ? a : b; }
 
+/* A unit normal's component in [-1, 1] as 16 bits, rounded half away from
+ * zero (a truncating conversion: vector code on every ISA alike). */
+static inline int16_t quantize(float c) {
+  const float s = c * FR_ATROUS_NORMAL_ONE;
+  return (int16_t)(int)(s + (s < 0.0f ? -0.5f : 0.5f));
+}
+
 void FR_ISA_FN(fr_denoise_split)(const float *restrict rgb, const float *restrict albedo, const float *restrict normal,
                                  const float *restrict depth, int n, float *restrict in0, float *restrict in1,
-                                 float *restrict in2, float *restrict n0, float *restrict n1, float *restrict n2,
-                                 float *restrict z) {
+                                 float *restrict in2, int16_t *restrict n0, int16_t *restrict n1,
+                                 int16_t *restrict n2, float *restrict z) {
   for (int x = 0; x < n; x++) {
     const float *c = rgb + 3 * x, *a = albedo + 3 * x, *nv = normal + 3 * x;
     const float zz = depth[x];
@@ -25,7 +33,7 @@ void FR_ISA_FN(fr_denoise_split)(const float *restrict rgb, const float *restric
     in0[x] = hit ? q0 : c[0];
     in1[x] = hit ? q1 : c[1];
     in2[x] = hit ? q2 : c[2];
-    n0[x] = nv[0] * inv, n1[x] = nv[1] * inv, n2[x] = nv[2] * inv;
+    n0[x] = quantize(nv[0] * inv), n1[x] = quantize(nv[1] * inv), n2[x] = quantize(nv[2] * inv);
     z[x] = hit ? zz : FR_DENOISE_MISS;
   }
 }
