@@ -7,9 +7,11 @@
 static inline float maxf(float a, float b) { return a > b ? a : b; }
 
 /* A unit normal's component in [-1, 1] as 16 bits, rounded half away from
- * zero (a truncating conversion: vector code on every ISA alike). */
+ * zero (a truncating conversion: vector code on every ISA alike); NaN, or
+ * anything outside, is 0. */
 static inline int16_t quantize(float c) {
-  const float s = c * FR_ATROUS_NORMAL_ONE;
+  float s = c * FR_ATROUS_NORMAL_ONE;
+  s = s >= -FR_ATROUS_NORMAL_ONE && s <= FR_ATROUS_NORMAL_ONE ? s : 0.0f;
   return (int16_t)(int)(s + (s < 0.0f ? -0.5f : 0.5f));
 }
 
