@@ -1,4 +1,5 @@
-/* The denoiser (film/denoise.h): every ISA gives the same bits; noise on a
+/* The denoiser (film/denoise.h): every ISA gives the same bits, and
+ * finite colour stays finite where guides are NaN or infinite; noise on a
  * flat lit plane falls tenfold in squared error; an edge between two
  * normals is not blurred across; background pixels pass through; albedo
  * detail survives; black specks at 1 spp take their neighbours' light,
@@ -53,6 +54,9 @@ static void every_isa_alike(void **st) {
   plane(&im, 0.3f, 1);
   for (size_t i = 0; i < NP; i += 7) im.depth[i] = FR_DEPTH_MISS; /* background specks */
   for (size_t i = 0; i < NP; i++) im.normal[3 * i] = (float)(i % 5) * 0.1f;
+  /* broken guides and colour: a NaN or infinite normal, an infinite colour */
+  for (size_t i = 3; i < NP; i += 97) im.normal[3 * i + 1] = i % 2 ? NAN : INFINITY;
+  for (size_t i = 5; i < NP; i += 89) im.rgb[3 * i] = INFINITY;
   fr_denoiser *d;
   assert_int_equal(fr_denoiser_new(W, H, &d), FR_OK);
   static float out[3][3 * NP];
@@ -62,6 +66,7 @@ static void every_isa_alike(void **st) {
     fr_denoise(d, im.rgb, im.albedo, im.normal, im.depth, 4, 2, out[isa]);
     if (isa > FR_ISA_SCALAR) assert_memory_equal(out[isa], out[FR_ISA_SCALAR], sizeof out[0]);
   }
+  for (size_t i = 0; i < 3 * NP; i++) assert_true(isfinite(out[FR_ISA_SCALAR][i]) || !isfinite(im.rgb[i]));
   fr_set_isa(best);
   fr_denoiser_free(d);
 }

@@ -32,9 +32,9 @@ void FR_ISA_FN(fr_denoise_split)(const float *restrict rgb, const float *restric
     const float c2 = c[2] - c[2] == 0.0f ? c[2] : 0.0f;
     const float q0 = c0 / maxf(a[0], FR_DENOISE_ALBEDO_MIN), q1 = c1 / maxf(a[1], FR_DENOISE_ALBEDO_MIN);
     const float q2 = c2 / maxf(a[2], FR_DENOISE_ALBEDO_MIN);
-    in0[x] = hit ? q0 : c[0];
-    in1[x] = hit ? q1 : c[1];
-    in2[x] = hit ? q2 : c[2];
+    in0[x] = hit ? q0 : c0;
+    in1[x] = hit ? q1 : c1;
+    in2[x] = hit ? q2 : c2;
     n0[x] = quantize(nv[0] * inv), n1[x] = quantize(nv[1] * inv), n2[x] = quantize(nv[2] * inv);
     z[x] = hit ? zz : FR_DENOISE_MISS;
   }

@@ -12,8 +12,9 @@
 #define FR_DENOISE_MISS 1e30f       /* depth of the background (FR_DEPTH_MISS) */
 
 /* fr_denoise_split_ISA: n pixels of rgb, albedo, normal (3 floats each)
- * and depth: illumination (colour over albedo, non-finite colour as 0;
- * background pixels keep their colour) into in0..in2, unit normals (0 for
+ * and depth: illumination (colour over albedo; background pixels keep
+ * their colour; non-finite colour as 0, so that no tap spreads NaN) into
+ * in0..in2, unit normals (0 for
  * background, times FR_ATROUS_NORMAL_ONE and rounded) into n0..n2, depth (FR_DENOISE_MISS for background) into z.
  * fr_denoise_merge_ISA: n pixels back: illumination s0..s2 times albedo
  * where z sees geometry, the colour itself elsewhere, into out (3 floats
