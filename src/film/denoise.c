@@ -133,8 +133,8 @@ void fr_denoise(fr_denoiser *d, const float *rgb, const float *albedo, const flo
   const float lum_floor = mean / (float)(spp > 1 ? spp : 1);
   float *src[3] = {p[P_IN0], p[P_IN1], p[P_IN2]}, *dst[3] = {p[P_TMP0], p[P_TMP1], p[P_TMP2]};
   for (int level = 0; level < FR_DENOISE_LEVELS; level++) {
-    fr_atrous_level L = {{src[0], src[1], src[2]}, {dst[0], dst[1], dst[2]}, {d->nrm[0], d->nrm[1], d->nrm[2]}, p[P_Z], p[P_ZG],
-                         d->stride, d->row, 1 << level, sigma_l0 / (float)(1 << level), 2.0f, lum_floor};
+    fr_atrous_level L = {{src[0], src[1], src[2]}, {dst[0], dst[1], dst[2]}, {d->nrm[0], d->nrm[1], d->nrm[2]},
+                         p[P_Z], p[P_ZG], d->stride, d->row, 1 << level, sigma_l0 / (float)(1 << level), 2.0f, lum_floor};
     const int chunk = 8;
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
     for (int y0 = 0; y0 < H; y0 += chunk) atrous_rows(&L, y0, y0 + chunk < H ? y0 + chunk : H);

@@ -21,10 +21,10 @@ void fr_denoiser_free(fr_denoiser *d);
 /* out (W*H*3) from rgb (W*H*3 linear), guided by albedo (W*H*3), normal
  * (W*H*3, facing the camera; averaged normals are renormalized) and depth
  * (W*H, FR_DEPTH_MISS where the camera sees the background, whose pixels
- * are copied); colour that is not finite comes out 0, and NaN or infinite
- * guides leave their pixel unblended, never NaN. spp, the samples per pixel behind rgb, sets how far
- * luminance differences are trusted. out may be rgb. Runs on threads
- * threads (OpenMP). */
+ * are copied); colour that is not finite comes out 0, and no pixel comes
+ * out NaN whatever the guides hold. spp, the samples per pixel behind rgb,
+ * sets how far luminance differences are trusted. out may be rgb. Runs on
+ * threads threads (OpenMP). */
 void fr_denoise(fr_denoiser *d, const float *rgb, const float *albedo, const float *normal, const float *depth, int spp,
                 int threads, float *out);
 #endif
