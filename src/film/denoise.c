@@ -10,7 +10,6 @@
 #include "render/progressive.h"
 
 #define MISS FR_DEPTH_MISS
-_Static_assert(FR_DENOISE_MISS == FR_DEPTH_MISS, "the planes' background depth is the guides'");
 
 /* max and min as compares (fmaxf and fminf are calls at this ISA level) */
 static inline float maxf(float a, float b) { return a > b ? a : b; }

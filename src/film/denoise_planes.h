@@ -9,7 +9,7 @@
 #include <stdint.h>
 
 #define FR_DENOISE_ALBEDO_MIN 0.01f /* dividing by less would amplify noise on black surfaces */
-#define FR_DENOISE_MISS 1e30f       /* depth of the background (FR_DEPTH_MISS) */
+#define FR_DENOISE_MISS 1e30f       /* depth of the background in the planes: past 1e29, as the filter tests */
 
 /* fr_denoise_split_ISA: n pixels of rgb, albedo, normal (3 floats each)
  * and depth: illumination (colour over albedo; background pixels keep
