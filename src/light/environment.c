@@ -57,7 +57,9 @@ fr_error fr_env_load(fr_env *e, const char *path) {
 void fr_env_orient(fr_env *e, vec3 up, float rotate_deg, float intensity) {
   e->az = v3_norm(up);
   v3_onb(e->az, &e->ax, &e->ay);
-  e->rotate = rotate_deg * PI_F / 180.0f;
+  const float turns = rotate_deg / 360.0f;
+  e->rotate = turns - floorf(turns);
+  if (!(e->rotate < 1.0f)) e->rotate = 0.0f; /* a tiny negative turn rounds up to a whole one */
   e->intensity = intensity;
 }
 
@@ -68,17 +70,11 @@ void fr_env_free(fr_env *e) {
   memset(e, 0, sizeof *e);
 }
 
-/* The map's rotation in turns, in [0, 1). */
-static float rotate_turns(const fr_env *e) {
-  const float r = e->rotate * (0.5f / PI_F);
-  return r - floorf(r);
-}
-
 /* dir to image coordinates (u, v) in [0, 1)^2 and sin(theta): theta =
  * acos(z) is atan2(sin theta, z), both angles in turns (base/trig.h) */
 static void to_uv(const fr_env *e, vec3 d, float *u, float *v, float *sin_t) {
   const float z = fr_maxf(-1.0f, fr_minf(1.0f, v3_dot(d, e->az))), st = sqrtf(fr_maxf(0.0f, 1.0f - z * z));
-  float uu = fr_atan2_turns(v3_dot(d, e->ay), v3_dot(d, e->ax)) - rotate_turns(e);
+  float uu = fr_atan2_turns(v3_dot(d, e->ay), v3_dot(d, e->ax)) - e->rotate;
   uu -= floorf(uu);
   *u = uu < 1.0f ? uu : 0.0f;
   *v = fr_minf(2.0f * fr_atan2_turns(st, z), 0.99999994f);
@@ -115,7 +111,7 @@ vec3 fr_env_sample(const fr_env *e, float u1, float u2, vec3 *dir, float *pdf) {
   fr_dist2d_sample(&e->dist, u1, u2, &u, &v, &x, &y);
   const float *t = e->texels + 4 * ((size_t)y * e->w + x), puv = t[3];
   /* theta = pi v, phi = 2 pi u + rotate: both in turns */
-  float st, ct, sp, cp, turns = u + rotate_turns(e);
+  float st, ct, sp, cp, turns = u + e->rotate;
   fr_sincos_turns(0.5f * v, &st, &ct);
   fr_sincos_turns(turns < 1.0f ? turns : turns - 1.0f, &sp, &cp);
   if (!(puv > 0.0f) || !(st > 0.0f)) { *pdf = 0.0f; return v3(0, 0, 0); }

@@ -21,7 +21,7 @@ typedef struct fr_env {
   fr_dist2d dist;
   vec3 ax, ay, az;  /* world frame: az the zenith */
   float intensity;
-  float rotate;     /* radians */
+  float rotate;     /* turns about the zenith, in [0, 1) */
   int black;        /* emits nothing: never sampled */
 } fr_env;
 
