@@ -95,9 +95,14 @@ static inline void fr_hammersley_point(uint32_t j, uint32_t n, uint32_t key, flo
   *u2 = fr_sampler_unit(fr_sampler_reverse(j) ^ fr_sampler_mix(key ^ 0x7f4a7c15u));
 }
 
+/* The key of dimension pair d of a pixel's pattern. */
+static inline uint32_t fr_sampler_pair_key(uint32_t pixel_key, uint32_t d) {
+  return fr_sampler_mix(pixel_key + d * 0x51ed2705u);
+}
+
 static inline __attribute__((always_inline)) void fr_sample2d(fr_sampler_kind k, uint32_t pixel_key, uint32_t i,
                                                              uint32_t n, uint32_t d, float *u1, float *u2) {
-  const uint32_t key = fr_sampler_mix(pixel_key + d * 0x51ed2705u);
+  const uint32_t key = fr_sampler_pair_key(pixel_key, d);
   if (k == FR_SAMPLER_SOBOL) {
     /* the shuffled index j = owen(i, key), as its reversal jr */
     const uint32_t jr = fr_sampler_owen_reversed(fr_sampler_reverse(i), key);
