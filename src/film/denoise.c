@@ -28,12 +28,19 @@ struct fr_denoiser {
   int *row_hits;          /* ... and how many pixels that is */
 };
 
-static void atrous_rows(const fr_atrous_level *L, int y0, int y1) {
-  switch (fr_get_isa()) {
-  case FR_ISA_AVX512: fr_atrous_rows_avx512(L, y0, y1); break;
-  case FR_ISA_AVX2: fr_atrous_rows_avx2(L, y0, y1); break;
-  default: fr_atrous_rows_scalar(L, y0, y1); break;
-  }
+/* The per-ISA loops (film/atrous.h, film/denoise_planes.h), chosen once a call. */
+typedef struct denoise_kernels {
+  void (*atrous_rows)(const fr_atrous_level *L, int y0, int y1);
+  void (*split)(const float *rgb, const float *albedo, const float *normal, const float *depth, int n, float *in0,
+                float *in1, float *in2, int16_t *n0, int16_t *n1, int16_t *n2, float *z);
+  void (*merge)(const float *s0, const float *s1, const float *s2, const float *z, const float *albedo, int n, float *out);
+} denoise_kernels;
+
+static const denoise_kernels *kernels_of(fr_isa isa) {
+  static const denoise_kernels avx512 = {fr_atrous_rows_avx512, fr_denoise_split_avx512, fr_denoise_merge_avx512};
+  static const denoise_kernels avx2 = {fr_atrous_rows_avx2, fr_denoise_split_avx2, fr_denoise_merge_avx2};
+  static const denoise_kernels scalar = {fr_atrous_rows_scalar, fr_denoise_split_scalar, fr_denoise_merge_scalar};
+  return isa == FR_ISA_AVX512 ? &avx512 : isa == FR_ISA_AVX2 ? &avx2 : &scalar;
 }
 
 fr_error fr_denoiser_new(int width, int height, fr_denoiser **out) {
@@ -76,17 +83,13 @@ static size_t at(const fr_denoiser *d, int x, int y) {
 
 /* Row y of the image into the planes (film/denoise_planes.h, vector code
  * per ISA), and its summed illumination where it sees geometry. */
-static void split_row(fr_denoiser *d, const float *rgb, const float *albedo, const float *normal, const float *depth,
-                      int y) {
+static void split_row(fr_denoiser *d, const denoise_kernels *k, const float *rgb, const float *albedo,
+                      const float *normal, const float *depth, int y) {
   const size_t o = at(d, 0, y);
   float *const *p = d->p;
   float *in0 = p[P_IN0] + o, *in1 = p[P_IN1] + o, *in2 = p[P_IN2] + o, *z = p[P_Z] + o;
   int16_t *n0 = d->nrm[0] + o, *n1 = d->nrm[1] + o, *n2 = d->nrm[2] + o;
-  switch (fr_get_isa()) {
-  case FR_ISA_AVX512: fr_denoise_split_avx512(rgb, albedo, normal, depth, d->width, in0, in1, in2, n0, n1, n2, z); break;
-  case FR_ISA_AVX2: fr_denoise_split_avx2(rgb, albedo, normal, depth, d->width, in0, in1, in2, n0, n1, n2, z); break;
-  default: fr_denoise_split_scalar(rgb, albedo, normal, depth, d->width, in0, in1, in2, n0, n1, n2, z); break;
-  }
+  k->split(rgb, albedo, normal, depth, d->width, in0, in1, in2, n0, n1, n2, z);
   double lum = 0.0;
   int hits = 0;
   for (int x = 0; x < d->width; x++)
@@ -115,9 +118,12 @@ void fr_denoise(fr_denoiser *d, const float *rgb, const float *albedo, const flo
                 int threads, float *out) {
   const int W = d->width, H = d->height;
   float **p = d->p;
+  const denoise_kernels *k = kernels_of(fr_get_isa());
 #pragma omp parallel for num_threads(threads) schedule(static)
-  for (int y = 0; y < H; y++) split_row(d, rgb + 3 * (size_t)y * W, albedo + 3 * (size_t)y * W, normal + 3 * (size_t)y * W,
-                                        depth + (size_t)y * W, y);
+  for (int y = 0; y < H; y++) {
+    const size_t i = (size_t)y * W;
+    split_row(d, k, rgb + 3 * i, albedo + 3 * i, normal + 3 * i, depth + i, y);
+  }
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (int y = 0; y < H; y++) depth_gradient_row(d, y);
   /* luminance is trusted more as samples add up: noise falls as 1/sqrt(spp) */
@@ -136,16 +142,12 @@ void fr_denoise(fr_denoiser *d, const float *rgb, const float *albedo, const flo
                          p[P_Z], p[P_ZG], d->stride, d->row, 1 << level, sigma_l0 / (float)(1 << level), 2.0f, lum_floor};
     const int chunk = 8;
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
-    for (int y0 = 0; y0 < H; y0 += chunk) atrous_rows(&L, y0, y0 + chunk < H ? y0 + chunk : H);
+    for (int y0 = 0; y0 < H; y0 += chunk) k->atrous_rows(&L, y0, y0 + chunk < H ? y0 + chunk : H);
     for (int c = 0; c < 3; c++) { float *t = src[c]; src[c] = dst[c]; dst[c] = t; }
   }
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (int y = 0; y < H; y++) {
     const size_t o = at(d, 0, y), i = 3 * (size_t)y * W;
-    switch (fr_get_isa()) {
-    case FR_ISA_AVX512: fr_denoise_merge_avx512(src[0] + o, src[1] + o, src[2] + o, p[P_Z] + o, albedo + i, W, out + i); break;
-    case FR_ISA_AVX2: fr_denoise_merge_avx2(src[0] + o, src[1] + o, src[2] + o, p[P_Z] + o, albedo + i, W, out + i); break;
-    default: fr_denoise_merge_scalar(src[0] + o, src[1] + o, src[2] + o, p[P_Z] + o, albedo + i, W, out + i); break;
-    }
+    k->merge(src[0] + o, src[1] + o, src[2] + o, p[P_Z] + o, albedo + i, W, out + i);
   }
 }
