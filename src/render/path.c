@@ -154,10 +154,11 @@ static int nonzero(vec3 c) { return c.x > 0.0f || c.y > 0.0f || c.z > 0.0f; }
 
 static void add3(float *dst, vec3 v) { dst[0] += v.x, dst[1] += v.y, dst[2] += v.z; }
 
-/* The sample points of dimension pairs d .. d + npairs - 1 for the paths
- * st[0..m) (m <= POINT_BLOCK): pair q's in pts[2q] and pts[2q + 1]. */
-static void block_points(const fr_path_setup *P, const path_state *st, size_t m, uint32_t d, int npairs,
+/* The sample points of dimension pairs d .. d + npairs - 1 for the next
+ * POINT_BLOCK paths of st[0..left): pair q's in pts[2q] and pts[2q + 1]. */
+static void block_points(const fr_path_setup *P, const path_state *st, size_t left, uint32_t d, int npairs,
                          float pts[][POINT_BLOCK]) {
+  const size_t m = left < POINT_BLOCK ? left : POINT_BLOCK;
   uint32_t key[POINT_BLOCK], idx[POINT_BLOCK];
   for (size_t j = 0; j < m; j++) key[j] = st[j].key, idx[j] = st[j].sample;
   for (int q = 0; q < npairs; q++)
@@ -223,7 +224,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
     const int lens = P->aperture > 0.0f;
     for (size_t k = 0; k < n; k++) {
       const size_t b = k % POINT_BLOCK;
-      if (pts && !b) block_points(P, S->st + k, n - k < POINT_BLOCK ? n - k : POINT_BLOCK, 0, 1 + lens, block);
+      if (pts && !b) block_points(P, S->st + k, n - k, 0, 1 + lens, block);
       int x, y;
       tile_pixel(S->st[k].slot % npix, side, &x, &y);
       x += tx, y += ty;
@@ -254,7 +255,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
       const uint32_t dim = 2u + 4u * (uint32_t)depth;
       for (size_t k = 0; k < n; k++) {
         const size_t b = k % POINT_BLOCK;
-        if (pts && !b) block_points(P, S->st + k, n - k < POINT_BLOCK ? n - k : POINT_BLOCK, dim, 4, block);
+        if (pts && !b) block_points(P, S->st + k, n - k, dim, 4, block);
         if (k + PREFETCH_AHEAD < n) {
           const uint32_t ahead = S->hit[k + PREFETCH_AHEAD].prim;
           if (ahead < P->nsurf) {
