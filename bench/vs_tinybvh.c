@@ -23,6 +23,7 @@
 #include "frusta.h"
 #include "base/rng.h"
 #include "base/timer.h"
+#include "render/camera.h"
 #include "render/views.h"
 
 void *tbs_build(const float *xyz, const uint32_t *idx, size_t nt, int optimize);
@@ -112,16 +113,12 @@ int main(int argc, char **argv) {
   fr_ray *cam = malloc(np * sizeof(fr_ray)), *sec = malloc(3 * np * sizeof(fr_ray));
   fr_hit *hits = malloc(np * sizeof(fr_hit));
   if (!cam || !sec || !hits) return 1;
-  const vec3 fwd = v3_norm(v3_sub(v.at, v.eye)), right = v3_norm(v3_cross(fwd, v.up)), up = v3_cross(right, fwd);
-  const float th = tanf(0.5f * v.fov * 3.14159265f / 180.0f);
+  fr_camera c;
+  if (fr_camera_setup(&c, v.eye, v.at, v.up, v.fov, W, H)) { fprintf(stderr, "%s\n", fr_last_error()); return 1; }
   size_t n = 0;
   for (int by = 0; by < H; by += 4)
     for (int bx = 0; bx < W; bx += 4)
-      for (int k = 0; k < 16; k++) {
-        const int x = bx + k % 4, y = by + k / 4;
-        const float sx = (2.0f * (x + 0.5f) / W - 1.0f) * th * W / H, sy = (1.0f - 2.0f * (y + 0.5f) / H) * th;
-        cam[n++] = ray_of(v.eye, v3_norm(v3_add(fwd, v3_add(v3_scale(right, sx), v3_scale(up, sy)))), INFINITY);
-      }
+      for (int k = 0; k < 16; k++) cam[n++] = fr_camera_ray(&c, bx + k % 4, by + k / 4);
   measure(name, build, "camera", s, tb, cam, np, 0, repeat);
   frusta_closest(s, cam, hits, np);
   /* from each hit: a shadow ray to the light, an ao ray and a diffuse bounce (one direction for both) */
