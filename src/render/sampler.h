@@ -40,10 +40,11 @@ static inline uint32_t fr_sampler_reverse(uint32_t x) {
 
 static inline float fr_sampler_unit(uint32_t x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
 
-/* One step of a bijection of [0, mask] (mask + 1 a power of two, sh =
- * log2(mask + 1) / 2 + 1) keyed by key: xor, odd multiply and xorshift,
- * each invertible modulo mask + 1. */
-static inline uint32_t fr_sampler_permute_step(uint32_t i, uint32_t mask, unsigned sh, uint32_t key) {
+/* One step of a bijection of [0, 2^bits) (bits in 1..32) keyed by key:
+ * xor, odd multiply and xorshift, each invertible modulo 2^bits. */
+static inline uint32_t fr_sampler_permute_step(uint32_t i, unsigned bits, uint32_t key) {
+  const uint32_t mask = bits >= 32 ? 0xffffffffu : (1u << bits) - 1u;
+  const unsigned sh = bits / 2u + 1u;
   i = (i ^ key) & mask;
   i = (i * 0x2c1b3c6du) & mask;
   i ^= i >> sh;
@@ -57,8 +58,7 @@ static inline uint32_t fr_sampler_permute_step(uint32_t i, uint32_t mask, unsign
 static inline uint32_t fr_sampler_permute(uint32_t i, uint32_t n, uint32_t key) {
   if (n <= 1) return 0;
   const unsigned bits = 32u - (unsigned)__builtin_clz(n - 1);
-  const uint32_t mask = bits >= 32 ? 0xffffffffu : (1u << bits) - 1u;
-  do i = fr_sampler_permute_step(i, mask, bits / 2u + 1u, key);
+  do i = fr_sampler_permute_step(i, bits, key);
   while (i >= n);
   return i;
 }

@@ -16,9 +16,8 @@ void FR_ISA_FN(fr_sobol2d_batch)(const uint32_t *restrict keys, const uint32_t *
 void FR_ISA_FN(fr_hammersley2d_pow2_batch)(const uint32_t *restrict keys, const uint32_t *restrict index, uint32_t n_spp,
                                            uint32_t dim, size_t n, float *restrict u1, float *restrict u2) {
   const unsigned bits = 32u - (unsigned)__builtin_clz(n_spp - 1);
-  const uint32_t mask = n_spp - 1u;
   for (size_t i = 0; i < n; i++) {
     const uint32_t key = fr_sampler_pair_key(keys[i], dim);
-    fr_hammersley_point(fr_sampler_permute_step(index[i], mask, bits / 2u + 1u, key), n_spp, key, &u1[i], &u2[i]);
+    fr_hammersley_point(fr_sampler_permute_step(index[i], bits, key), n_spp, key, &u1[i], &u2[i]);
   }
 }
