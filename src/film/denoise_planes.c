@@ -2,9 +2,8 @@
 #include "film/denoise_planes.h"
 #include <math.h>
 #include "base/simd.h"
+#include "base/vec3.h"
 #include "film/atrous.h"
-
-static inline float maxf(float a, float b) { return a > b ? a : b; }
 
 /* A unit normal's component in [-1, 1] as 16 bits, rounded half away from
  * zero (a truncating conversion: vector code on every ISA alike); NaN, or
@@ -30,8 +29,8 @@ void FR_ISA_FN(fr_denoise_split)(const float *restrict rgb, const float *restric
     /* c - c is 0 for a finite colour only: inf and NaN become 0 */
     const float c0 = c[0] - c[0] == 0.0f ? c[0] : 0.0f, c1 = c[1] - c[1] == 0.0f ? c[1] : 0.0f;
     const float c2 = c[2] - c[2] == 0.0f ? c[2] : 0.0f;
-    const float q0 = c0 / maxf(a[0], FR_DENOISE_ALBEDO_MIN), q1 = c1 / maxf(a[1], FR_DENOISE_ALBEDO_MIN);
-    const float q2 = c2 / maxf(a[2], FR_DENOISE_ALBEDO_MIN);
+    const float q0 = c0 / fr_maxf(a[0], FR_DENOISE_ALBEDO_MIN), q1 = c1 / fr_maxf(a[1], FR_DENOISE_ALBEDO_MIN);
+    const float q2 = c2 / fr_maxf(a[2], FR_DENOISE_ALBEDO_MIN);
     in0[x] = hit ? q0 : c0;
     in1[x] = hit ? q1 : c1;
     in2[x] = hit ? q2 : c2;
@@ -44,8 +43,8 @@ void FR_ISA_FN(fr_denoise_merge)(const float *restrict s0, const float *restrict
                                  const float *restrict z, const float *restrict albedo, int n, float *restrict out) {
   for (int x = 0; x < n; x++) {
     const int hit = z[x] < 1e29f;
-    out[3 * x] = hit ? s0[x] * maxf(albedo[3 * x], FR_DENOISE_ALBEDO_MIN) : s0[x];
-    out[3 * x + 1] = hit ? s1[x] * maxf(albedo[3 * x + 1], FR_DENOISE_ALBEDO_MIN) : s1[x];
-    out[3 * x + 2] = hit ? s2[x] * maxf(albedo[3 * x + 2], FR_DENOISE_ALBEDO_MIN) : s2[x];
+    out[3 * x] = hit ? s0[x] * fr_maxf(albedo[3 * x], FR_DENOISE_ALBEDO_MIN) : s0[x];
+    out[3 * x + 1] = hit ? s1[x] * fr_maxf(albedo[3 * x + 1], FR_DENOISE_ALBEDO_MIN) : s1[x];
+    out[3 * x + 2] = hit ? s2[x] * fr_maxf(albedo[3 * x + 2], FR_DENOISE_ALBEDO_MIN) : s2[x];
   }
 }
