@@ -24,7 +24,9 @@ int main(int argc, char **argv) {
   if (W < 1 || H < 1 || repeat < 1 || repeat > 10000) { fprintf(stderr, "denoise_time: bad size or repeat\n"); return 2; }
   fr_scene *s;
   fr_renderer *r;
-  const fr_render_desc d = {{{0}, {0}, {0}, 0.0f, W, H}, FR_RENDER_PATH, 1, 0, {0}, NULL, 0.0f, 0, 2};
+  fr_render_desc d;
+  fr_render_desc_default(&d);
+  d.camera.width = W, d.camera.height = H, d.shade = FR_RENDER_PATH, d.spp = 1, d.threads = 2;
   if (fr_scene_load(argv[1], &s) || fr_scene_commit(s) || fr_renderer_new(s, &d, &r) || fr_renderer_render(r)) {
     fprintf(stderr, "denoise_time: %s\n", fr_last_error());
     return 1;

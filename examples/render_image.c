@@ -12,7 +12,11 @@ int main(int argc, char **argv) {
     return 1;
   }
   enum { W = 160, H = 120 };
-  fr_render_desc d = {.camera = {.width = W, .height = H}, .shade = FR_RENDER_PATH, .spp = 8};
+  fr_render_desc d;
+  fr_render_desc_default(&d); /* then what differs: the size, the shade, the samples */
+  d.camera.width = W, d.camera.height = H;
+  d.shade = FR_RENDER_PATH;
+  d.spp = 8;
   fr_renderer *r;
   float *rgb = malloc(sizeof(float) * W * H * 3);
   if (!rgb || fr_renderer_new(s, &d, &r) != FR_OK) {

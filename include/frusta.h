@@ -343,48 +343,122 @@ typedef enum fr_render_shade {
   FR_RENDER_PATH        /* path tracing (materials from the MTL, environment and area light) */
 } fr_render_shade;
 
+/* The path tracer's sample patterns. */
+typedef enum fr_render_sampler {
+  FR_SAMPLER_HAMMERSLEY, /* padded replication of a scrambled Hammersley pattern (the MIC paper's) */
+  FR_SAMPLER_SOBOL       /* scrambled Sobol points */
+} fr_render_sampler;
+
+/* The lights that shine on the path tracer's paths (fr_render_desc.lights). */
+#define FR_LIGHT_ENV 1u   /* the environment */
+#define FR_LIGHT_AREA 2u  /* the quad area light */
+#define FR_LIGHT_POINT 4u /* the point light */
+
+/* What a renderer draws. Begin with fr_render_desc_default, which sets
+ * every field to its default (given in brackets), then change what you
+ * need: a field left zero means zero, not its default. The strings are
+ * copied by fr_renderer_new and fr_renderer_update. */
 typedef struct fr_render_desc {
-  fr_pinhole camera;      /* the view; fov_deg 0: the scene's own view (the shared scenes' views,
-                             else one framing its bounds) at camera.width x camera.height */
-  fr_render_shade shade;
-  int spp;                /* samples per pixel in all (0: 16): path samples, ao's hemisphere and
-                             softshadow's light samples (multiples of 16 for those two) */
-  int has_light;          /* 1: light is the point light (shadows, whitted); else the view's (the
-                             area light of softshadow and path is always the view's) */
+  fr_pinhole camera;      /* the view; fov_deg 0: the scene's own view (the shared scenes'
+                             views, else one framing its bounds) at camera.width x camera.height
+                             [fov_deg 0; the size 0 by 0: set it] */
+  fr_render_shade shade;  /* [FR_RENDER_EYELIGHT] */
+  int spp;                /* samples per pixel in all: path samples, ao's hemisphere and
+                             softshadow's light samples (multiples of 16 for those two) [16] */
+  int has_light;          /* 1: light is the point light (shadows, whitted, path's FR_LIGHT_POINT);
+                             0: the scene's view's [0] */
   float light[3];
-  const char *environment; /* path: a lat-long .hdr or .exr environment (NULL: a white sky) */
-  float exposure;         /* path: stops, for fr_renderer_image's display values */
-  int denoise;            /* 1: fr_renderer_image denoises path, ao and softshadow sums */
-  int threads;            /* 0: all cores */
+  const char *environment; /* path: a lat-long .hdr or .exr environment [NULL: env_color] */
+  float exposure;         /* path: stops, for fr_renderer_image's display values [0] */
+  int denoise;            /* 1: fr_renderer_image denoises path, ao and softshadow sums [0] */
+  int threads;            /* [0: all cores] */
+  float light_intensity[3]; /* path: the point light's intensity, W/sr [0: as bright as makes a white
+                             surface where the camera looks, facing it, as bright as under a white sky] */
+  int has_area;           /* 1: the quad area light is area_corner + a area_e1 + b area_e2 (a, b in
+                             [0, 1]), shining from the side area_e1 x area_e2 faces; 0: the view's [0] */
+  float area_corner[3], area_e1[3], area_e2[3];
+  float area_radiance[3]; /* path: the area light's radiance [0: automatic, as light_intensity] */
+  unsigned lights;        /* path: the lights that shine, FR_LIGHT_* [FR_LIGHT_ENV | FR_LIGHT_AREA] */
+  float env_color[3];     /* path: the environment's radiance without a file [1, 1, 1] */
+  float env_intensity;    /* path: scales the environment [1] */
+  float env_rotate;       /* path: the environment turned about the view's up, degrees [0] */
+  const char *mirror;     /* path, whitted: comma-separated names of the scene's materials made
+                             mirrors (chrome) [NULL: the scene's suggestions] */
+  const char *glass;      /* the same for glass [NULL] */
+  int max_depth;          /* path: segments per path, 1..64 [13]; whitted: reflection and refraction
+                             depth, 1..8 [4]; 0: the shade's default */
+  fr_render_sampler sampler; /* path [FR_SAMPLER_HAMMERSLEY] */
+  uint32_t seed;          /* path: the sampler's scramble [1] */
+  float aperture;         /* path: the thin lens's radius, scene units [0: a pinhole] */
+  float focus;            /* path: the distance in focus [0: from the eye to camera.at] */
+  int temporal;           /* path, ao: after fr_renderer_set_camera, blend the last image carried to the
+                             new view into the new one while it has few passes (SVGF's reprojection) [0] */
+  int camera_frusta;      /* 1: camera rays, hard and soft shadows as multi-frusta where the scene has
+                             no spheres; 0: every ray as the scene's trace mode [1] */
+  int pass_spp;           /* path: samples per pixel one pass adds, 1..spp [8]; 1 suits an
+                             interactive frame. Any split sums to the same image. */
 } fr_render_desc;
+
+/* The defaults, as listed above. */
+void fr_render_desc_default(fr_render_desc *d);
 
 typedef struct fr_renderer fr_renderer;
 
-/* A renderer of s as d says (d is copied; the environment is loaded now).
- * s must be committed and outlive the renderer. Errors: FR_ERR_ARG (an
- * empty image, a bad camera or shade, spp not a multiple of 16 where it
- * must be), FR_ERR_STATE (not committed), FR_ERR_IO and FR_ERR_FORMAT (the
- * environment), FR_ERR_NOMEM. */
+/* A renderer of s as d says (the environment is loaded now, materials
+ * and textures made). s must be committed and outlive the renderer. A
+ * scene loaded from a scene file renders with the file's materials.
+ * Errors: FR_ERR_ARG (an empty image, a bad camera, shade or light, a
+ * field out of range, spp not a multiple of 16 where it must be, an
+ * unknown mirror or glass name), FR_ERR_STATE (not committed), FR_ERR_IO
+ * and FR_ERR_FORMAT (the environment, a texture), FR_ERR_NOMEM. */
 fr_error fr_renderer_new(const fr_scene *s, const fr_render_desc *d, fr_renderer **out);
 void fr_renderer_release(fr_renderer *r);
+/* Renders as d says from now on, keeping what it can: a new exposure,
+ * denoise, temporal or threads keeps the passes summed; a new camera of
+ * the same size starts the passes again (as fr_renderer_set_camera); any
+ * other change starts afresh, reusing the environment and materials where
+ * their fields are unchanged. On an error the renderer is as before. The
+ * errors of fr_renderer_new. */
+fr_error fr_renderer_update(fr_renderer *r, const fr_render_desc *d);
+/* The description the renderer follows (its strings live as long as it
+ * or the next update). */
+void fr_renderer_desc(const fr_renderer *r, fr_render_desc *d);
 /* One more pass on all the renderer's threads; *done (may be NULL) becomes
  * 1 once another pass would change nothing (spp reached; at once for the
- * one-pass shades). FR_ERR_NOMEM. */
+ * one-pass shades). A pass abandoned by fr_renderer_set_cancel adds
+ * nothing (a path pass's partial sums are dropped: the passes start again).
+ * FR_ERR_NOMEM. */
 fr_error fr_renderer_pass(fr_renderer *r, int *done);
 /* Passes until done. */
 fr_error fr_renderer_render(fr_renderer *r);
+/* While cancel is 1, a pass under way stops at its next tile and passes
+ * started do nothing; 0 lets them run again. The one call that may come
+ * from another thread while fr_renderer_pass runs (for an interactive
+ * viewer whose input makes the frame in flight worthless). */
+void fr_renderer_set_cancel(fr_renderer *r, int cancel);
 /* Samples per pixel summed so far. */
 int fr_renderer_spp(const fr_renderer *r);
-/* A new view of the same image size: the passes start again. FR_ERR_ARG
- * for a bad camera or another size. */
+/* A new view of the same image size: the passes start again (and with
+ * temporal set, the next images blend in the last one). FR_ERR_ARG for a
+ * bad camera or another size. */
 fr_error fr_renderer_set_camera(fr_renderer *r, const fr_pinhole *camera);
 /* The image so far, width * height RGB floats, row 0 at the top: linear
  * (display 0), or display values (display 1: path through the filmic
- * curve at the exposure; the other shades are in [0, 1] already), denoised
- * if asked. albedo and normal (3 floats a pixel) and depth (1; 1e30 where
- * the camera sees nothing) get the guides when not NULL. FR_ERR_NOMEM. A
- * renderer serves one thread at a time. */
+ * curve at the exposure; the other shades are in [0, 1] already), blended
+ * and denoised where asked. albedo and normal (3 floats a pixel) and depth
+ * (1; 1e30 where the camera sees nothing) get the guides when not NULL.
+ * FR_ERR_NOMEM. */
 fr_error fr_renderer_image(fr_renderer *r, int display, float *rgb, float *albedo, float *normal, float *depth);
+
+typedef struct fr_render_stats {
+  uint64_t rays;          /* traced by the last pass */
+  double seconds;         /* the last pass's time */
+  double denoise_seconds; /* the last fr_renderer_image's denoising */
+  int cancelled;          /* 1: the last pass was abandoned */
+  float reused;           /* temporal: the share of the last image's pixels blended with the one before */
+} fr_render_stats;
+void fr_renderer_stats(const fr_renderer *r, fr_render_stats *out);
+/* A renderer serves one thread at a time, but for fr_renderer_set_cancel. */
 
 /* ---- images ------------------------------------------------------------------------
  * Writes width * height RGB floats (row 0 at the top) by path's extension:

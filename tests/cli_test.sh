@@ -46,9 +46,9 @@ done
 head -c 4 "$T/b.png" | od -c | grep -q 'P   N   G' && ok || bad "not a PNG"
 # camera rays go as multi-frusta by default; --mft off traces them as streams
 expect 0 "$F" render --builtin --size 64x48 --out "$T/e1.pfm"
-grep -q 'shade=eyelight tracer=mft ' "$T/out" && ok || bad "render: camera rays not as frusta"
+grep -q 'shade=eyelight spp=1 tracer=frusta mode=mft ' "$T/out" && ok || bad "render: camera rays not as frusta"
 expect 0 "$F" render --builtin --size 64x48 --mft off --out "$T/e2.pfm"
-grep -q 'shade=eyelight tracer=auto ' "$T/out" && ok || bad "render --mft off: not as streams"
+grep -q 'shade=eyelight spp=1 tracer=frusta mode=auto ' "$T/out" && ok || bad "render --mft off: not as streams"
 head -c 2 "$T/b.pfm" | grep -q PF && ok || bad "not a PFM"
 
 expect 2 "$F" bench --builtin --workload primary

@@ -3,8 +3,12 @@
  * to finite, non-black images with guides; one-pass shades are done at
  * once, progressive ones after spp / 16 (or spp / 8 for path) passes and
  * equal to the mean of their passes; the same description renders the
- * same bits twice and on 1 and 3 threads; a new camera restarts; errors;
- * fr_image_save writes what the readers read back.
+ * same bits twice and on 1 and 3 threads; a new camera restarts; an
+ * update keeps the passes where only what is done with them changes and
+ * renders as a new renderer would otherwise; cancelled passes add
+ * nothing; the temporal blend carries the image to a moved camera; every
+ * field out of range is refused; fr_image_save writes what the readers
+ * read back.
  * That it renders what `frusta render` does is checked from Python
  * (tests/python), byte for byte against the command.
  */
@@ -26,13 +30,23 @@ static float *render(const fr_scene *s, fr_render_desc d, int *spp) {
   return img;
 }
 
+static fr_render_desc desc_of(fr_render_shade shade, int spp) {
+  fr_render_desc d;
+  fr_render_desc_default(&d);
+  d.camera.width = W, d.camera.height = H;
+  d.shade = shade;
+  d.spp = spp;
+  return d;
+}
+
 static void every_shade(void **state) {
   (void)state;
   fr_scene *s;
   assert_int_equal(fr_scene_builtin(&s), FR_OK);
   assert_int_equal(fr_scene_commit(s), FR_OK);
   for (int shade = FR_RENDER_EYELIGHT; shade <= FR_RENDER_PATH; shade++) {
-    fr_render_desc d = {.camera = {.width = W, .height = H}, .shade = (fr_render_shade)shade, .threads = 2};
+    fr_render_desc d = desc_of((fr_render_shade)shade, 16);
+    d.threads = 2;
     if (shade == FR_RENDER_PATH) d.spp = 4;
     if (shade == FR_RENDER_AO || shade == FR_RENDER_SOFTSHADOW) d.spp = 32;
     int spp;
@@ -64,7 +78,7 @@ static void passes_camera_and_errors(void **state) {
   (void)state;
   fr_scene *s;
   assert_int_equal(fr_scene_builtin(&s), FR_OK);
-  fr_render_desc d = {.camera = {.width = W, .height = H}, .shade = FR_RENDER_AO, .spp = 48};
+  fr_render_desc d = desc_of(FR_RENDER_AO, 48);
   fr_renderer *r = NULL;
   assert_int_equal(fr_renderer_new(s, &d, &r), FR_ERR_STATE);
   assert_int_equal(fr_scene_commit(s), FR_OK);
@@ -114,6 +128,162 @@ static void passes_camera_and_errors(void **state) {
   assert_int_equal(fr_renderer_new(s, &d, &r), FR_ERR_ARG);
   assert_int_equal(fr_renderer_new(NULL, &d, &r), FR_ERR_ARG);
   fr_renderer_release(NULL);
+  fr_scene_release(s);
+}
+
+static float *image_of(fr_renderer *r) {
+  float *img = malloc((size_t)W * H * 3 * sizeof(float));
+  assert_int_equal(fr_renderer_image(r, 0, img, NULL, NULL, NULL), FR_OK);
+  return img;
+}
+
+static void update_keeps_what_it_can(void **state) {
+  (void)state;
+  fr_scene *s;
+  assert_int_equal(fr_scene_builtin_materials(&s), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  fr_render_desc d = desc_of(FR_RENDER_PATH, 4);
+  d.pass_spp = 1;
+  fr_renderer *r;
+  assert_int_equal(fr_renderer_new(s, &d, &r), FR_OK);
+  assert_int_equal(fr_renderer_pass(r, NULL), FR_OK);
+  assert_int_equal(fr_renderer_pass(r, NULL), FR_OK);
+  assert_int_equal(fr_renderer_spp(r), 2);
+  /* what is done with the sums: they stay */
+  d.exposure = 1.5f, d.denoise = 1, d.threads = 1, d.pass_spp = 2;
+  assert_int_equal(fr_renderer_update(r, &d), FR_OK);
+  assert_int_equal(fr_renderer_spp(r), 2);
+  assert_int_equal(fr_renderer_pass(r, NULL), FR_OK);
+  assert_int_equal(fr_renderer_spp(r), 4);
+  fr_render_desc got;
+  fr_renderer_desc(r, &got);
+  assert_true(got.exposure == 1.5f && got.pass_spp == 2);
+  /* another seed, sampler and lights: rendered as a new renderer would */
+  d.seed = 9, d.sampler = FR_SAMPLER_SOBOL, d.lights = FR_LIGHT_ENV | FR_LIGHT_POINT, d.denoise = 0;
+  d.env_color[1] = 0.5f;
+  assert_int_equal(fr_renderer_update(r, &d), FR_OK);
+  assert_int_equal(fr_renderer_spp(r), 0);
+  assert_int_equal(fr_renderer_render(r), FR_OK);
+  float *a = image_of(r);
+  fr_renderer *fresh;
+  assert_int_equal(fr_renderer_new(s, &d, &fresh), FR_OK);
+  assert_int_equal(fr_renderer_render(fresh), FR_OK);
+  float *b = image_of(fresh);
+  assert_memory_equal(a, b, (size_t)W * H * 3 * sizeof(float));
+  free(b);
+  /* a shade and back, a new camera: passes again */
+  d.shade = FR_RENDER_EYELIGHT;
+  assert_int_equal(fr_renderer_update(r, &d), FR_OK);
+  assert_int_equal(fr_renderer_render(r), FR_OK);
+  assert_int_equal(fr_renderer_spp(r), 1);
+  d.shade = FR_RENDER_PATH;
+  assert_int_equal(fr_renderer_update(r, &d), FR_OK);
+  assert_int_equal(fr_renderer_render(r), FR_OK);
+  b = image_of(r);
+  assert_memory_equal(a, b, (size_t)W * H * 3 * sizeof(float));
+  free(b);
+  const fr_pinhole cam = {{0.0f, 2.0f, 12.0f}, {0.0f, 1.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 45.0f, W, H};
+  d.camera = cam;
+  assert_int_equal(fr_renderer_update(r, &d), FR_OK);
+  assert_int_equal(fr_renderer_spp(r), 0);
+  /* a failed update leaves the renderer as it was */
+  fr_render_desc bad = d;
+  bad.environment = "/nonexistent/sky.exr";
+  bad.seed = 3;
+  assert_int_equal(fr_renderer_update(r, &bad), FR_ERR_IO);
+  fr_renderer_desc(r, &got);
+  assert_true(got.seed == 9 && got.environment == NULL);
+  assert_int_equal(fr_renderer_render(r), FR_OK);
+  assert_int_equal(fr_renderer_spp(r), 4);
+  free(a);
+  fr_renderer_release(fresh);
+  fr_renderer_release(r);
+  fr_scene_release(s);
+}
+
+static void cancel_stats_and_temporal(void **state) {
+  (void)state;
+  fr_scene *s;
+  assert_int_equal(fr_scene_builtin(&s), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  fr_render_desc d = desc_of(FR_RENDER_PATH, 8);
+  d.pass_spp = 1, d.temporal = 1, d.denoise = 1;
+  fr_renderer *r;
+  assert_int_equal(fr_renderer_new(s, &d, &r), FR_OK);
+  fr_render_stats st;
+  fr_renderer_set_cancel(r, 1);
+  assert_int_equal(fr_renderer_pass(r, NULL), FR_OK);
+  fr_renderer_stats(r, &st);
+  assert_true(st.cancelled && st.rays == 0);
+  assert_int_equal(fr_renderer_spp(r), 0);
+  fr_renderer_set_cancel(r, 0);
+  assert_int_equal(fr_renderer_pass(r, NULL), FR_OK);
+  assert_int_equal(fr_renderer_pass(r, NULL), FR_OK);
+  fr_renderer_stats(r, &st);
+  assert_true(!st.cancelled && st.rays > (uint64_t)W * H && st.seconds > 0.0);
+  assert_int_equal(fr_renderer_spp(r), 2);
+  float *img = image_of(r);
+  fr_renderer_stats(r, &st);
+  assert_true(st.denoise_seconds > 0.0);
+  /* a small turn of the camera: most pixels take the image carried over */
+  fr_pinhole cam;
+  fr_render_desc now;
+  fr_renderer_desc(r, &now);
+  cam = now.camera;
+  const fr_pinhole turned = {{0.2f, 3.0f, 9.0f}, {0.0f, 0.5f, 0.0f}, {0.0f, 1.0f, 0.0f}, 50.0f, W, H};
+  const fr_pinhole start = {{0.0f, 3.0f, 9.0f}, {0.0f, 0.5f, 0.0f}, {0.0f, 1.0f, 0.0f}, 50.0f, W, H};
+  (void)cam;
+  assert_int_equal(fr_renderer_set_camera(r, &start), FR_OK);
+  assert_int_equal(fr_renderer_pass(r, NULL), FR_OK);
+  assert_int_equal(fr_renderer_set_camera(r, &turned), FR_OK);
+  assert_int_equal(fr_renderer_pass(r, NULL), FR_OK);
+  fr_renderer_stats(r, &st);
+  assert_true(st.reused > 0.5f);
+  free(img);
+  img = image_of(r);
+  for (size_t i = 0; i < (size_t)W * H * 3; i++) assert_true(isfinite(img[i]) && img[i] >= 0.0f);
+  free(img);
+  fr_renderer_release(r);
+  fr_scene_release(s);
+}
+
+static void fields_out_of_range(void **state) {
+  (void)state;
+  fr_scene *s;
+  assert_int_equal(fr_scene_builtin_materials(&s), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  const fr_render_desc good = desc_of(FR_RENDER_PATH, 4);
+  fr_renderer *r = NULL;
+  fr_render_desc d;
+#define REFUSED(change)                                       \
+  d = good;                                                   \
+  change;                                                     \
+  assert_int_equal(fr_renderer_new(s, &d, &r), FR_ERR_ARG);   \
+  assert_null(r);
+  REFUSED(d.spp = 0);
+  REFUSED(d.max_depth = 65);
+  REFUSED((d.shade = FR_RENDER_WHITTED, d.max_depth = 9));
+  REFUSED(d.max_depth = -1);
+  REFUSED(d.lights = 8);
+  REFUSED(d.sampler = (fr_render_sampler)2);
+  REFUSED(d.aperture = -0.1f);
+  REFUSED(d.focus = NAN);
+  REFUSED((d.has_light = 1, d.light[1] = INFINITY));
+  REFUSED((d.has_area = 1, d.area_e1[0] = NAN));
+  REFUSED(d.area_radiance[2] = -1.0f);
+  REFUSED(d.light_intensity[0] = NAN);
+  REFUSED(d.env_color[0] = -0.5f);
+  REFUSED(d.env_intensity = -1.0f);
+  REFUSED(d.env_rotate = 400.0f);
+  REFUSED(d.exposure = 31.0f);
+  REFUSED(d.pass_spp = 0);
+  REFUSED(d.threads = -2);
+  REFUSED(d.mirror = "no_such_material");
+#undef REFUSED
+  d = good;
+  d.mirror = "lambert"; /* the showcase's Lambert sphere made chrome */
+  assert_int_equal(fr_renderer_new(s, &d, &r), FR_OK);
+  fr_renderer_release(r);
   fr_scene_release(s);
 }
 
@@ -170,6 +340,9 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(every_shade),
       cmocka_unit_test(passes_camera_and_errors),
+      cmocka_unit_test(update_keeps_what_it_can),
+      cmocka_unit_test(cancel_stats_and_temporal),
+      cmocka_unit_test(fields_out_of_range),
       cmocka_unit_test(images_save),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -678,17 +678,26 @@ static const char *shade_names[] = {"eyelight", "normals", "shadows", "softshado
 
 static PyObject *scene_render(SceneObject *s, PyObject *args, PyObject *kw) {
   static char *names[] = {"width", "height", "shade", "eye", "at", "up", "fov", "spp", "light", "environment",
-                          "exposure", "denoise", "display", NULL};
-  int width, height, spp = 0, denoise = 0, display = 1;
-  const char *shade = "eyelight";
-  PyObject *eo = Py_None, *ao = Py_None, *uo = Py_None, *lo = Py_None, *envo = Py_None;
-  float fov = 0.0f, exposure = 0.0f;
-  if (!PyArg_ParseTupleAndKeywords(args, kw, "ii|sOOOfiOOfpp", names, &width, &height, &shade, &eo, &ao, &uo, &fov,
-                                   &spp, &lo, &envo, &exposure, &denoise, &display))
+                          "exposure", "denoise", "display", "max_depth", "sampler", "seed", "aperture", "focus",
+                          "env_color", "env_intensity", "env_rotate", NULL};
+  fr_render_desc d;
+  fr_render_desc_default(&d);
+  int width, height, spp = d.spp, denoise = 0, display = 1, max_depth = 0;
+  unsigned seed = d.seed;
+  const char *shade = "eyelight", *sampler = "hammersley";
+  PyObject *eo = Py_None, *ao = Py_None, *uo = Py_None, *lo = Py_None, *envo = Py_None, *co = Py_None;
+  float fov = 0.0f, exposure = 0.0f, aperture = 0.0f, focus = 0.0f, env_intensity = 1.0f, env_rotate = 0.0f;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "ii|sOOOfiOOfppisIffOff", names, &width, &height, &shade, &eo, &ao, &uo,
+                                   &fov, &spp, &lo, &envo, &exposure, &denoise, &display, &max_depth, &sampler, &seed,
+                                   &aperture, &focus, &co, &env_intensity, &env_rotate))
     return NULL;
   if (!scene_open(s)) return NULL;
-  fr_render_desc d;
-  memset(&d, 0, sizeof d);
+  if (!strcmp(sampler, "hammersley")) d.sampler = FR_SAMPLER_HAMMERSLEY;
+  else if (!strcmp(sampler, "sobol")) d.sampler = FR_SAMPLER_SOBOL;
+  else return PyErr_Format(PyExc_ValueError, "render: sampler '%s' is neither hammersley nor sobol", sampler);
+  if (co != Py_None && !vec3_arg(co, "env_color", d.env_color)) return NULL;
+  d.max_depth = max_depth, d.seed = seed, d.aperture = aperture, d.focus = focus;
+  d.env_intensity = env_intensity, d.env_rotate = env_rotate;
   d.camera.width = width, d.camera.height = height;
   if (width <= 0 || height <= 0 || (int64_t)width * height > ((int64_t)1 << 26))
     return PyErr_Format(PyExc_ValueError, "render: image size %dx%d is empty or too large", width, height);

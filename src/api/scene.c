@@ -146,6 +146,12 @@ fr_error fr_scene_load_json(const char *path, const char *root, fr_scene_file *d
   if (!e) e = fr_mesh_validate(&s->mesh, path);
   if (e) { fr_scene_release(s); fr_scene_file_free(&f); return e; }
   scene_name(path, s->name, sizeof s->name);
+  if (f.nmaterials > 0) {
+    s->file_mats = malloc((size_t)f.nmaterials * sizeof *s->file_mats);
+    if (!s->file_mats) { fr_scene_release(s); fr_scene_file_free(&f); return fr_fail(FR_ERR_NOMEM, "out of memory"); }
+    memcpy(s->file_mats, f.materials, (size_t)f.nmaterials * sizeof *s->file_mats);
+    s->nfile_mats = f.nmaterials;
+  }
   if (desc) *desc = f;
   else fr_scene_file_free(&f);
   *out = s;
@@ -299,7 +305,14 @@ void fr_scene_release(fr_scene *s) {
   fr_bvhn_free(&s->bvh4);
   fr_bvhn_free(&s->bvh8);
   fr_plane_occluders_free(&s->planes);
+  free(s->file_mats);
   free(s);
+}
+
+const fr_bsdf *fr_scene_file_bsdf(const fr_scene *s, const char *name) {
+  for (int i = 0; s && name && i < s->nfile_mats; i++)
+    if (!strcmp(s->file_mats[i].name, name)) return &s->file_mats[i].bsdf;
+  return NULL;
 }
 
 /* The SAH tree over the non-degenerate triangles (n of them); sets s->bounds. */

@@ -24,6 +24,8 @@ struct fr_scene {
   aabb bounds;
   double build_seconds;
   char name[64];        /* scene name for views and reports */
+  struct fr_scene_file_material *file_mats; /* a scene file's path-tracer materials, by name */
+  int nfile_mats;
 };
 
 /* How the scene's packets and streams are traced (base/tuning.h): for
@@ -63,6 +65,9 @@ void fr_occluded_raystream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, 
  * when not NULL; the caller frees it with fr_scene_file_free. */
 struct fr_scene_file;
 fr_error fr_scene_load_json(const char *path, const char *root, struct fr_scene_file *desc, fr_scene **out);
+/* The path tracer's material called name in the scene file s was loaded
+ * from, or NULL. */
+const struct fr_bsdf *fr_scene_file_bsdf(const fr_scene *s, const char *name);
 /* The unit shading normal of triangle prim at barycentrics (u, v): its
  * corner normals interpolated; 0 where it has none (flat). */
 int fr_scene_shading_normal(const fr_scene *s, uint32_t prim, float u, float v, float n[3]);

@@ -7,6 +7,7 @@ typedef struct vec3 { float x, y, z; } vec3;
 
 static inline vec3 v3(float x, float y, float z) { vec3 r = {x, y, z}; return r; }
 static inline vec3 v3_load(const float *p) { return v3(p[0], p[1], p[2]); }
+static inline void v3_store(float *p, vec3 a) { p[0] = a.x, p[1] = a.y, p[2] = a.z; }
 static inline vec3 v3_add(vec3 a, vec3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
 static inline vec3 v3_sub(vec3 a, vec3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
 static inline vec3 v3_mul(vec3 a, vec3 b) { return v3(a.x * b.x, a.y * b.y, a.z * b.z); }

@@ -1,6 +1,7 @@
 #include "path_scene.h"
 #include <stdlib.h>
 #include <string.h>
+#include "api/scene.h"
 #include "render/surfaces.h"
 
 void fr_path_options_default(fr_path_options *o) {
@@ -10,8 +11,9 @@ void fr_path_options_default(fr_path_options *o) {
   o->env_color = v3(1, 1, 1), o->env_intensity = 1.0f;
 }
 
-fr_error fr_path_scene_init(fr_path_scene *r, const fr_scene *s, const fr_view *v, const fr_path_options *o,
-                            fr_path_material_lookup lookup, const void *ctx) {
+static int positive(vec3 c) { return c.x > 0.0f || c.y > 0.0f || c.z > 0.0f; }
+
+fr_error fr_path_scene_init(fr_path_scene *r, const fr_scene *s, const fr_view *v, const fr_path_options *o) {
   memset(r, 0, sizeof *r);
   if (o->env_file) {
     fr_error e = fr_env_load(&r->env, o->env_file);
@@ -22,8 +24,8 @@ fr_error fr_path_scene_init(fr_path_scene *r, const fr_scene *s, const fr_view *
   if (!(o->lights & FR_PATH_LIGHT_ENV)) { fr_env_free(&r->env); fr_env_constant(&r->env, v3(0, 0, 0)); }
   fr_env_orient(&r->env, v->up, o->env_rotate, o->env_intensity);
   fr_error e = fr_path_mats_build(s, o->mirror, o->glass, &r->mats, &r->count, &r->textures, &r->ntextures);
-  for (size_t i = 0; !e && lookup && i + 1 < r->count; i++) {
-    const fr_bsdf *b = lookup(ctx, fr_scene_material(s, i)->name);
+  for (size_t i = 0; !e && i + 1 < r->count; i++) {
+    const fr_bsdf *b = fr_scene_file_bsdf(s, fr_scene_material(s, i)->name);
     if (b) r->mats[i] = *b;
   }
   fr_path_setup *P = &r->setup;
@@ -39,11 +41,11 @@ fr_error fr_path_scene_init(fr_path_scene *r, const fr_scene *s, const fr_view *
   P->lights.area = (o->lights & FR_PATH_LIGHT_AREA) && area > 0.0f;
   P->lights.area_c = v->area_c, P->lights.area_e1 = v->area_e1, P->lights.area_e2 = v->area_e2;
   const float la = area > 0.0f ? 3.14159265f * da * da / area : 0.0f;
-  P->lights.area_radiance = v3(la, la, la);
+  P->lights.area_radiance = positive(o->area_radiance) ? o->area_radiance : v3(la, la, la);
   P->lights.point = (o->lights & FR_PATH_LIGHT_POINT) != 0;
   P->lights.point_pos = v->light;
   const float ip = 3.14159265f * dp * dp;
-  P->lights.point_intensity = v3(ip, ip, ip);
+  P->lights.point_intensity = positive(o->point_intensity) ? o->point_intensity : v3(ip, ip, ip);
   P->max_depth = o->max_depth;
   P->sampler = o->sampler;
   P->spp = o->spp, P->spp_begin = 0, P->spp_end = o->spp;

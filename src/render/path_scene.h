@@ -19,6 +19,7 @@ typedef struct fr_path_options {
   float env_intensity, env_rotate; /* rotate: degrees about the view's up */
   const char *mirror, *glass;     /* comma-separated material names made mirror or glass (NULL: none) */
   float aperture, focus;          /* thin lens; focus <= 0: the distance from eye to at */
+  vec3 area_radiance, point_intensity; /* 0: as bright as fr_path_scene_init says */
 } fr_path_options;
 
 /* 16 spp, depth 13, the environment (white) and the view's area light, seed 1. */
@@ -34,15 +35,12 @@ typedef struct fr_path_scene {
   fr_path_setup setup;            /* whole frame: spp 0..spp */
 } fr_path_scene;
 
-/* A material to use in place of the one the MTL gives, by name (NULL: keep it). */
-typedef const fr_bsdf *(*fr_path_material_lookup)(const void *ctx, const char *name);
-
-/* Sets up r for scene s seen from v. The area and point lights are as
- * bright as makes a white surface where the camera looks, facing them, as
- * bright as under a white sky. lookup may be NULL. Errors: the
+/* Sets up r for scene s seen from v. The materials are the MTL's, and a
+ * scene file's where it names one. The area and point lights are, unless
+ * o says, as bright as makes a white surface where the camera looks,
+ * facing them, as bright as under a white sky. Errors: the
  * environment's (FR_ERR_IO, FR_ERR_FORMAT), FR_ERR_ARG (an unknown mirror
  * or glass name), FR_ERR_NOMEM; r is then empty. */
-fr_error fr_path_scene_init(fr_path_scene *r, const fr_scene *s, const fr_view *v, const fr_path_options *o,
-                            fr_path_material_lookup lookup, const void *ctx);
+fr_error fr_path_scene_init(fr_path_scene *r, const fr_scene *s, const fr_view *v, const fr_path_options *o);
 void fr_path_scene_free(fr_path_scene *r);
 #endif

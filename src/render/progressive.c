@@ -55,19 +55,27 @@ void fr_progressive_free(fr_progressive *p) {
 
 void fr_progressive_restart(fr_progressive *p) {
   p->passes = 0;
+  p->path_spp = 0;
   memset(p->sum, 0, p->np * 3 * sizeof(float));
   memset(p->albedo, 0, p->np * 7 * sizeof(float));
 }
 
 /* Soft shadows: the spread passes summed, and whether the preview is what shows. */
 static int soft_spread(const fr_progressive *p) { return p->passes - (p->soft_preview && p->passes > 0); }
-static int soft_shows_preview(const fr_progressive *p) { return p->soft_preview && soft_spread(p) < FR_SOFT_SPREAD_SHOWN; }
+/* The preview shows until FR_SOFT_SPREAD_SHOWN spread passes are summed,
+ * or all there will be where max_passes allows fewer. */
+static int soft_shows_preview(const fr_progressive *p) {
+  if (!p->soft_preview) return 0;
+  const int spread_max = p->max_passes > 0 ? p->max_passes - 1 : FR_SOFT_SPREAD_SHOWN;
+  const int shown_at = spread_max < FR_SOFT_SPREAD_SHOWN ? spread_max : FR_SOFT_SPREAD_SHOWN;
+  return shown_at == 0 || soft_spread(p) < shown_at;
+}
 
 int fr_progressive_spp(const fr_progressive *p) {
   switch (p->mode) {
   case FR_SM_SOFTSHADOW: return p->passes == 0 ? 0 : soft_shows_preview(p) ? 16 : 16 * soft_spread(p);
   case FR_SM_AO: return 16 * p->passes;
-  case FR_SM_PATH: return p->passes * p->spp_per_pass < p->path.spp ? p->passes * p->spp_per_pass : p->path.spp;
+  case FR_SM_PATH: return p->path_spp;
   default: return p->passes;
   }
 }
@@ -101,6 +109,7 @@ void fr_progressive_pass(fr_progressive *p, const fr_tracer *t, const int *cance
     w.gbuf_vis = vis, w.gbuf_depth = p->depth, w.gbuf_normal = p->normal, w.gbuf_albedo = p->albedo;
     break;
   case FR_SM_PATH:
+    w.path = &p->path; /* p's own copy, wherever p now lives */
     p->path.spp_begin = fr_progressive_spp(p);
     p->path.spp_end = p->path.spp_begin + p->spp_per_pass < p->path.spp ? p->path.spp_begin + p->spp_per_pass : p->path.spp;
     w.image = p->sum;
@@ -121,6 +130,8 @@ void fr_progressive_pass(fr_progressive *p, const fr_tracer *t, const int *cance
     for (size_t i = 0; i < p->np; i++) p->sum[i] += vis[i];
   else if (p->mode == FR_SM_AO)
     for (size_t i = 0; i < 3 * p->np; i++) p->sum[i] += p->pass[i];
+  else if (p->mode == FR_SM_PATH)
+    p->path_spp = p->path.spp_end;
   p->passes++;
 }
 

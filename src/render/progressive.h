@@ -12,7 +12,8 @@
  *               the first pass takes the chosen light sets and the
  *               discontinuity filter, Benthin & Wald's real-time frame,
  *               and is shown until FR_SOFT_SPREAD_SHOWN more passes of
- *               spread sets are summed; their unfiltered mean, which
+ *               spread sets are summed (or all there will be, if
+ *               max_passes allows fewer); their unfiltered mean, which
  *               converges to the light's true visibility, is shown after.
  *   ao          16 hemisphere rays per pixel, a new scramble per pass
  *   path        spp_per_pass samples per pixel, up to the setup's spp
@@ -44,7 +45,8 @@ typedef struct fr_progressive {
   fr_softshadow_opts soft; /* softshadow: the preview's filter and sets (samples is not used) */
   int soft_preview;      /* softshadow: 1 (default) for the preview pass first */
   fr_path_setup path;    /* path: a copy of *w->path, whose spp_begin and spp_end the passes set */
-  int spp_per_pass;      /* path: samples per pixel in one pass (1..spp) */
+  int spp_per_pass;      /* path: samples per pixel in one pass (1..spp; may change between passes) */
+  int path_spp;          /* path: samples per pixel summed */
   int max_passes;        /* ao and softshadow: passes after which it is done (0: never) */
   int passes;            /* passes summed since the last restart */
   size_t np;

@@ -15,8 +15,10 @@
 #define FR_RENDER_SAMPLER_H
 #include <stddef.h>
 #include <stdint.h>
+#include "frusta.h"
 
-typedef enum fr_sampler_kind { FR_SAMPLER_HAMMERSLEY, FR_SAMPLER_SOBOL, FR_SAMPLER_COUNT } fr_sampler_kind;
+typedef fr_render_sampler fr_sampler_kind; /* the public enum (frusta.h) */
+#define FR_SAMPLER_COUNT 2
 
 const char *fr_sampler_name(fr_sampler_kind k);
 int fr_sampler_parse(const char *name, fr_sampler_kind *k);

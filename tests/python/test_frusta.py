@@ -553,10 +553,33 @@ def test_render_equals_the_command(tmp_path, shade, spp):
                    check=True, capture_output=True)
     want = read_pfm(out)
     scene = frusta.Scene.builtin()
-    got = scene.render(96, 64, shade, spp=spp, display=False)
+    got = scene.render(96, 64, shade, spp=spp or 16, display=False)
     assert got.rgb.shape == (64, 96, 3)
     np.testing.assert_array_equal(got.rgb, want)
     assert got.spp == {"eyelight": 1, "normals": 1, "shadows": 1, "whitted": 1}.get(shade, spp)
+
+
+def test_render_path_options_equal_the_command(tmp_path):
+    command = os.environ.get("FRUSTA_BIN")
+    if not command or not os.path.exists(command):
+        pytest.skip("FRUSTA_BIN names no frusta command")
+    out = tmp_path / "p.pfm"
+    subprocess.run([command, "render", "--builtin=materials", "--shade", "path", "--size", "64x48", "--spp", "3",
+                    "--sampler", "sobol", "--seed", "7", "--max-depth", "5", "--aperture", "0.05", "--focus", "9",
+                    "--env-color", "0.5,0.6,0.7", "--env-intensity", "2", "--env-rotate", "30", "--out", str(out)],
+                   check=True, capture_output=True)
+    got = frusta.Scene.builtin("materials").render(64, 48, "path", spp=3, sampler="sobol", seed=7, max_depth=5,
+                                                   aperture=0.05, focus=9.0, env_color=(0.5, 0.6, 0.7),
+                                                   env_intensity=2.0, env_rotate=30.0, display=False)
+    np.testing.assert_array_equal(got.rgb, read_pfm(out))
+    other = frusta.Scene.builtin("materials").render(64, 48, "path", spp=3, sampler="sobol", seed=8, max_depth=5,
+                                                     aperture=0.05, focus=9.0, env_color=(0.5, 0.6, 0.7),
+                                                     env_intensity=2.0, env_rotate=30.0, display=False)
+    assert not np.array_equal(got.rgb, other.rgb)  # the seed is the image's
+    with pytest.raises(ValueError, match="sampler"):
+        frusta.Scene.builtin().render(8, 8, "path", sampler="halton")
+    with pytest.raises(ValueError, match="max_depth"):
+        frusta.Scene.builtin().render(8, 8, "path", max_depth=99)
 
 
 def test_save_image(tmp_path):

@@ -14,6 +14,9 @@ int cli_path_from_args(const cli_args *a, cli_path *o) {
   o->env_color = v3(1, 1, 1), o->env_intensity = 1.0f, o->focus = -1.0f;
   o->env_file = a->val[F_ENV], o->mirror = a->val[F_MIRROR], o->glass = a->val[F_GLASS];
   o->aov = a->val[F_AOV] != NULL;
+  const fr_scene_file *file = cli_scene_file(); /* its lights' brightness (0: automatic) */
+  if (file && file->has_area_radiance) o->area_radiance = file->area_radiance;
+  if (file && file->has_point_intensity) o->point_intensity = file->point_intensity;
   int seed = 1, rc;
   static const char *const samplers[] = {"hammersley", "sobol"};
   int sampler = 0;
@@ -52,9 +55,16 @@ int cli_path_from_args(const cli_args *a, cli_path *o) {
   return 0;
 }
 
-/* the scene file's materials, by name */
-static const fr_bsdf *file_material(const void *ctx, const char *name) {
-  return fr_scene_file_find_material((const fr_scene_file *)ctx, name);
+void cli_path_print(const cli_path *o, const fr_path_setup *P) {
+  char lights[32] = "";
+  if (o->lights & CLI_LIGHT_ENV) strcat(lights, ",env");
+  if (P->lights.area) strcat(lights, ",area");
+  if (P->lights.point) strcat(lights, ",point");
+  printf("path spp=%d max_depth=%d sampler=%s lights=%s env=%s area_radiance=%.4g point_intensity=%.4g aperture=%g "
+         "focus=%g\n",
+         o->spp, o->max_depth, fr_sampler_name(o->sampler), lights[0] ? lights + 1 : "none",
+         o->env_file ? o->env_file : "constant", (double)P->lights.area_radiance.x, (double)P->lights.point_intensity.x,
+         (double)P->aperture, (double)P->focus);
 }
 
 int cli_path_setup(const cli_path *o, fr_workload *w, cli_path_run *r) {
@@ -65,23 +75,25 @@ int cli_path_setup(const cli_path *o, fr_workload *w, cli_path_run *r) {
   po.env_file = o->env_file, po.env_color = o->env_color, po.env_intensity = o->env_intensity;
   po.env_rotate = o->env_rotate, po.mirror = o->mirror, po.glass = o->glass;
   po.aperture = o->aperture, po.focus = o->focus;
-  const fr_scene_file *file = cli_scene_file();
-  fr_error e = fr_path_scene_init(r, w->scene, v, &po, file ? file_material : NULL, file);
+  po.area_radiance = o->area_radiance, po.point_intensity = o->point_intensity;
+  fr_error e = fr_path_scene_init(r, w->scene, v, &po);
   if (e) return cli_error(e == FR_ERR_ARG ? CLI_USAGE_ERROR : 1, "%s", fr_last_error());
   fr_path_setup *P = &r->setup;
-  if (file && file->has_area_radiance) P->lights.area_radiance = file->area_radiance;
-  if (file && file->has_point_intensity) P->lights.point_intensity = file->point_intensity;
   w->path = P;
-  char lights[32] = "";
-  if (o->lights & CLI_LIGHT_ENV) strcat(lights, ",env");
-  if (P->lights.area) strcat(lights, ",area");
-  if (P->lights.point) strcat(lights, ",point");
-  printf("path spp=%d max_depth=%d sampler=%s lights=%s env=%s area_radiance=%.4g point_intensity=%.4g aperture=%g "
-         "focus=%g\n",
-         o->spp, o->max_depth, fr_sampler_name(o->sampler), lights[0] ? lights + 1 : "none",
-         o->env_file ? o->env_file : "constant", (double)P->lights.area_radiance.x, (double)P->lights.point_intensity.x,
-         (double)P->aperture, (double)P->focus);
+  cli_path_print(o, P);
   return 0;
 }
 
 void cli_path_free(cli_path_run *r) { fr_path_scene_free(r); }
+
+void cli_path_desc(const cli_path *o, fr_render_desc *d) {
+  d->max_depth = o->max_depth, d->sampler = o->sampler, d->seed = o->seed, d->lights = (unsigned)o->lights;
+  d->environment = o->env_file;
+  v3_store(d->env_color, o->env_color);
+  d->env_intensity = o->env_intensity, d->env_rotate = o->env_rotate;
+  d->mirror = o->mirror, d->glass = o->glass;
+  d->aperture = o->aperture, d->focus = o->focus > 0.0f ? o->focus : 0.0f;
+  v3_store(d->area_radiance, o->area_radiance);
+  v3_store(d->light_intensity, o->point_intensity);
+  d->exposure = o->exposure;
+}

@@ -17,6 +17,7 @@ typedef struct cli_path {
   const char *env_file, *mirror, *glass;
   vec3 env_color;
   float env_intensity, env_rotate, aperture, focus, exposure; /* focus < 0: not given */
+  vec3 area_radiance, point_intensity; /* a scene file's (0: automatic) */
   int aov;
 } cli_path;
 
@@ -29,4 +30,8 @@ int cli_path_from_args(const cli_args *a, cli_path *o);
  * 0, or the exit code after reporting. Prints one line of what it set. */
 int cli_path_setup(const cli_path *o, fr_workload *w, cli_path_run *r);
 void cli_path_free(cli_path_run *r);
+/* The path tracer's fields of a renderer's description (spp aside). */
+void cli_path_desc(const cli_path *o, fr_render_desc *d);
+/* The line of what the path tracer was set up with. */
+void cli_path_print(const cli_path *o, const fr_path_setup *P);
 #endif

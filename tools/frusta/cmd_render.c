@@ -1,26 +1,25 @@
-/* frusta render: an image of a scene through the workload engine. */
+/* frusta render: an image of a scene through the public renderer
+ * (fr_renderer), with the command's measurement switches (Embree, large
+ * packets, the soft-shadow preview's filter and sets, a cluster's ranks)
+ * set through its internal tuning (api/renderer_tuning.h). */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include "api/renderer_tuning.h"
 #include "api/scene.h"
+#include "base/timer.h"
 #include "cli.h"
 #include "cli_cluster.h"
+#include "cli_path.h"
 #include "cli_scene_file.h"
 #include "commands.h"
-#include "base/timer.h"
-#include "cli_path.h"
 #include "embree_tracer.h"
-#include "film/denoise.h"
-#include "film/tonemap.h"
 #include "io/file_read.h"
 #include "io/image_write.h"
 #include "render/progressive.h"
-#include "render/softshadow.h"
-#include "render/whitted.h"
-#include "render/workload.h"
 
 /* Mean absolute difference of two images of ch channels per pixel, over
  * the n pixels that hit (not background in the RGB image img). */
@@ -35,47 +34,6 @@ static double mae(const float *a, const float *b, int ch, const float *img, size
   return cnt ? sum / (double)cnt : 0.0;
 }
 
-/* --shade softshadow: visibility by multi-frusta tracing, optionally against a
- * many-sample reference rendered in the same run. */
-static int render_soft(fr_scene *s, fr_workload *w, const fr_softshadow_opts *so, int mft, const char *out,
-                       const char *ref_out, int threads) {
-  size_t np = (size_t)w->cam.width * (size_t)w->cam.height;
-  float *img = malloc(np * 3 * sizeof(float)), *vis = malloc(np * sizeof(float));
-  float *rimg = ref_out ? malloc(np * 3 * sizeof(float)) : NULL, *rvis = ref_out ? malloc(np * sizeof(float)) : NULL;
-  int rc = 0;
-  if (!img || !vis || (ref_out && (!rimg || !rvis))) { rc = cli_error(1, "out of memory for a %dx%d image", w->cam.width, w->cam.height); goto done; }
-  fr_mft_tracer ctx = fr_mft_tracer_of(s, fr_mft_opts_default());
-  fr_tracer t = mft ? fr_tracer_mft(&ctx) : fr_tracer_frusta(s);
-  fr_workload_result r;
-  if (fr_render_softshadow(w, &t, so, img, vis, &r)) { rc = cli_error(1, "%s", fr_last_error()); goto done; }
-  if (cli_cluster_leader() && fr_image_write(out, w->cam.width, w->cam.height, img)) {
-    rc = cli_error(1, "%s", fr_last_error());
-    goto done;
-  }
-  const fr_softshadow_opts used = fr_softshadow_used(so);
-  printf("rendered scene=%s tris=%zu size=%dx%d shade=softshadow light_samples=%d filter=%s light_sets=%s tracer=%s "
-         "isa=%s threads=%d rays=%llu seconds=%.3f mrays=%.2f -> %s\n",
-         s->name, fr_scene_triangle_count(s), w->cam.width, w->cam.height, used.samples, used.filter ? "on" : "off",
-         used.sets == FR_LIGHT_SETS_CELLS ? "cells" : "spread", mft ? "mft" : "auto", fr_isa_name(fr_get_isa()), threads,
-         (unsigned long long)r.rays, r.seconds, (double)r.rays / r.seconds * 1e-6, out);
-  if (ref_out) {
-    fr_softshadow_opts ro = {256, 0, FR_LIGHT_SETS_SPREAD};
-    fr_workload rw = *w;
-    rw.seed = w->seed + 1000;
-    rw.progress = 0;
-    if (fr_render_softshadow(&rw, &t, &ro, rimg, rvis, &r)) { rc = cli_error(1, "%s", fr_last_error()); goto done; }
-    if (cli_cluster_leader() && fr_image_write(ref_out, w->cam.width, w->cam.height, rimg)) {
-      rc = cli_error(1, "%s", fr_last_error());
-      goto done;
-    }
-    printf("reference light_samples=256 filter=off -> %s\nmae_visibility=%.4f mae_rgb=%.4f\n", ref_out,
-           mae(vis, rvis, 1, rimg, np), mae(img, rimg, 3, rimg, np));
-  }
-done:
-  free(img); free(vis); free(rimg); free(rvis);
-  return rc;
-}
-
 /* out with ".albedo.exr" for its extension */
 static void aov_name(const char *out, const char *kind, char *buf, size_t n) {
   const char *dot = strrchr(out, '.');
@@ -83,167 +41,122 @@ static void aov_name(const char *out, const char *kind, char *buf, size_t n) {
   snprintf(buf, n, "%.*s.%s.exr", stem, out, kind);
 }
 
-/* --shade path, ao, or softshadow with --denoise: passes summed
- * (render/progressive.h; path's are of FR_PATH_CHUNK samples), a progress
- * line, the mean optionally denoised, written linear (EXR, PFM) or
- * tone-mapped (PNG, path only; the others are in [0, 1] already). */
-static int render_progressive(fr_scene *s, fr_workload *w, fr_shade_mode mode, const cli_path *po,
-                              const fr_softshadow_opts *so, int denoise, const char *out, int threads, int trace_mode,
-                              int embree, int mft) {
-  const size_t np = (size_t)w->cam.width * (size_t)w->cam.height;
-  const int path = mode == FR_SM_PATH;
-  cli_path_run run;
-  memset(&run, 0, sizeof run);
-  int rc = path ? cli_path_setup(po, w, &run) : 0;
-  if (rc) return rc;
-  char albedo_out[4096], normal_out[4096];
-  aov_name(out, "albedo", albedo_out, sizeof albedo_out);
-  aov_name(out, "normal", normal_out, sizeof normal_out);
-  float *img = malloc(np * 10 * sizeof(float));
-  fr_progressive p;
-  memset(&p, 0, sizeof p);
-  fr_denoiser *dn = NULL;
-  ebr_scene *e = NULL;
-  if (!img || fr_progressive_init(&p, w, mode) || (denoise && fr_denoiser_new(w->cam.width, w->cam.height, &dn))) {
-    rc = cli_error(1, "out of memory for a %dx%d image", w->cam.width, w->cam.height);
-    goto done;
-  }
-  float *albedo = img + 3 * np, *normal = img + 6 * np, *depth = img + 9 * np;
-  static const char *const mode_names[] = {"auto", "single", "packet8", "packet16", "hybrid16", "raystream"};
-  if (embree) {
-    ebr_options eo = {.threads = threads, .quality = 2}; /* high quality, not robust: Embree's fastest */
-    if (ebr_create(s, eo, &e)) { rc = cli_error(1, "embree: cannot build the scene"); goto done; }
-  } else if (fr_scene_set_trace_mode(s, (fr_trace_mode)trace_mode)) {
-    rc = cli_error(1, "%s", fr_last_error());
-    goto done;
-  }
-  /* camera rays (and soft shadows) as multi-frusta, as the other shades
-   * trace them, unless the scene has spheres; paths trace streams only */
-  fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
-  const int use_mft = !e && mft != 0 && mode != FR_SM_PATH && !fr_scene_sphere_count(s);
-  fr_tracer t = e ? ebr_tracer(e, EBR_STREAM, EBR_FLAG_HINT, EBR_PACK_RAYS) : use_mft ? fr_tracer_mft(&mctx) : fr_tracer_frusta(s);
-  p.w.progress = 0;
-  int passes;
-  if (path && w->feed) {
-    /* a cluster's tile takes all its samples at once: a worker's pixels
-     * are then whole sums, the same bits as passes summed here */
-    p.spp_per_pass = run.setup.spp;
-    p.w.progress = 1;
-    passes = 1;
-  } else if (path) {
-    p.spp_per_pass = FR_PATH_CHUNK;
-    passes = (run.setup.spp + FR_PATH_CHUNK - 1) / FR_PATH_CHUNK;
-  } else if (mode == FR_SM_SOFTSHADOW) {
-    const fr_softshadow_opts used = fr_softshadow_used(so);
-    p.soft = used;
-    passes = used.samples / 16;
-    p.soft_preview = passes == 1;
-  } else {
-    passes = po->spp / 16;
-  }
-  uint64_t rays = 0;
+typedef struct render_job {
+  fr_scene *s;
+  fr_render_desc d;
+  fr_renderer_tuning tune;
+  const char *tracer, *mode; /* for the report: frusta or embree; mft, a trace mode or large packets */
+  int aov;
+  const char *out;
+} render_job;
+
+/* Passes until done, with a progress line on a terminal; the image, its
+ * guides (W*H*10 floats: rgb, albedo, normal, depth) written by rank 0. */
+static int run(fr_renderer *r, const render_job *j, int report, float *img, uint64_t *rays, double *seconds,
+               double *denoise_seconds) {
+  const fr_render_desc *d = &j->d;
+  const size_t np = (size_t)d->camera.width * (size_t)d->camera.height;
+  const int path = d->shade == FR_RENDER_PATH;
+  const int passes = path ? (j->tune.whole_path_passes ? 1 : (d->spp + d->pass_spp - 1) / d->pass_spp)
+                     : d->shade == FR_RENDER_AO ? d->spp / 16
+                     : d->shade == FR_RENDER_SOFTSHADOW ? (d->spp > 16 && j->tune.soft_preview) + d->spp / 16
+                                                        : 1;
+  const int tty = report && isatty(fileno(stderr)) && cli_cluster_leader() && passes > 1;
   const double t0 = fr_seconds();
   double last = t0;
-  /* the progress line is for a person watching */
-  const int tty = isatty(fileno(stderr)) && cli_cluster_leader() && passes > 1;
-  for (int k = 0; k < passes; k++) {
-    fr_workload_result r;
-    fr_progressive_pass(&p, &t, NULL, &r);
-    if (r.failed) { rc = cli_error(1, "%s", fr_last_error()); goto done; }
-    rays += r.rays;
+  *rays = 0;
+  int done = 0;
+  for (int k = 0; !done; k++) {
+    if (fr_renderer_pass(r, &done)) return cli_error(1, "%s", fr_last_error());
+    fr_render_stats st;
+    fr_renderer_stats(r, &st);
+    *rays += st.rays;
     const double now = fr_seconds();
-    if (tty && (now - last > 0.5 || k + 1 == passes)) {
+    if (tty && (now - last > 0.5 || done)) {
       last = now;
-      const double el = now - t0, left = el / (k + 1) * (passes - k - 1);
-      fprintf(stderr, "\r%s: %d/%d passes  %.1f Mrays/s  %.1f s, %.1f s left  ", fr_shade_mode_name(mode), k + 1, passes,
-              rays / el * 1e-6, el, left);
+      const double el = now - t0, left = el / (k + 1) * (passes - k - 1 > 0 ? passes - k - 1 : 0);
+      fprintf(stderr, "\r%s: %d/%d passes  %.1f Mrays/s  %.1f s, %.1f s left  ",
+              fr_shade_mode_name((fr_shade_mode)d->shade), k + 1, passes, *rays / el * 1e-6, el, left);
       fflush(stderr);
     }
   }
   if (tty) fprintf(stderr, "\n");
-  fr_progressive_resolve(&p, img, albedo, normal, depth);
-  const double render_seconds = fr_seconds() - t0;
-  double denoise_seconds = 0.0;
-  if (!cli_cluster_leader()) goto done; /* rank 0 has the image */
-  if (dn) {
-    const double t1 = fr_seconds();
-    fr_denoise(dn, img, albedo, normal, depth, fr_progressive_spp(&p), threads, img);
-    denoise_seconds = fr_seconds() - t1;
+  *seconds = fr_seconds() - t0;
+  const int display = path && fr_has_suffix(j->out, ".png");
+  if (fr_renderer_image(r, display, img, img + 3 * np, img + 6 * np, img + 9 * np)) return cli_error(1, "%s", fr_last_error());
+  fr_render_stats st;
+  fr_renderer_stats(r, &st);
+  *denoise_seconds = st.denoise_seconds;
+  return 0;
+}
+
+/* The image of j; with ref_out, also soft shadows' 256-sample unfiltered
+ * reference, and how far the image is from it. */
+static int render(const render_job *j, const char *ref_out) {
+  const fr_render_desc *d = &j->d;
+  const int W = d->camera.width, H = d->camera.height;
+  const size_t np = (size_t)W * (size_t)H;
+  fr_renderer *r = NULL, *ref = NULL;
+  float *img = malloc(np * 10 * sizeof(float)), *vis = NULL, *rimg = NULL;
+  int rc = 0;
+  if (!img) { rc = cli_error(1, "out of memory for a %dx%d image", W, H); goto done; }
+  const fr_error e = fr_renderer_new(j->s, d, &r);
+  if (e) { /* FR_ERR_ARG: a flag's value (a material name), else a file or memory */
+    rc = cli_error(e == FR_ERR_ARG ? CLI_USAGE_ERROR : 1, "%s", fr_last_error());
+    goto done;
   }
-  const int png = fr_has_suffix(out, ".png");
-  if (path && png) fr_tonemap_filmic(img, 3 * np, po->exposure);
-  if (fr_image_write(out, w->cam.width, w->cam.height, img) ||
-      (path && po->aov && (fr_image_write(albedo_out, w->cam.width, w->cam.height, albedo) ||
-                           fr_image_write(normal_out, w->cam.width, w->cam.height, normal)))) {
+  fr_renderer_tune(r, &j->tune);
+  const fr_path_setup *P = fr_renderer_path_setup(r);
+  if (P && cli_cluster_leader()) {
+    cli_path p = {.spp = d->spp, .max_depth = d->max_depth, .lights = (int)d->lights, .sampler = d->sampler,
+                  .env_file = d->environment};
+    cli_path_print(&p, P);
+  }
+  const fr_whitted_mats *mats = fr_renderer_whitted_mats(r);
+  if (mats && cli_cluster_leader()) {
+    size_t nm, ng;
+    fr_whitted_mats_census(j->s, mats, &nm, &ng);
+    printf("whitted depth=%d mirror_prims=%zu glass_prims=%zu\n", d->max_depth, nm, ng);
+  }
+  uint64_t rays;
+  double seconds, denoise_seconds;
+  if ((rc = run(r, j, 1, img, &rays, &seconds, &denoise_seconds))) goto done;
+  if (!cli_cluster_leader()) goto done; /* rank 0 has the image */
+  char albedo_out[4096], normal_out[4096];
+  aov_name(j->out, "albedo", albedo_out, sizeof albedo_out);
+  aov_name(j->out, "normal", normal_out, sizeof normal_out);
+  if (fr_image_write(j->out, W, H, img) ||
+      (j->aov && (fr_image_write(albedo_out, W, H, img + 3 * np) || fr_image_write(normal_out, W, H, img + 6 * np)))) {
     rc = cli_error(1, "%s", fr_last_error());
     goto done;
   }
   printf("rendered scene=%s tris=%zu size=%dx%d shade=%s spp=%d tracer=%s mode=%s isa=%s threads=%d "
          "build_seconds=%.3f rays=%llu seconds=%.3f mrays=%.2f denoise_seconds=%.4f -> %s%s%s%s%s\n",
-         s->name, fr_scene_triangle_count(s), w->cam.width, w->cam.height, fr_shade_mode_name(mode), fr_progressive_spp(&p),
-         e ? "embree" : "frusta", e ? "stream" : use_mft ? "mft" : mode_names[trace_mode], fr_isa_name(fr_get_isa()),
-         threads, s->build_seconds, (unsigned long long)rays, render_seconds, rays / render_seconds * 1e-6,
-         denoise_seconds, out, path && po->aov ? " " : "", path && po->aov ? albedo_out : "",
-         path && po->aov ? " " : "", path && po->aov ? normal_out : "");
-done:
-  free(img);
-  fr_progressive_free(&p);
-  fr_denoiser_free(dn);
-  ebr_release(e);
-  cli_path_free(&run);
-  return rc;
-}
-
-/* The image of the scene in shade, as the flags ask. */
-static int render_scene(fr_scene *s, fr_workload *wp, const char *const *val, int shade, const cli_view *vp,
-                        const cli_whitted *wop, const cli_path *pop, const fr_softshadow_opts *sop, int mft, int mode,
-                        int embree, int denoise, int threads) {
-  fr_workload w = *wp;
-  const cli_view v = *vp;
-  const cli_whitted wo = *wop;
-  const cli_path po = *pop;
-  const fr_softshadow_opts so = *sop;
-  const char *out = val[F_OUT], *ref_out = val[F_REFERENCE_OUT];
-  const char *const *shades = fr_shade_mode_names;
-  int rc = 0;
-  w.seed = 1;
-  w.progress = 1;
-  if (shade == FR_SM_PATH || shade == FR_SM_AO || (shade == FR_SM_SOFTSHADOW && denoise))
-    return render_progressive(s, &w, (fr_shade_mode)shade, &po, &so, denoise, out, threads, mode, embree, mft);
-  if (w.kind == FR_WL_SOFT16) /* multi-frusta tracing does not see spheres: such scenes go the packet way */
-    return render_soft(s, &w, &so, mft != 0 && !fr_scene_sphere_count(s), out, ref_out, threads);
-  fr_whitted_mats mats = {0};
-  if (w.kind == FR_WL_WHITTED && (rc = cli_whitted_setup(s, &wo, &mats, &w))) return rc;
-  w.image = calloc((size_t)v.width * (size_t)v.height * 3, sizeof(float));
-  if (!w.image) { fr_whitted_mats_free(&mats); return cli_error(1, "out of memory for a %dx%d image", v.width, v.height); }
-  /* Whitted: camera rays by multi-frusta tracing and the rest as streams
-   * (the fastest), or with --mft off or any of --packet, --traversal,
-   * --cull: large packets of --packet x --packet */
-  fr_lp_tracer lpc = {s, cli_lp_scene(s), wo.lp, wo.packet};
-  fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
-  /* multi-frusta tracing does not see spheres: such scenes go the packet
-   * way. Camera rays are traced as frusta by default for every shade, the
-   * rest as streams (auto). */
-  const int use_mft = mft != 0 && !fr_scene_sphere_count(s) && !(w.kind == FR_WL_WHITTED && wo.large_flags);
-  fr_tracer t = use_mft ? fr_tracer_mft(&mctx) : w.kind != FR_WL_WHITTED ? fr_tracer_frusta(s) : fr_tracer_lp(&lpc);
-  const int whitted_mft = w.kind == FR_WL_WHITTED && use_mft;
-  if (w.kind == FR_WL_WHITTED && cli_cluster_leader()) {
-    if (whitted_mft) printf("whitted tracer=mft\n");
-    else printf("whitted tracer=packet%dx%d/%s/%s\n", wo.packet, wo.packet, fr_lp_traversal_name(wo.lp.traversal),
-                fr_cull_name(wo.lp.cull));
+         j->s->name, fr_scene_triangle_count(j->s), W, H, fr_shade_mode_name((fr_shade_mode)d->shade),
+         fr_renderer_spp(r), j->tracer, j->mode, fr_isa_name(fr_get_isa()), d->threads, j->s->build_seconds,
+         (unsigned long long)rays, seconds, rays / seconds * 1e-6, denoise_seconds, j->out, j->aov ? " " : "",
+         j->aov ? albedo_out : "", j->aov ? " " : "", j->aov ? normal_out : "");
+  if (ref_out) { /* 256 spread light samples, summed unfiltered */
+    render_job rj = *j;
+    rj.d.spp = 256;
+    rj.tune.soft_preview = 0;
+    rj.out = ref_out;
+    vis = malloc(np * 2 * sizeof(float));
+    rimg = malloc(np * 10 * sizeof(float));
+    if (!vis || !rimg) { rc = cli_error(1, "out of memory for the reference"); goto done; }
+    if (fr_renderer_new(j->s, &rj.d, &ref)) { rc = cli_error(1, "%s", fr_last_error()); goto done; }
+    fr_renderer_tune(ref, &j->tune);
+    if ((rc = run(ref, &rj, 0, rimg, &rays, &seconds, &denoise_seconds))) goto done;
+    if (fr_image_write(ref_out, W, H, rimg)) { rc = cli_error(1, "%s", fr_last_error()); goto done; }
+    fr_renderer_visibility(r, vis);
+    fr_renderer_visibility(ref, vis + np);
+    printf("reference light_samples=256 filter=off -> %s\nmae_visibility=%.4f mae_rgb=%.4f\n", ref_out,
+           mae(vis, vis + np, 1, rimg, np), mae(img, rimg, 3, rimg, np));
   }
-  fr_workload_result r = fr_workload_run(&w, &t);
-  if (r.failed) rc = cli_error(1, "%s", fr_last_error());
-  else if (!cli_cluster_leader()) rc = 0;
-  else if (fr_image_write(out, v.width, v.height, w.image)) rc = cli_error(1, "%s", fr_last_error());
-  else
-    printf("rendered scene=%s tris=%zu size=%dx%d shade=%s tracer=%s isa=%s threads=%d build_seconds=%.3f rays=%llu "
-           "seconds=%.3f mrays=%.2f -> %s\n",
-           s->name, fr_scene_triangle_count(s), v.width, v.height, shades[shade],
-           use_mft ? "mft" : w.kind == FR_WL_WHITTED ? "packets" : "auto", fr_isa_name(fr_get_isa()), threads,
-           s->build_seconds, (unsigned long long)r.rays, r.seconds, (double)r.rays / r.seconds * 1e-6, out);
-  free(w.image);
-  fr_whitted_mats_free(&mats);
+done:
+  fr_renderer_release(r);
+  fr_renderer_release(ref);
+  free(img), free(vis), free(rimg);
   return rc;
 }
 
@@ -254,7 +167,7 @@ int cmd_render(int argc, char **argv) {
   if ((rc = cli_scene_file_defaults(&a))) return rc;
   const char *scene = a.pos[0], *out = a.val[F_OUT], *ref_out = a.val[F_REFERENCE_OUT];
   int threads = omp_get_num_procs(), mft = -1; /* -1: not given */
-  fr_softshadow_opts so = {16, 1, FR_LIGHT_SETS_CELLS};
+  int light_samples = 16, filter = 1;
   const char *const *shades = fr_shade_mode_names;
   static const char *const sets[] = {"cells", "spread"}; /* FR_LIGHT_SETS_CELLS, _SPREAD */
   int shade = 0, set = 0, mode = 0, embree = 0, denoise = 0;
@@ -265,8 +178,8 @@ int cmd_render(int argc, char **argv) {
   cli_path po;
   if ((rc = cli_view_from_args(&a, &v)) || (rc = cli_whitted_from_args(&a, &wo)) || (rc = cli_path_from_args(&a, &po)) ||
       (rc = cli_common_from_args(&a, &threads)) || (rc = cli_arg_choice(&a, F_SHADE, shades, FR_SM_COUNT, &shade)) ||
-      (rc = cli_arg_choice(&a, F_LIGHT_SETS, sets, 2, &set)) || (rc = cli_arg_onoff(&a, F_FILTER, &so.filter)) ||
-      (rc = cli_arg_onoff(&a, F_MFT, &mft)) || (rc = cli_arg_int(&a, F_LIGHT_SAMPLES, 16, 4096, &so.samples)) ||
+      (rc = cli_arg_choice(&a, F_LIGHT_SETS, sets, 2, &set)) || (rc = cli_arg_onoff(&a, F_FILTER, &filter)) ||
+      (rc = cli_arg_onoff(&a, F_MFT, &mft)) || (rc = cli_arg_int(&a, F_LIGHT_SAMPLES, 16, 4096, &light_samples)) ||
       (rc = cli_arg_choice(&a, F_MODE, modes, 6, &mode)) || (rc = cli_arg_choice(&a, F_TRACER, tracers, 2, &embree)) ||
       (rc = cli_arg_onoff(&a, F_DENOISE, &denoise)))
     return rc;
@@ -276,10 +189,10 @@ int cmd_render(int argc, char **argv) {
   if (denoise && !fr_shade_mode_progressive((fr_shade_mode)shade))
     return cli_error(CLI_USAGE_ERROR, "--denoise is for path, ao and softshadow, not %s", shades[shade]);
   if (denoise && ref_out) return cli_error(CLI_USAGE_ERROR, "--reference-out and --denoise: give one");
+  if (ref_out && shade != FR_SM_SOFTSHADOW) return cli_error(CLI_USAGE_ERROR, "--reference-out is for --shade softshadow");
   if (shade == FR_SM_AO && po.spp % 16)
     return cli_error(CLI_USAGE_ERROR, "ao: --spp wants a multiple of 16 (hemisphere rays per pixel), got '%s'", a.val[F_SPP]);
-  so.sets = set ? FR_LIGHT_SETS_SPREAD : FR_LIGHT_SETS_CELLS;
-  if (so.samples % 16)
+  if (light_samples % 16)
     return cli_error(CLI_USAGE_ERROR, "--light-samples wants a multiple of 16 (16..4096), got '%s'", a.val[F_LIGHT_SAMPLES]);
   if (!scene || !out)
     return cli_error(CLI_USAGE_ERROR, "usage: frusta render SCENE|--builtin --out FILE.png|.exr|.pfm [flags] "
@@ -287,12 +200,12 @@ int cmd_render(int argc, char **argv) {
   if (!fr_image_format_known(out)) return cli_error(CLI_USAGE_ERROR, "%s: unknown image format (use .png, .exr or .pfm)", out);
   if (ref_out && !fr_image_format_known(ref_out))
     return cli_error(CLI_USAGE_ERROR, "%s: unknown image format (use .png, .exr or .pfm)", ref_out);
+  if (shade == FR_SM_WHITTED && mft == 1 && wo.large_flags)
+    return cli_error(CLI_USAGE_ERROR, "--mft on and --packet/--traversal/--cull: large packets need --mft off");
+
   fr_workload w;
   memset(&w, 0, sizeof w);
   fr_shade_mode_workload((fr_shade_mode)shade, &w.kind, &w.shade);
-
-  if (w.kind == FR_WL_WHITTED && mft == 1 && wo.large_flags)
-    return cli_error(CLI_USAGE_ERROR, "--mft on and --packet/--traversal/--cull: large packets need --mft off");
   fr_scene *s = NULL;
   fr_cluster_feed *feed = NULL;
   const int set_up = cli_workload_setup(scene, &v, threads, &s, &w);
@@ -300,7 +213,55 @@ int cmd_render(int argc, char **argv) {
     if (!set_up) fr_scene_release(s);
     return rc;
   }
-  rc = render_scene(s, &w, a.val, shade, &v, &wo, &po, &so, mft, mode, embree, denoise, threads);
+
+  render_job j;
+  memset(&j, 0, sizeof j);
+  j.s = s, j.out = out, j.aov = shade == FR_SM_PATH && po.aov;
+  fr_render_desc *d = &j.d;
+  fr_render_desc_default(d);
+  const fr_view *view = &w.view;
+  v3_store(d->camera.eye, view->eye), v3_store(d->camera.at, view->at), v3_store(d->camera.up, view->up);
+  d->camera.fov_deg = view->fov, d->camera.width = v.width, d->camera.height = v.height;
+  d->has_light = 1, v3_store(d->light, view->light);
+  d->has_area = 1;
+  v3_store(d->area_corner, view->area_c), v3_store(d->area_e1, view->area_e1), v3_store(d->area_e2, view->area_e2);
+  d->shade = (fr_render_shade)shade;
+  cli_path_desc(&po, d);
+  d->spp = shade == FR_SM_SOFTSHADOW ? light_samples : po.spp;
+  if (shade == FR_SM_WHITTED) d->max_depth = wo.depth, d->mirror = wo.mirror, d->glass = wo.glass;
+  d->denoise = denoise, d->threads = threads;
+  d->camera_frusta = mft != 0 && !(shade == FR_SM_WHITTED && wo.large_flags);
+  fr_renderer_tuning_default(&j.tune);
+  j.tune.feed = w.feed;
+  j.tune.whole_path_passes = w.feed != NULL; /* a cluster's tile takes all its samples at once */
+  j.tune.progress = !fr_shade_mode_progressive((fr_shade_mode)shade);
+  j.tune.soft_preview = d->spp == 16; /* more samples: their mean is the image, no preview needed */
+  j.tune.soft_filter = filter;
+  j.tune.soft_sets = set ? FR_LIGHT_SETS_SPREAD : FR_LIGHT_SETS_CELLS;
+  /* Whitted: camera rays by multi-frusta tracing and the rest as streams
+   * (the fastest), or with --mft off or any of --packet, --traversal,
+   * --cull: large packets of --packet x --packet (so too with spheres,
+   * which multi-frusta tracing does not see) */
+  ebr_scene *e = NULL;
+  fr_lp_tracer lpc = {s, cli_lp_scene(s), wo.lp, wo.packet};
+  char lp_name[64];
+  const int frusta = d->camera_frusta && !fr_scene_sphere_count(s) && shade != FR_SM_PATH;
+  j.tracer = "frusta";
+  j.mode = frusta ? "mft" : shade == FR_SM_PATH ? modes[mode] : "auto";
+  if (embree) {
+    ebr_options eo = {.threads = threads, .quality = 2}; /* high quality, not robust: Embree's fastest */
+    if (ebr_create(s, eo, &e)) { rc = cli_error(1, "embree: cannot build the scene"); goto done; }
+    j.tune.has_tracer = 1, j.tune.tracer = ebr_tracer(e, EBR_STREAM, EBR_FLAG_HINT, EBR_PACK_RAYS);
+    j.tracer = "embree", j.mode = "stream";
+  } else if (shade == FR_SM_WHITTED && !frusta) {
+    j.tune.has_tracer = 1, j.tune.tracer = fr_tracer_lp(&lpc);
+    snprintf(lp_name, sizeof lp_name, "packet%dx%d/%s/%s", wo.packet, wo.packet, fr_lp_traversal_name(wo.lp.traversal),
+             fr_cull_name(wo.lp.cull));
+    j.mode = lp_name;
+  }
+  if (shade == FR_SM_WHITTED && cli_cluster_leader()) printf("whitted tracer=%s\n", j.mode);
+  if (!embree && fr_scene_set_trace_mode(s, (fr_trace_mode)mode)) { rc = cli_error(1, "%s", fr_last_error()); goto done; }
+  rc = render(&j, ref_out);
   if (!rc && feed) { /* the last frame's deal: what each rank rendered, what came to rank 0 */
     uint64_t bytes = 0;
     printf("cluster ranks=%d threads_per_rank=%d rank_tiles=", fr_cluster_size(), threads);
@@ -311,6 +272,8 @@ int cmd_render(int argc, char **argv) {
     }
     printf(" bytes_sent=%llu\n", (unsigned long long)bytes);
   }
+done:
+  ebr_release(e);
   fr_cluster_feed_free(feed);
   fr_scene_release(s);
   return rc;
