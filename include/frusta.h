@@ -431,6 +431,8 @@ void fr_renderer_desc(const fr_renderer *r, fr_render_desc *d);
 fr_error fr_renderer_pass(fr_renderer *r, int *done);
 /* Passes until done. */
 fr_error fr_renderer_render(fr_renderer *r);
+/* 1 once another pass would change nothing. */
+int fr_renderer_done(const fr_renderer *r);
 /* While cancel is 1, a pass under way stops at its next tile and passes
  * started do nothing; 0 lets them run again. The one call that may come
  * from another thread while fr_renderer_pass runs (for an interactive

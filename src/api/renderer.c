@@ -208,7 +208,7 @@ static fr_error ensure_buffers(fr_renderer *r, const fr_render_desc *d) {
     const fr_error e = fr_denoiser_new(W, H, &r->dn);
     if (e) return e;
   }
-  if (d->temporal && !r->tp) {
+  if (d->temporal && (d->shade == FR_RENDER_PATH || d->shade == FR_RENDER_AO) && !r->tp) {
     r->frame = malloc((size_t)W * (size_t)H * 10 * sizeof(float));
     if (!r->frame || fr_temporal_new(W, H, &r->tp)) {
       free(r->frame);
@@ -452,6 +452,8 @@ fr_error fr_renderer_render(fr_renderer *r) {
   while (!e && !done) e = fr_renderer_pass(r, &done);
   return e;
 }
+
+int fr_renderer_done(const fr_renderer *r) { return !r || fr_progressive_done(&r->p); }
 
 int fr_renderer_spp(const fr_renderer *r) { return r ? fr_progressive_spp(&r->p) : 0; }
 

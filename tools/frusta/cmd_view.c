@@ -92,6 +92,7 @@ static void *worker(void *arg) {
     char step_shot[sizeof sh->step_shot];
     memcpy(step_shot, sh->step_shot, sizeof step_shot);
     __atomic_store_n(&sh->cancel, 0, __ATOMIC_RELAXED);
+    view_renderer_cancel(&app->r, 0);
     pthread_mutex_unlock(&sh->lock);
     int rc = 0, fresh = 0;
     if (!have || applied != gen) {
@@ -103,7 +104,7 @@ static void *worker(void *arg) {
       sh->changed_at = 0.0;
       pthread_mutex_unlock(&sh->lock);
     }
-    if (!rc) fresh = view_renderer_pass(&app->r, &sh->cancel);
+    if (!rc && (fresh = view_renderer_pass(&app->r)) < 0) rc = 1;
     /* every step shows a frame, the last one again when nothing was left to
      * do; a step abandoned (the window closed) shows and writes nothing */
     if (!rc && sh->lockstep && !__atomic_load_n(&sh->cancel, __ATOMIC_RELAXED)) {
@@ -237,7 +238,7 @@ static int run_interactive(view_app *app, view_settings init, float speed) {
       sh->want = w;
       sh->gen++;
       if (sh->changed_at == 0.0) sh->changed_at = fr_seconds();
-      __atomic_store_n(&sh->cancel, 1, __ATOMIC_RELAXED);
+      __atomic_store_n(&sh->cancel, 1, __ATOMIC_RELAXED), view_renderer_cancel(&app->r, 1);
       pthread_cond_signal(&sh->wake);
       pthread_mutex_unlock(&sh->lock);
       if (app->record) view_camera_path_write(app->record, &w.cam);
@@ -255,7 +256,7 @@ static int run_interactive(view_app *app, view_settings init, float speed) {
   }
   pthread_mutex_lock(&sh->lock);
   sh->quit = 1;
-  __atomic_store_n(&sh->cancel, 1, __ATOMIC_RELAXED);
+  __atomic_store_n(&sh->cancel, 1, __ATOMIC_RELAXED), view_renderer_cancel(&app->r, 1);
   pthread_cond_signal(&sh->wake);
   pthread_mutex_unlock(&sh->lock);
   pthread_join(th, NULL);
@@ -343,7 +344,7 @@ static int run_frames(view_app *app, view_settings s, int frames, const view_cam
   }
   pthread_mutex_lock(&sh->lock);
   sh->quit = 1;
-  __atomic_store_n(&sh->cancel, 1, __ATOMIC_RELAXED); /* a frame asked for and no longer wanted */
+  __atomic_store_n(&sh->cancel, 1, __ATOMIC_RELAXED), view_renderer_cancel(&app->r, 1); /* a frame asked for and no longer wanted */
   pthread_cond_signal(&sh->wake);
   pthread_mutex_unlock(&sh->lock);
   pthread_join(th, NULL);
@@ -366,7 +367,7 @@ int cmd_view(int argc, char **argv) {
   const char *scene = a.pos[0];
   int threads = omp_get_num_procs(), shade = 0, set = 0, trace = 0, denoise = 1, temporal = 1, frames = 0;
   float turntable = 0.0f;
-  fr_softshadow_opts so = {16, 1, FR_LIGHT_SETS_CELLS};
+  int filter = 1;
   static const char *const sets[] = {"cells", "spread"};
   cli_view v;
   cli_whitted wo;
@@ -374,7 +375,7 @@ int cmd_view(int argc, char **argv) {
   if ((rc = cli_view_from_args(&a, &v)) || (rc = cli_whitted_from_args(&a, &wo)) || (rc = cli_path_from_args(&a, &po)) ||
       (rc = cli_common_from_args(&a, &threads)) ||
       (rc = cli_arg_choice(&a, F_SHADE, fr_shade_mode_names, FR_SM_COUNT, &shade)) ||
-      (rc = cli_arg_choice(&a, F_LIGHT_SETS, sets, 2, &set)) || (rc = cli_arg_onoff(&a, F_FILTER, &so.filter)) ||
+      (rc = cli_arg_choice(&a, F_LIGHT_SETS, sets, 2, &set)) || (rc = cli_arg_onoff(&a, F_FILTER, &filter)) ||
       (rc = cli_arg_choice(&a, F_MODE, view_trace_names, VIEW_TRACE_COUNT, &trace)) ||
       (rc = cli_arg_onoff(&a, F_DENOISE, &denoise)) || (rc = cli_arg_onoff(&a, F_TEMPORAL, &temporal)) ||
       (rc = cli_arg_int(&a, F_FRAMES, 1, 1000000, &frames)) ||
@@ -386,7 +387,6 @@ int cmd_view(int argc, char **argv) {
   if (!a.val[F_SAMPLER]) po.sampler = FR_SAMPLER_SOBOL;
   if (shade == FR_SM_AO && po.spp % 16)
     return cli_error(CLI_USAGE_ERROR, "ao: --spp wants a multiple of 16 (hemisphere rays per pixel), got '%s'", a.val[F_SPP]);
-  so.sets = set ? FR_LIGHT_SETS_SPREAD : FR_LIGHT_SETS_CELLS;
   const char *screenshot = a.val[F_SCREENSHOT];
   if (screenshot && !fr_image_format_known(screenshot))
     return cli_error(CLI_USAGE_ERROR, "%s: unknown image format (use .png, .exr or .pfm)", screenshot);
@@ -423,7 +423,11 @@ int cmd_view(int argc, char **argv) {
     rc = cli_error(1, "%s: cannot write the camera path", a.val[F_RECORD]);
     goto done;
   }
-  view_renderer_init(&app.r, s, &w, &po, &wo, so);
+  view_settings init = {{w.view.eye, w.view.at, w.view.up, w.view.fov}, v.width, v.height, (fr_shade_mode)shade,
+                        (view_trace)trace, denoise, temporal};
+  if ((rc = view_renderer_init(&app.r, s, &w.view, &po, &wo, filter, set ? FR_LIGHT_SETS_SPREAD : FR_LIGHT_SETS_CELLS,
+                               threads, &init)))
+    goto done;
   pthread_mutex_init(&app.sh.lock, NULL);
   pthread_cond_init(&app.sh.wake, NULL);
   pthread_cond_init(&app.sh.ready, NULL);
@@ -431,8 +435,6 @@ int cmd_view(int argc, char **argv) {
                              frames ? 0 : SDL_WINDOW_RESIZABLE);
   if (app.win) app.ren = SDL_CreateRenderer(app.win, -1, 0);
   if (!app.win || !app.ren) { rc = cli_error(1, "view: cannot open a window: %s", SDL_GetError()); goto done; }
-  view_settings init = {{w.view.eye, w.view.at, w.view.up, w.view.fov}, v.width, v.height, (fr_shade_mode)shade,
-                        (view_trace)trace, denoise, temporal};
   if (frames) rc = run_frames(&app, init, frames, path, npath, turntable, screenshot);
   else rc = run_interactive(&app, init, 0.25f * v3_len(v3_sub(s->bounds.hi, s->bounds.lo)));
 done:

@@ -1,15 +1,14 @@
 /* What the viewer draws: a scene in one shade mode, trace mode and camera,
- * rendered pass by pass (render/progressive.h), denoised where asked, and
- * turned into screen pixels. Called from one thread at a time. */
+ * rendered pass by pass by the public renderer (fr_renderer), denoised and
+ * blended where asked, and turned into screen pixels. Called from one
+ * thread at a time, but for view_renderer_cancel. */
 #ifndef FR_TOOL_VIEW_RENDERER_H
 #define FR_TOOL_VIEW_RENDERER_H
 #include <stdint.h>
+#include "api/renderer_tuning.h"
 #include "cli.h"
 #include "cli_path.h"
-#include "film/denoise.h"
-#include "film/temporal.h"
 #include "render/progressive.h"
-#include "render/whitted.h"
 #include "view_camera.h"
 
 typedef enum view_trace { VIEW_TRACE_MFT, VIEW_TRACE_AUTO, VIEW_TRACE_PACKET16, VIEW_TRACE_SINGLE, VIEW_TRACE_COUNT } view_trace;
@@ -28,33 +27,27 @@ typedef struct view_settings {
 
 typedef struct view_renderer {
   fr_scene *scene;
-  fr_workload base;        /* view, eps, threads, seed */
+  fr_render_desc base;     /* the flags' description; the settings give camera, size, shade and the rest */
+  int path_depth, whitted_depth;
   const cli_path *po;
-  const cli_whitted *wo;
-  fr_softshadow_opts so;
-  cli_path_run path_run;   /* set up on the first path frame */
-  int path_ready;
-  fr_whitted_mats wmats;   /* built on the first whitted frame */
-  int whitted_ready;
+  fr_renderer *fr;
   view_settings cur;
-  int have_cur;
-  fr_progressive prog;
-  int prog_ready;
-  fr_denoiser *dn;
-  fr_temporal *tp;
-  fr_mft_tracer mctx;
-  float *rgb, *albedo, *normal, *depth; /* the resolved (and denoised) image and its guides */
+  int path_told, whitted_told; /* their set-up lines printed */
+  float *rgb;              /* the resolved (denoised, blended) image */
   uint8_t *bgra;           /* the screen's pixels, 4 bytes each */
   uint8_t srgb[VIEW_SRGB_STEPS + 1]; /* made before any thread reads it */
   int buf_w, buf_h;
+  int shown;               /* rgb and bgra hold a frame */
   /* the last pass */
   uint64_t rays;
   double seconds, denoise_seconds;
 } view_renderer;
 
-/* base: scene, view, eps, threads and seed set (cli_workload_setup). */
-void view_renderer_init(view_renderer *r, fr_scene *s, const fr_workload *base, const cli_path *po, const cli_whitted *wo,
-                        fr_softshadow_opts so);
+/* A renderer of s with the flags' options (the lights of view, po, wo,
+ * the soft-shadow preview's filter and sets) in the settings first; 0, or
+ * the exit code after reporting. */
+int view_renderer_init(view_renderer *r, fr_scene *s, const fr_view *view, const cli_path *po, const cli_whitted *wo,
+                       int filter, fr_light_sets sets, int threads, const view_settings *first);
 void view_renderer_free(view_renderer *r);
 /* Makes the next pass render s: a new mode, trace mode or size starts
  * afresh, a new camera restarts the sums (and, with temporal set, the
@@ -63,12 +56,14 @@ void view_renderer_free(view_renderer *r);
 int view_renderer_apply(view_renderer *r, const view_settings *s);
 /* Whether another pass would change the image. */
 int view_renderer_done(const view_renderer *r);
+/* While cancel is 1 the pass under way stops and passes do nothing; from any thread. */
+void view_renderer_cancel(view_renderer *r, int cancel);
 /* One pass; 1 when the image changed (rgb and bgra hold it), 0 when it was
- * abandoned (*cancel set) or nothing was left to do. */
-int view_renderer_pass(view_renderer *r, const int *cancel);
+ * abandoned (cancelled) or nothing was left to do; -1 after reporting an error. */
+int view_renderer_pass(view_renderer *r);
 /* The share of the last frame's pixels blended with the one before (0..1). */
 float view_renderer_reused(const view_renderer *r);
-/* Samples per pixel of the image (render/progressive.h). */
+/* Samples per pixel of the image. */
 int view_renderer_spp(const view_renderer *r);
 /* Writes the image as `frusta render` would (PNG of a path image through
  * the filmic curve); and for path, the linear image as EXR beside a PNG.
