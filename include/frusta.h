@@ -401,6 +401,15 @@ typedef struct fr_render_desc {
 
 /* The defaults, as listed above. */
 void fr_render_desc_default(fr_render_desc *d);
+/* The description a scene file gives (docs/scenefile.md): the defaults,
+ * with what the file s was loaded from sets (camera, lens, size, shade,
+ * spp, max_depth, sampler, seed, lights and their brightness, which
+ * lights shine, the environment); the camera fields it leaves out are the
+ * scene's own view's. For a scene not loaded from a scene file, the
+ * defaults. The strings point into s. Errors: FR_ERR_ARG (NULL),
+ * FR_ERR_STATE (not committed: the scene's own view needs its bounds),
+ * FR_ERR_FORMAT (a shade or sampler the file names that frusta lacks). */
+fr_error fr_render_desc_of_scene(const fr_scene *s, fr_render_desc *d);
 
 typedef struct fr_renderer fr_renderer;
 

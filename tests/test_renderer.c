@@ -280,6 +280,16 @@ static void fields_out_of_range(void **state) {
   REFUSED(d.threads = -2);
   REFUSED(d.mirror = "no_such_material");
 #undef REFUSED
+  /* a scene not from a scene file describes the defaults */
+  fr_render_desc of, def;
+  fr_render_desc_default(&def);
+  assert_int_equal(fr_render_desc_of_scene(s, &of), FR_OK);
+  assert_memory_equal(&of, &def, sizeof of);
+  assert_int_equal(fr_render_desc_of_scene(NULL, &of), FR_ERR_ARG);
+  fr_scene *raw;
+  assert_int_equal(fr_scene_builtin_materials(&raw), FR_OK);
+  assert_int_equal(fr_render_desc_of_scene(raw, &of), FR_ERR_STATE);
+  fr_scene_release(raw);
   d = good;
   d.mirror = "lambert"; /* the showcase's Lambert sphere made chrome */
   assert_int_equal(fr_renderer_new(s, &d, &r), FR_OK);

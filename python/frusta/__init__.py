@@ -105,25 +105,28 @@ class Scene(_Scene):
             eps = 1e-5 * float(((hi - lo) ** 2).sum()) ** 0.5
         return self._occluded_point_light(points, light, eps)
 
-    def render(self, width, height, shade="eyelight", eye=None, at=None, up=None, fov=None, spp=16, light=None,
-               environment=None, exposure=0.0, denoise=False, display=True, max_depth=0, sampler="hammersley",
-               seed=1, aperture=0.0, focus=0.0, env_color=None, env_intensity=1.0, env_rotate=0.0):
-        """frusta's renderers, as `frusta render` draws: shade is eyelight,
-        normals, shadows, softshadow, whitted, ao or path. The view is the
-        scene's own unless eye and at are given (up defaults to +y, fov to 50
-        degrees vertical). spp: samples per pixel (multiples of 16 for ao
-        and softshadow). light: the point light of shadows and whitted.
-        Path tracing: environment, a lat-long .hdr or .exr sky (else
-        env_color, default white), scaled by env_intensity and turned by
-        env_rotate degrees; max_depth segments a path (0: 13; whitted's
-        depth, 0: 4); sampler "hammersley" or "sobol" with seed; a thin lens
-        of radius aperture focused at focus (0: at `at`). display=True gives
-        display values (path through the filmic curve at exposure stops),
-        else linear radiance; denoise=True denoises path, ao and softshadow.
-        Returns an Image."""
-        return Image(*self._render(width, height, shade, eye, at, up, 0.0 if fov is None else fov, spp, light,
-                                   environment, exposure, denoise, display, max_depth, sampler, seed, aperture,
-                                   focus, env_color, env_intensity, env_rotate))
+    def render(self, width=None, height=None, shade=None, eye=None, at=None, up=None, fov=None, spp=None,
+               light=None, environment=None, exposure=None, denoise=False, display=True, max_depth=None,
+               sampler=None, seed=None, aperture=None, focus=None, env_color=None, env_intensity=None,
+               env_rotate=None):
+        """frusta's renderers, as `frusta render` draws. What is not given
+        comes from the scene file the scene was loaded from, if any, else
+        the defaults: shade is eyelight, normals, shadows, softshadow,
+        whitted, ao or path (eyelight); the size (required unless the file
+        gives one); the scene's own view unless eye and at are given (up
+        +y, fov 50 degrees vertical); spp, samples per pixel (16; multiples
+        of 16 for ao and softshadow); light, the point light of shadows,
+        whitted and path. Path tracing: environment, a lat-long .hdr or
+        .exr sky (else env_color, white), scaled by env_intensity and
+        turned by env_rotate degrees; max_depth segments a path (13;
+        whitted's depth, 4); sampler "hammersley" or "sobol" with seed
+        (1); a thin lens of radius aperture focused at focus (at `at`).
+        display=True gives display values (path through the filmic curve
+        at exposure stops), else linear radiance; denoise=True denoises
+        path, ao and softshadow. Returns an Image."""
+        return Image(*self._render(width, height, shade, eye, at, up, fov, spp, light, environment, exposure,
+                                   denoise, display, max_depth, sampler, seed, aperture, focus, env_color,
+                                   env_intensity, env_rotate))
 
     def visibility_area_light(self, points, corner, e1, e2, samples=16, seed=1, eps=None):
         """The fraction of a quad light (corner + a e1 + b e2, a and b in

@@ -676,48 +676,92 @@ static PyObject *scene_visibility_area_light(SceneObject *s, PyObject *args, PyO
 
 static const char *shade_names[] = {"eyelight", "normals", "shadows", "softshadow", "whitted", "ao", "path"};
 
+/* A float keyword argument when given (not None). */
+static int float_arg(PyObject *o, const char *name, float *out) {
+  if (o == Py_None) return 1;
+  const double v = PyFloat_AsDouble(o);
+  if (v == -1.0 && PyErr_Occurred()) {
+    PyErr_Clear();
+    PyErr_Format(PyExc_TypeError, "render: %s wants a number", name);
+    return 0;
+  }
+  *out = (float)v;
+  return 1;
+}
+
+/* An int keyword argument when given (not None). */
+static int int_arg(PyObject *o, const char *name, long lo, long hi, long *out) {
+  if (o == Py_None) return 1;
+  const long v = PyLong_AsLong(o);
+  if (v == -1 && PyErr_Occurred()) {
+    PyErr_Clear();
+    PyErr_Format(PyExc_TypeError, "render: %s wants an integer", name);
+    return 0;
+  }
+  if (v < lo || v > hi) {
+    PyErr_Format(PyExc_ValueError, "render: %s %ld is not in %ld..%ld", name, v, lo, hi);
+    return 0;
+  }
+  *out = v;
+  return 1;
+}
+
 static PyObject *scene_render(SceneObject *s, PyObject *args, PyObject *kw) {
   static char *names[] = {"width", "height", "shade", "eye", "at", "up", "fov", "spp", "light", "environment",
                           "exposure", "denoise", "display", "max_depth", "sampler", "seed", "aperture", "focus",
                           "env_color", "env_intensity", "env_rotate", NULL};
-  fr_render_desc d;
-  fr_render_desc_default(&d);
-  int width, height, spp = d.spp, denoise = 0, display = 1, max_depth = 0;
-  unsigned seed = d.seed;
-  const char *shade = "eyelight", *sampler = "hammersley";
-  PyObject *eo = Py_None, *ao = Py_None, *uo = Py_None, *lo = Py_None, *envo = Py_None, *co = Py_None;
-  float fov = 0.0f, exposure = 0.0f, aperture = 0.0f, focus = 0.0f, env_intensity = 1.0f, env_rotate = 0.0f;
-  if (!PyArg_ParseTupleAndKeywords(args, kw, "ii|sOOOfiOOfppisIffOff", names, &width, &height, &shade, &eo, &ao, &uo,
-                                   &fov, &spp, &lo, &envo, &exposure, &denoise, &display, &max_depth, &sampler, &seed,
-                                   &aperture, &focus, &co, &env_intensity, &env_rotate))
+  PyObject *wo = Py_None, *ho = Py_None, *so = Py_None, *eo = Py_None, *ao = Py_None, *uo = Py_None, *fo = Py_None;
+  PyObject *sppo = Py_None, *lo = Py_None, *envo = Py_None, *expo = Py_None, *mdo = Py_None, *samo = Py_None;
+  PyObject *seedo = Py_None, *apo = Py_None, *foco = Py_None, *co = Py_None, *eio = Py_None, *ero = Py_None;
+  int denoise = 0, display = 1;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "|OOOOOOOOOOOppOOOOOOOO", names, &wo, &ho, &so, &eo, &ao, &uo, &fo, &sppo,
+                                   &lo, &envo, &expo, &denoise, &display, &mdo, &samo, &seedo, &apo, &foco, &co, &eio,
+                                   &ero))
     return NULL;
   if (!scene_open(s)) return NULL;
-  if (!strcmp(sampler, "hammersley")) d.sampler = FR_SAMPLER_HAMMERSLEY;
-  else if (!strcmp(sampler, "sobol")) d.sampler = FR_SAMPLER_SOBOL;
-  else return PyErr_Format(PyExc_ValueError, "render: sampler '%s' is neither hammersley nor sobol", sampler);
-  if (co != Py_None && !vec3_arg(co, "env_color", d.env_color)) return NULL;
-  d.max_depth = max_depth, d.seed = seed, d.aperture = aperture, d.focus = focus;
-  d.env_intensity = env_intensity, d.env_rotate = env_rotate;
-  d.camera.width = width, d.camera.height = height;
+  fr_render_desc d; /* the scene file's settings, then the arguments given */
+  fr_error e = fr_render_desc_of_scene(s->scene, &d);
+  if (e) return raise_fr(e, fr_last_error());
+  long width = d.camera.width, height = d.camera.height, spp = d.spp, max_depth = d.max_depth, seed = d.seed;
+  if (!int_arg(wo, "width", 1, 1 << 16, &width) || !int_arg(ho, "height", 1, 1 << 16, &height) ||
+      !int_arg(sppo, "spp", 1, 65536, &spp) || !int_arg(mdo, "max_depth", 0, 64, &max_depth) ||
+      !int_arg(seedo, "seed", 0, 0xFFFFFFFFl, &seed) || !float_arg(expo, "exposure", &d.exposure) ||
+      !float_arg(apo, "aperture", &d.aperture) || !float_arg(foco, "focus", &d.focus) ||
+      !float_arg(eio, "env_intensity", &d.env_intensity) || !float_arg(ero, "env_rotate", &d.env_rotate))
+    return NULL;
   if (width <= 0 || height <= 0 || (int64_t)width * height > ((int64_t)1 << 26))
-    return PyErr_Format(PyExc_ValueError, "render: image size %dx%d is empty or too large", width, height);
-  int m = -1;
-  for (int k = 0; k < 7; k++)
-    if (!strcmp(shade, shade_names[k])) m = k;
-  if (m < 0)
-    return PyErr_Format(PyExc_ValueError, "render: shade '%s' is none of eyelight, normals, shadows, softshadow, "
-                        "whitted, ao, path", shade);
-  d.shade = (fr_render_shade)m;
+    return PyErr_Format(PyExc_ValueError, "render: image size %ldx%ld is empty or too large (give width and height)",
+                        width, height);
+  const int W = (int)width, H = (int)height;
+  d.camera.width = W, d.camera.height = H;
+  d.spp = (int)spp, d.max_depth = (int)max_depth, d.seed = (uint32_t)seed;
+  if (so != Py_None) {
+    const char *shade = PyUnicode_Check(so) ? PyUnicode_AsUTF8(so) : NULL;
+    int m = -1;
+    for (int k = 0; shade && k < 7; k++)
+      if (!strcmp(shade, shade_names[k])) m = k;
+    if (m < 0)
+      return PyErr_Format(PyExc_ValueError, "render: shade %R is none of eyelight, normals, shadows, softshadow, "
+                          "whitted, ao, path", so);
+    d.shade = (fr_render_shade)m;
+  }
+  if (samo != Py_None) {
+    const char *sampler = PyUnicode_Check(samo) ? PyUnicode_AsUTF8(samo) : "";
+    if (sampler && !strcmp(sampler, "hammersley")) d.sampler = FR_SAMPLER_HAMMERSLEY;
+    else if (sampler && !strcmp(sampler, "sobol")) d.sampler = FR_SAMPLER_SOBOL;
+    else return PyErr_Format(PyExc_ValueError, "render: sampler %R is neither hammersley nor sobol", samo);
+  }
+  if (co != Py_None && !vec3_arg(co, "env_color", d.env_color)) return NULL;
   if ((eo != Py_None) != (ao != Py_None))
     return PyErr_Format(PyExc_ValueError, "render: give eye and at together (or neither: the scene's own view)");
   if (eo != Py_None) {
-    float upv[3] = {0.0f, 1.0f, 0.0f};
+    float upv[3] = {0.0f, 1.0f, 0.0f}, fov = 50.0f;
     if (!vec3_arg(eo, "eye", d.camera.eye) || !vec3_arg(ao, "at", d.camera.at) ||
-        (uo != Py_None && !vec3_arg(uo, "up", upv)))
+        (uo != Py_None && !vec3_arg(uo, "up", upv)) || !float_arg(fo, "fov", &fov))
       return NULL;
     memcpy(d.camera.up, upv, sizeof upv);
-    d.camera.fov_deg = fov > 0.0f ? fov : 50.0f;
-  } else if (uo != Py_None || fov != 0.0f) {
+    d.camera.fov_deg = fov;
+  } else if (uo != Py_None || fo != Py_None) {
     return PyErr_Format(PyExc_ValueError, "render: up and fov need eye and at");
   }
   if (lo != Py_None) {
@@ -729,8 +773,8 @@ static PyObject *scene_render(SceneObject *s, PyObject *args, PyObject *kw) {
     if (!PyUnicode_FSConverter(envo, &env)) return NULL;
     d.environment = PyBytes_AS_STRING(env);
   }
-  d.spp = spp, d.exposure = exposure, d.denoise = denoise, d.threads = n_threads;
-  npy_intp dims[3] = {height, width, 3}, dims1[2] = {height, width};
+  d.denoise = denoise, d.threads = n_threads;
+  npy_intp dims[3] = {H, W, 3}, dims1[2] = {H, W};
   PyArrayObject *img = (PyArrayObject *)PyArray_SimpleNew(3, dims, NPY_FLOAT32);
   PyArrayObject *alb = (PyArrayObject *)PyArray_SimpleNew(3, dims, NPY_FLOAT32);
   PyArrayObject *nrm = (PyArrayObject *)PyArray_SimpleNew(3, dims, NPY_FLOAT32);
@@ -739,7 +783,6 @@ static PyObject *scene_render(SceneObject *s, PyObject *args, PyObject *kw) {
   if (!img || !alb || !nrm || !dep) goto done;
   s->busy++;
   const fr_scene *sc = s->scene;
-  fr_error e;
   char msg[512] = "";
   int got_spp = 0;
   Py_BEGIN_ALLOW_THREADS

@@ -14,6 +14,7 @@
 #include "film/denoise.h"
 #include "film/temporal.h"
 #include "film/tonemap.h"
+#include "io/scene_file.h"
 #include "render/path_scene.h"
 #include "render/progressive.h"
 #include "renderer_tuning.h"
@@ -87,6 +88,51 @@ void fr_render_desc_default(fr_render_desc *d) {
   d->seed = 1;
   d->camera_frusta = 1;
   d->pass_spp = DEFAULT_PASS_SPP;
+}
+
+fr_error fr_render_desc_of_scene(const fr_scene *s, fr_render_desc *d) {
+  if (!s || !d) return fr_fail(FR_ERR_ARG, "fr_render_desc_of_scene: NULL scene or description");
+  if (!s->committed) return fr_fail(FR_ERR_STATE, "fr_render_desc_of_scene: the scene is not committed");
+  fr_render_desc_default(d);
+  const fr_scene_file *f = s->file;
+  if (!f) return FR_OK;
+  if (f->has_eye || f->has_at || f->has_up || f->has_fov) { /* the rest from the scene's own view */
+    fr_view v = fr_view_of(s->name, s->bounds);
+    if (f->has_eye) v.eye = f->eye;
+    if (f->has_at) v.at = f->at;
+    if (f->has_up) v.up = f->up;
+    if (f->has_fov) v.fov = f->fov;
+    v3_store(d->camera.eye, v.eye), v3_store(d->camera.at, v.at), v3_store(d->camera.up, v.up);
+    d->camera.fov_deg = v.fov;
+  }
+  if (f->has_aperture) d->aperture = f->aperture;
+  if (f->has_focus) d->focus = f->focus;
+  if (f->has_env_file) d->environment = f->env_file;
+  if (f->has_env_color) v3_store(d->env_color, f->env_color);
+  if (f->has_env_intensity) d->env_intensity = f->env_intensity;
+  if (f->has_env_rotate) d->env_rotate = f->env_rotate;
+  if (f->has_area) {
+    d->has_area = 1;
+    v3_store(d->area_corner, f->area[0]), v3_store(d->area_e1, f->area[1]), v3_store(d->area_e2, f->area[2]);
+  }
+  if (f->has_area_radiance) v3_store(d->area_radiance, f->area_radiance);
+  if (f->has_point) d->has_light = 1, v3_store(d->light, f->point);
+  if (f->has_point_intensity) v3_store(d->light_intensity, f->point_intensity);
+  if (f->has_lights) d->lights = FR_LIGHT_ENV | (f->has_area ? FR_LIGHT_AREA : 0u) | (f->has_point ? FR_LIGHT_POINT : 0u);
+  if (f->has_size) d->camera.width = f->width, d->camera.height = f->height;
+  if (f->has_spp) d->spp = f->spp;
+  if (f->has_max_depth) d->max_depth = f->max_depth;
+  if (f->has_seed) d->seed = (uint32_t)f->seed;
+  if (f->has_sampler && !fr_sampler_parse(f->sampler, &d->sampler))
+    return fr_fail(FR_ERR_FORMAT, "%s: render.sampler: '%s' is neither hammersley nor sobol", s->name, f->sampler);
+  if (f->has_shade) {
+    int m = -1;
+    for (int k = 0; k < FR_SM_COUNT; k++)
+      if (!strcmp(f->shade, fr_shade_mode_names[k])) m = k;
+    if (m < 0) return fr_fail(FR_ERR_FORMAT, "%s: render.shade: '%s' is no shade frusta knows", s->name, f->shade);
+    d->shade = (fr_render_shade)m;
+  }
+  return FR_OK;
 }
 
 void fr_renderer_tuning_default(fr_renderer_tuning *t) {

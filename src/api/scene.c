@@ -129,7 +129,7 @@ static fr_error append_mesh(fr_mesh *m, const fr_mesh *add, vec3 scale, vec3 mov
   return e;
 }
 
-fr_error fr_scene_load_json(const char *path, const char *root, fr_scene_file *desc, fr_scene **out) {
+fr_error fr_scene_load_json(const char *path, const char *root, fr_scene **out) {
   *out = NULL;
   fr_scene_file f;
   fr_error e = fr_scene_file_read(path, root, &f);
@@ -144,16 +144,12 @@ fr_error fr_scene_load_json(const char *path, const char *root, fr_scene_file *d
     fr_mesh_free(&m);
   }
   if (!e) e = fr_mesh_validate(&s->mesh, path);
+  if (!e && !(s->file = malloc(sizeof *s->file))) e = fr_fail(FR_ERR_NOMEM, "out of memory");
   if (e) { fr_scene_release(s); fr_scene_file_free(&f); return e; }
   scene_name(path, s->name, sizeof s->name);
-  if (f.nmaterials > 0) {
-    s->file_mats = malloc((size_t)f.nmaterials * sizeof *s->file_mats);
-    if (!s->file_mats) { fr_scene_release(s); fr_scene_file_free(&f); return fr_fail(FR_ERR_NOMEM, "out of memory"); }
-    memcpy(s->file_mats, f.materials, (size_t)f.nmaterials * sizeof *s->file_mats);
-    s->nfile_mats = f.nmaterials;
-  }
-  if (desc) *desc = f;
-  else fr_scene_file_free(&f);
+  free(f.meshes); /* in the scene now */
+  f.meshes = NULL, f.nmeshes = 0;
+  *s->file = f;
   *out = s;
   return FR_OK;
 }
@@ -161,7 +157,7 @@ fr_error fr_scene_load_json(const char *path, const char *root, fr_scene_file *d
 fr_error fr_scene_load(const char *path, fr_scene **out) {
   if (!out) return fr_fail(FR_ERR_ARG, "fr_scene_load: out is NULL");
   *out = NULL;
-  if (path && fr_has_suffix(path, ".json")) return fr_scene_load_json(path, NULL, NULL, out);
+  if (path && fr_has_suffix(path, ".json")) return fr_scene_load_json(path, NULL, out);
   fr_scene *s = scene_new();
   if (!s) return fr_fail(FR_ERR_NOMEM, "out of memory");
   fr_error e = fr_import(path, &s->mesh);
@@ -305,14 +301,13 @@ void fr_scene_release(fr_scene *s) {
   fr_bvhn_free(&s->bvh4);
   fr_bvhn_free(&s->bvh8);
   fr_plane_occluders_free(&s->planes);
-  free(s->file_mats);
+  if (s->file) fr_scene_file_free(s->file);
+  free(s->file);
   free(s);
 }
 
 const fr_bsdf *fr_scene_file_bsdf(const fr_scene *s, const char *name) {
-  for (int i = 0; s && name && i < s->nfile_mats; i++)
-    if (!strcmp(s->file_mats[i].name, name)) return &s->file_mats[i].bsdf;
-  return NULL;
+  return s && s->file && name ? fr_scene_file_find_material(s->file, name) : NULL;
 }
 
 /* The SAH tree over the non-degenerate triangles (n of them); sets s->bounds. */

@@ -24,8 +24,7 @@ struct fr_scene {
   aabb bounds;
   double build_seconds;
   char name[64];        /* scene name for views and reports */
-  struct fr_scene_file_material *file_mats; /* a scene file's path-tracer materials, by name */
-  int nfile_mats;
+  struct fr_scene_file *file; /* the scene file it was loaded from, meshes aside (NULL if none) */
 };
 
 /* How the scene's packets and streams are traced (base/tuning.h): for
@@ -60,11 +59,11 @@ fr_error fr_scene_build_bvh2(fr_scene *s, int max_leaf, fr_bvh2 *out);
  * scale of the triangles (multi-frusta tiles that fell back to rays). */
 void fr_occluded_raystream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n);
 /* A scene file's meshes (io/scene_file.h) as one scene, named after the
- * file; files it names stay under root (NULL: the file's folder). *desc
- * gets the rest of the file (camera, lights, materials, render settings)
- * when not NULL; the caller frees it with fr_scene_file_free. */
+ * file; files it names stay under root (NULL: the file's folder). The
+ * scene keeps the rest of the file (camera, lights, materials, render
+ * settings) in s->file. */
 struct fr_scene_file;
-fr_error fr_scene_load_json(const char *path, const char *root, struct fr_scene_file *desc, fr_scene **out);
+fr_error fr_scene_load_json(const char *path, const char *root, fr_scene **out);
 /* The path tracer's material called name in the scene file s was loaded
  * from, or NULL. */
 const struct fr_bsdf *fr_scene_file_bsdf(const fr_scene *s, const char *name);

@@ -582,6 +582,56 @@ def test_render_path_options_equal_the_command(tmp_path):
         frusta.Scene.builtin().render(8, 8, "path", max_depth=99)
 
 
+SCENE_OBJ = """mtllib box.mtl
+v -4 0 -4
+v 4 0 -4
+v 4 0 4
+v -4 0 4
+v 0 0.2 0
+v 1 0.2 0
+v 0 1.8 0
+v 0 0.2 1
+usemtl floor
+f 1 3 2
+f 1 4 3
+usemtl statue
+f 5 6 7
+f 5 7 8
+f 5 8 6
+f 6 8 7
+"""
+
+SCENE_JSON = """{
+  "meshes": [{"file": "box.obj"}],
+  "materials": {"statue": {"type": "metal", "preset": "gold", "roughness": 0.3}},
+  "camera": {"eye": [3, 2.5, 4], "at": [0, 0.6, 0], "fov": 40},
+  "environment": {"color": [0.4, 0.5, 0.7], "intensity": 1.5},
+  "lights": {"point": {"position": [2, 5, 2], "intensity": [40, 40, 40]}},
+  "render": {"shade": "path", "size": [40, 30], "spp": 3, "sampler": "sobol", "seed": 5, "max_depth": 6}
+}"""
+
+
+def test_render_a_scene_file_as_the_command(tmp_path):
+    command = os.environ.get("FRUSTA_BIN")
+    if not command or not os.path.exists(command):
+        pytest.skip("FRUSTA_BIN names no frusta command")
+    (tmp_path / "box.obj").write_text(SCENE_OBJ)
+    (tmp_path / "box.mtl").write_text("newmtl floor\nKd 0.7 0.7 0.7\nnewmtl statue\nKd 0.2 0.2 0.9\n")
+    (tmp_path / "scene.json").write_text(SCENE_JSON)
+    out = tmp_path / "c.pfm"
+    subprocess.run([command, "render", str(tmp_path / "scene.json"), "--out", str(out)], check=True,
+                   capture_output=True)
+    scene = frusta.Scene.load(str(tmp_path / "scene.json"))
+    got = scene.render(display=False)  # everything from the file: size, shade, camera, lights, materials
+    assert got.rgb.shape == (30, 40, 3) and got.spp == 3
+    np.testing.assert_array_equal(got.rgb, read_pfm(out))
+    plain = tmp_path / "plain.json"  # the same without the gold: the MTL's blue Lambert
+    plain.write_text(SCENE_JSON.replace('"materials": {"statue": {"type": "metal", "preset": "gold", "roughness": 0.3}},', ""))
+    assert not np.array_equal(frusta.Scene.load(str(plain)).render(display=False).rgb, got.rgb)
+    quick = scene.render(spp=1, shade="eyelight")  # arguments win over the file
+    assert quick.spp == 1 and quick.rgb.shape == (30, 40, 3)
+
+
 def test_save_image(tmp_path):
     rgb = np.random.default_rng(3).random((12, 20, 3)).astype(np.float32)
     for ext in ("png", "exr", "pfm"):
@@ -622,7 +672,9 @@ def test_render_options_and_errors():
         scene.render(8, 8, "ao", spp=20)
     with pytest.raises(ValueError, match="eye and at"):
         scene.render(8, 8, eye=(0, 0, 1))
-    with pytest.raises(ValueError, match="empty"):
+    with pytest.raises(ValueError, match="width 0"):
         scene.render(0, 8)
+    with pytest.raises(ValueError, match="size"):
+        scene.render(shade="eyelight")  # no size: the built-in scene has no scene file to give one
     with pytest.raises(OSError):
         scene.render(8, 8, "path", environment="/nonexistent/sky.hdr")

@@ -140,7 +140,7 @@ int cli_load_scene_smooth(const char *arg, float smooth, fr_scene **s) {
   else if (strcmp(arg, "--builtin=materials") == 0) e = fr_scene_builtin_materials(s);
   else if (cli_is_builtin(arg))
     return cli_error(CLI_USAGE_ERROR, "unknown built-in scene '%s' (default, sphereflake or materials)", arg + 10);
-  else if (fr_has_suffix(arg, ".json")) e = fr_scene_load_json(arg, cli_scene_root(), NULL, s);
+  else if (fr_has_suffix(arg, ".json")) e = fr_scene_load_json(arg, cli_scene_root(), s);
   else e = fr_scene_load(arg, s);
   if (e) return cli_error(1, "%s", fr_last_error());
   if (smooth > 0.0f) e = fr_scene_smooth(*s, smooth);
