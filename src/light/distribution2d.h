@@ -28,6 +28,11 @@ void fr_dist2d_free(fr_dist2d *d);
 /* A point (u, v) in [0, 1)^2 from u1 (column) and u2 (row), and its cell
  * in *x, *y. */
 void fr_dist2d_sample(const fr_dist2d *d, float u1, float u2, float *u, float *v, int *x, int *y);
+/* n points as fr_dist2d_sample makes each (the same bits), their table
+ * lookups overlapped: each stage's memory accesses for all n are begun
+ * before the next stage reads them. */
+void fr_dist2d_sample_batch(const fr_dist2d *d, size_t n, const float *u1, const float *u2, float *u, float *v, int *x,
+                            int *y);
 /* The density over the unit square in cell (x, y), w h weight / total. */
 float fr_dist2d_pdf(const fr_dist2d *d, int x, int y);
 #endif

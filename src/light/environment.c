@@ -96,6 +96,20 @@ vec3 fr_env_eval(const fr_env *e, vec3 dir) {
   return v3_scale(v3_load(texel(e, u, v)), e->intensity);
 }
 
+/* The light sample at image point (u, v) in texel (x, y). */
+static vec3 sample_at(const fr_env *e, float u, float v, int x, int y, vec3 *dir, float *pdf) {
+  const float *t = e->texels + 4 * ((size_t)y * e->w + x), puv = t[3];
+  /* theta = pi v, phi = 2 pi u + rotate: both in turns */
+  float st, ct, sp, cp, turns = u + e->rotate;
+  fr_sincos_turns(0.5f * v, &st, &ct);
+  fr_sincos_turns(turns < 1.0f ? turns : turns - 1.0f, &sp, &cp);
+  if (!(puv > 0.0f) || !(st > 0.0f)) { *pdf = 0.0f; return v3(0, 0, 0); }
+  const vec3 l = v3(st * cp, st * sp, ct);
+  *dir = v3_add(v3_add(v3_scale(e->ax, l.x), v3_scale(e->ay, l.y)), v3_scale(e->az, l.z));
+  *pdf = puv / (2.0f * PI_F * PI_F * st);
+  return v3_scale(v3_load(t), e->intensity);
+}
+
 vec3 fr_env_sample(const fr_env *e, float u1, float u2, vec3 *dir, float *pdf) {
   if (e->black) { *pdf = 0.0f; return v3(0, 0, 0); }
   if (!e->rgb) { /* uniform over the sphere */
@@ -109,16 +123,26 @@ vec3 fr_env_sample(const fr_env *e, float u1, float u2, vec3 *dir, float *pdf) {
   float u, v;
   int x, y;
   fr_dist2d_sample(&e->dist, u1, u2, &u, &v, &x, &y);
-  const float *t = e->texels + 4 * ((size_t)y * e->w + x), puv = t[3];
-  /* theta = pi v, phi = 2 pi u + rotate: both in turns */
-  float st, ct, sp, cp, turns = u + e->rotate;
-  fr_sincos_turns(0.5f * v, &st, &ct);
-  fr_sincos_turns(turns < 1.0f ? turns : turns - 1.0f, &sp, &cp);
-  if (!(puv > 0.0f) || !(st > 0.0f)) { *pdf = 0.0f; return v3(0, 0, 0); }
-  const vec3 l = v3(st * cp, st * sp, ct);
-  *dir = v3_add(v3_add(v3_scale(e->ax, l.x), v3_scale(e->ay, l.y)), v3_scale(e->az, l.z));
-  *pdf = puv / (2.0f * PI_F * PI_F * st);
-  return v3_scale(v3_load(t), e->intensity);
+  return sample_at(e, u, v, x, y, dir, pdf);
+}
+
+void fr_env_sample_batch(const fr_env *e, size_t n, const float *u1, const float *u2, vec3 *dir, vec3 *le, float *pdf) {
+  enum { CHUNK = 64 };
+  for (size_t a = 0; a < n; a += CHUNK) {
+    const size_t m = n - a < CHUNK ? n - a : CHUNK;
+    if (e->black || !e->rgb) {
+      for (size_t j = a; j < a + m; j++) le[j] = fr_env_sample(e, u1[j], u2[j], dir + j, pdf + j);
+      continue;
+    }
+    float u[CHUNK], v[CHUNK];
+    int x[CHUNK], y[CHUNK];
+    fr_dist2d_sample_batch(&e->dist, m, u1 + a, u2 + a, u, v, x, y);
+    for (size_t j = 0; j < m; j++) {
+      __builtin_prefetch(e->texels + 4 * ((size_t)y[j] * e->w + x[j]));
+      dir[a + j] = v3(0, 0, 0); /* where the sample is void */
+    }
+    for (size_t j = 0; j < m; j++) le[a + j] = sample_at(e, u[j], v[j], x[j], y[j], dir + a + j, pdf + a + j);
+  }
 }
 
 float fr_env_pdf(const fr_env *e, vec3 dir) {

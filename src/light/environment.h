@@ -40,6 +40,10 @@ vec3 fr_env_eval(const fr_env *e, vec3 dir);
 /* A direction toward the sky with its solid-angle pdf, and the radiance from
  * it; pdf 0 when the environment is black. */
 vec3 fr_env_sample(const fr_env *e, float u1, float u2, vec3 *dir, float *pdf);
+/* n samples as fr_env_sample makes each (the same bits), radiance in
+ * le[i]: for a batch of paths, whose table and texel lookups then overlap
+ * rather than wait one after another. */
+void fr_env_sample_batch(const fr_env *e, size_t n, const float *u1, const float *u2, vec3 *dir, vec3 *le, float *pdf);
 float fr_env_pdf(const fr_env *e, vec3 dir);
 /* The same, interpolated bilinearly between texels: for the background
  * seen straight from the camera, where the map's texels would show. */

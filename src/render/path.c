@@ -104,19 +104,35 @@ static float area_pdf(const quad_light *q, vec3 d, float dist) {
   return c > 0.0f ? dist * dist / c : 0.0f;
 }
 
+/* The light uc picks of n (environment, area, point: those there are). */
+static int light_pick(int n, float uc) {
+  const int k = (int)(uc * (float)n);
+  return k >= n ? n - 1 : k;
+}
+
+/* The environment's light samples of a block of paths, made together
+ * (fr_env_sample_batch) before the block is shaded: for the paths that
+ * hit something and pick the environment. ready[b]: path b's is here. */
+typedef struct env_block {
+  vec3 dir[POINT_BLOCK], le[POINT_BLOCK];
+  float pdf[POINT_BLOCK];
+  uint8_t ready[POINT_BLOCK];
+} env_block;
+
 /* One light sample from p: direction, distance (INFINITY for the
  * environment), radiance arriving, solid-angle pdf including the choice
- * of light, and whether it is a delta light. 0 when none. */
-static int sample_light(const fr_path_lights *L, const quad_light *q, vec3 p, float uc, float u1, float u2, vec3 *wi,
-                        float *dist, vec3 *le, float *pdf, int *delta) {
+ * of light, and whether it is a delta light; the environment's from eb
+ * where it is ready there (eb may be NULL). 0 when none. */
+static int sample_light(const fr_path_lights *L, const quad_light *q, const env_block *eb, size_t b, vec3 p, float uc,
+                        float u1, float u2, vec3 *wi, float *dist, vec3 *le, float *pdf, int *delta) {
   const int n = light_count(L);
   if (!n) return 0;
-  int k = (int)(uc * (float)n);
-  if (k >= n) k = n - 1;
+  int k = light_pick(n, uc);
   *delta = 0;
   if (!L->env->black && k-- == 0) {
     float pe;
-    *le = fr_env_sample(L->env, u1, u2, wi, &pe);
+    if (eb && eb->ready[b]) *wi = eb->dir[b], *le = eb->le[b], pe = eb->pdf[b];
+    else *le = fr_env_sample(L->env, u1, u2, wi, &pe);
     *dist = INFINITY;
     *pdf = pe / (float)n;
     return pe > 0.0f;
@@ -174,6 +190,34 @@ static inline void path_point(const fr_path_setup *P, const float (*pts)[POINT_B
   else fr_sample2d(P->sampler, st->key, st->sample, (uint32_t)P->spp, d + (uint32_t)q, u1, u2);
 }
 
+/* eb for the next POINT_BLOCK paths of st[0..left) and their hits (dimension
+ * pairs dim: 0 picks the light, 1 places the sample on it). */
+static void env_block_sample(const fr_path_setup *P, const float (*pts)[POINT_BLOCK], const path_state *st,
+                             const fr_hit *hit, size_t left, uint32_t dim, env_block *eb) {
+  const size_t m = left < POINT_BLOCK ? left : POINT_BLOCK;
+  memset(eb->ready, 0, sizeof eb->ready);
+  const fr_env *e = P->lights.env;
+  const int n = light_count(&P->lights);
+  if (e->black || !e->rgb) return; /* nothing to fetch */
+  float u1[POINT_BLOCK], u2[POINT_BLOCK], pdf[POINT_BLOCK];
+  vec3 dir[POINT_BLOCK], le[POINT_BLOCK];
+  uint8_t idx[POINT_BLOCK];
+  size_t c = 0;
+  for (size_t j = 0; j < m; j++) {
+    if (hit[j].prim == FR_INVALID_ID) continue;
+    float uc, ul;
+    path_point(P, pts, j, st + j, dim, 0, &uc, &ul);
+    if (light_pick(n, uc) != 0) continue; /* the environment is light 0 */
+    path_point(P, pts, j, st + j, dim, 1, &u1[c], &u2[c]);
+    idx[c++] = (uint8_t)j;
+  }
+  fr_env_sample_batch(e, c, u1, u2, dir, le, pdf);
+  for (size_t q = 0; q < c; q++) {
+    const size_t j = idx[q];
+    eb->dir[j] = dir[q], eb->le[j] = le[q], eb->pdf[j] = pdf[q], eb->ready[j] = 1;
+  }
+}
+
 /* Pixel i of a tile of the given side, in blocks of 4x4 (consecutive 16
  * are coherent). */
 static void tile_pixel(int i, int side, int *x, int *y) {
@@ -200,6 +244,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
   const vec3 ru = v3_norm(c->right), uu = v3_norm(c->up);
   const int side = fr_path_tile_side(P), npix = side * side, chunk = WAVE / npix;
   float block[8][POINT_BLOCK];
+  env_block eb;
   const int batches = fr_sampler_batches(P->sampler, (uint32_t)P->spp);
   const float(*pts)[POINT_BLOCK] = batches ? (const float(*)[POINT_BLOCK])block : NULL;
   for (int s0 = P->spp_begin; s0 < P->spp_end; s0 += chunk) {
@@ -256,6 +301,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
       for (size_t k = 0; k < n; k++) {
         const size_t b = k % POINT_BLOCK;
         if (pts && !b) block_points(P, S->st + k, n - k, dim, 4, block);
+        if (!b && nlights) env_block_sample(P, pts, S->st + k, S->hit + k, n - k, dim, &eb);
         if (k + PREFETCH_AHEAD < n) {
           const uint32_t ahead = S->hit[k + PREFETCH_AHEAD].prim;
           if (ahead < P->nsurf) {
@@ -342,7 +388,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
           vec3 wi, le;
           float dist, pl;
           int delta;
-          if (sample_light(L, &quad, p, uc, u1, u2, &wi, &dist, &le, &pl, &delta) && same_side(wi, n, ngo)) {
+          if (sample_light(L, &quad, &eb, b, p, uc, u1, u2, &wi, &dist, &le, &pl, &delta) && same_side(wi, n, ngo)) {
             float pb;
             const vec3 f = fr_bsdf_eval(m, &sp, wo, to_local(wi, tb, bb, n), &pb);
             if (nonzero(f) && nonzero(le)) {
