@@ -395,7 +395,7 @@ typedef struct fr_render_desc {
                              new view into the new one while it has few passes (SVGF's reprojection) [0] */
   int camera_frusta;      /* 1: camera rays, hard and soft shadows as multi-frusta where the scene has
                              no spheres; 0: every ray as the scene's trace mode [1] */
-  int pass_spp;           /* path: samples per pixel one pass adds, 1..spp [8]; 1 suits an
+  int pass_spp;           /* path: samples per pixel one pass adds, at least 1 [8]; 1 suits an
                              interactive frame. Any split sums to the same image. */
 } fr_render_desc;
 
@@ -423,7 +423,7 @@ typedef struct fr_renderer fr_renderer;
 fr_error fr_renderer_new(const fr_scene *s, const fr_render_desc *d, fr_renderer **out);
 void fr_renderer_release(fr_renderer *r);
 /* Renders as d says from now on, keeping what it can: a new exposure,
- * denoise, temporal or threads keeps the passes summed; a new camera of
+ * denoise, temporal, threads or pass_spp keeps the passes summed; a new camera of
  * the same size starts the passes again (as fr_renderer_set_camera); any
  * other change starts afresh, reusing the environment and materials where
  * their fields are unchanged. On an error the renderer is as before. The

@@ -344,8 +344,8 @@ static fr_error rebuild(fr_renderer *r, const fr_render_desc *d) {
     if (e) free(mats), mats = NULL;
     if (!e) e = owned_set(&mats_from, d);
   }
-  w.path = mode != FR_SM_PATH ? NULL : path ? &path->setup : &r->path->setup;
-  w.mats = mode != FR_SM_WHITTED ? NULL : mats ? mats : r->mats;
+  if (mode == FR_SM_PATH && !e) w.path = path ? &path->setup : &r->path->setup;
+  if (mode == FR_SM_WHITTED && !e) w.mats = mats ? mats : r->mats;
   fr_progressive p;
   memset(&p, 0, sizeof p);
   if (!e) e = fr_progressive_init(&p, &w, mode);

@@ -163,6 +163,13 @@ vec3 fr_env_eval_pdf(const fr_env *e, vec3 dir, float *pdf) {
   return v3_scale(v3_load(t), e->intensity);
 }
 
+void fr_env_prefetch(const fr_env *e, vec3 dir) {
+  if (!e->texels) return;
+  float u, v, s;
+  to_uv(e, dir, &u, &v, &s);
+  __builtin_prefetch(texel(e, u, v));
+}
+
 vec3 fr_env_eval_smooth(const fr_env *e, vec3 dir) {
   if (!e->rgb) return v3_scale(e->color, e->intensity);
   float u, v, s;

@@ -193,7 +193,7 @@ static inline void path_point(const fr_path_setup *P, const float (*pts)[POINT_B
 /* eb for the next POINT_BLOCK paths of st[0..left) and their hits (dimension
  * pairs dim: 0 picks the light, 1 places the sample on it). */
 static void env_block_sample(const fr_path_setup *P, const float (*pts)[POINT_BLOCK], const path_state *st,
-                             const fr_hit *hit, size_t left, uint32_t dim, env_block *eb) {
+                             const fr_ray *ray, const fr_hit *hit, size_t left, uint32_t dim, env_block *eb) {
   const size_t m = left < POINT_BLOCK ? left : POINT_BLOCK;
   memset(eb->ready, 0, sizeof eb->ready);
   const fr_env *e = P->lights.env;
@@ -204,7 +204,10 @@ static void env_block_sample(const fr_path_setup *P, const float (*pts)[POINT_BL
   uint8_t idx[POINT_BLOCK];
   size_t c = 0;
   for (size_t j = 0; j < m; j++) {
-    if (hit[j].prim == FR_INVALID_ID) continue;
+    if (hit[j].prim == FR_INVALID_ID) { /* the sky: its texel too, for the MIS weight of a bounce */
+      if (st[j].depth > 0) fr_env_prefetch(e, v3_load(ray[j].dir));
+      continue;
+    }
     float uc, ul;
     path_point(P, pts, j, st + j, dim, 0, &uc, &ul);
     if (light_pick(n, uc) != 0) continue; /* the environment is light 0 */
@@ -301,7 +304,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
       for (size_t k = 0; k < n; k++) {
         const size_t b = k % POINT_BLOCK;
         if (pts && !b) block_points(P, S->st + k, n - k, dim, 4, block);
-        if (!b && nlights) env_block_sample(P, pts, S->st + k, S->hit + k, n - k, dim, &eb);
+        if (!b && nlights) env_block_sample(P, pts, S->st + k, S->ray + k, S->hit + k, n - k, dim, &eb);
         if (k + PREFETCH_AHEAD < n) {
           const uint32_t ahead = S->hit[k + PREFETCH_AHEAD].prim;
           if (ahead < P->nsurf) {
