@@ -151,23 +151,25 @@ float fr_env_pdf(const fr_env *e, vec3 dir) {
   return pdf;
 }
 
+const float *fr_env_texel(const fr_env *e, vec3 dir, float *sin_t) {
+  float u, v;
+  to_uv(e, dir, &u, &v, sin_t);
+  return texel(e, u, v);
+}
+
+vec3 fr_env_texel_radiance(const fr_env *e, const float *t, float sin_t, float *pdf) {
+  if (pdf) *pdf = !(sin_t > 0.0f) ? 0.0f : t[3] / (2.0f * PI_F * PI_F * sin_t); /* 0 where black */
+  return v3_scale(v3_load(t), e->intensity);
+}
+
 vec3 fr_env_eval_pdf(const fr_env *e, vec3 dir, float *pdf) {
   if (!e->rgb) {
     *pdf = e->black ? 0.0f : 1.0f / (4.0f * PI_F);
     return v3_scale(e->color, e->intensity);
   }
-  float u, v, s;
-  to_uv(e, dir, &u, &v, &s);
-  const float *t = texel(e, u, v);
-  *pdf = !(s > 0.0f) ? 0.0f : t[3] / (2.0f * PI_F * PI_F * s); /* 0 where black */
-  return v3_scale(v3_load(t), e->intensity);
-}
-
-void fr_env_prefetch(const fr_env *e, vec3 dir) {
-  if (!e->texels) return;
-  float u, v, s;
-  to_uv(e, dir, &u, &v, &s);
-  __builtin_prefetch(texel(e, u, v));
+  float s;
+  const float *t = fr_env_texel(e, dir, &s);
+  return fr_env_texel_radiance(e, t, s, pdf);
 }
 
 vec3 fr_env_eval_smooth(const fr_env *e, vec3 dir) {

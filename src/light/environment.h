@@ -45,8 +45,12 @@ vec3 fr_env_sample(const fr_env *e, float u1, float u2, vec3 *dir, float *pdf);
  * rather than wait one after another. */
 void fr_env_sample_batch(const fr_env *e, size_t n, const float *u1, const float *u2, vec3 *dir, vec3 *le, float *pdf);
 float fr_env_pdf(const fr_env *e, vec3 dir);
-/* Begins fetching the texel fr_env_eval_pdf(e, dir) reads. */
-void fr_env_prefetch(const fr_env *e, vec3 dir);
+/* An image environment's texel that fr_env_eval and fr_env_eval_pdf read
+ * for dir, and sin theta there; then its radiance, and the pdf of dir when
+ * pdf is not NULL: fr_env_eval_pdf in two steps, for a caller that fetches
+ * the texels of many directions before it reads them. */
+const float *fr_env_texel(const fr_env *e, vec3 dir, float *sin_t);
+vec3 fr_env_texel_radiance(const fr_env *e, const float *texel, float sin_t, float *pdf);
 /* The same, interpolated bilinearly between texels: for the background
  * seen straight from the camera, where the map's texels would show. */
 vec3 fr_env_eval_smooth(const fr_env *e, vec3 dir);

@@ -110,13 +110,17 @@ static int light_pick(int n, float uc) {
   return k >= n ? n - 1 : k;
 }
 
-/* The environment's light samples of a block of paths, made together
- * (fr_env_sample_batch) before the block is shaded: for the paths that
- * hit something and pick the environment. ready[b]: path b's is here. */
+/* What a block of paths reads of an image environment, fetched together
+ * before the block is shaded: the light samples of the paths that hit
+ * something and pick the environment (fr_env_sample_batch; ready[b]: path
+ * b's is here), and the texels the bounces that escape see (sky[b], NULL
+ * where none, with sin theta there). */
 typedef struct env_block {
   vec3 dir[POINT_BLOCK], le[POINT_BLOCK];
   float pdf[POINT_BLOCK];
   uint8_t ready[POINT_BLOCK];
+  const float *sky[POINT_BLOCK];
+  float sky_sin[POINT_BLOCK];
 } env_block;
 
 /* One light sample from p: direction, distance (INFINITY for the
@@ -196,6 +200,7 @@ static void env_block_sample(const fr_path_setup *P, const float (*pts)[POINT_BL
                              const fr_ray *ray, const fr_hit *hit, size_t left, uint32_t dim, env_block *eb) {
   const size_t m = left < POINT_BLOCK ? left : POINT_BLOCK;
   memset(eb->ready, 0, sizeof eb->ready);
+  memset(eb->sky, 0, sizeof eb->sky);
   const fr_env *e = P->lights.env;
   const int n = light_count(&P->lights);
   if (e->black || !e->rgb) return; /* nothing to fetch */
@@ -204,8 +209,11 @@ static void env_block_sample(const fr_path_setup *P, const float (*pts)[POINT_BL
   uint8_t idx[POINT_BLOCK];
   size_t c = 0;
   for (size_t j = 0; j < m; j++) {
-    if (hit[j].prim == FR_INVALID_ID) { /* the sky: its texel too, for the MIS weight of a bounce */
-      if (st[j].depth > 0) fr_env_prefetch(e, v3_load(ray[j].dir));
+    if (hit[j].prim == FR_INVALID_ID) { /* a bounce into the sky (the camera's see it filtered) */
+      if (st[j].depth > 0) {
+        eb->sky[j] = fr_env_texel(e, v3_load(ray[j].dir), &eb->sky_sin[j]);
+        __builtin_prefetch(eb->sky[j]);
+      }
       continue;
     }
     float uc, ul;
@@ -304,7 +312,7 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
       for (size_t k = 0; k < n; k++) {
         const size_t b = k % POINT_BLOCK;
         if (pts && !b) block_points(P, S->st + k, n - k, dim, 4, block);
-        if (!b && nlights) env_block_sample(P, pts, S->st + k, S->ray + k, S->hit + k, n - k, dim, &eb);
+        if (!b) env_block_sample(P, pts, S->st + k, S->ray + k, S->hit + k, n - k, dim, &eb);
         if (k + PREFETCH_AHEAD < n) {
           const uint32_t ahead = S->hit[k + PREFETCH_AHEAD].prim;
           if (ahead < P->nsurf) {
@@ -330,8 +338,10 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         }
         if (!hit) {
           float pe = 0.0f;
-          const vec3 le = depth == 0 ? fr_env_eval_smooth(L->env, d) /* the background, seen */
-                          : st.delta ? fr_env_eval(L->env, d) : fr_env_eval_pdf(L->env, d, &pe);
+          const vec3 le = depth == 0  ? fr_env_eval_smooth(L->env, d) /* the background, seen */
+                          : eb.sky[b] ? fr_env_texel_radiance(L->env, eb.sky[b], eb.sky_sin[b], st.delta ? NULL : &pe)
+                          : st.delta  ? fr_env_eval(L->env, d)
+                                      : fr_env_eval_pdf(L->env, d, &pe);
           const float w_mis = st.delta ? 1.0f : power_heuristic(st.pdf, pe / (float)nlights);
           S->acc[st.slot] = v3_add(S->acc[st.slot], v3_scale(v3_mul(st.weight, le), w_mis));
           continue;
