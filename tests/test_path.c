@@ -157,6 +157,26 @@ static void environment_sampling(void **st) {
   print_message("environment: exact %.4f\n", exact);
   assert_true(fabs(imp - exact) < 4.0 * se_imp + 1e-4 * exact);
   assert_true(se_imp < se_uni); /* and it pays */
+  /* the batched samples and the two-step lookups are the one-at-a-time bits */
+  enum { B = 200 };
+  float u1[B], u2[B], pdf[B];
+  vec3 dir[B], le[B];
+  for (int k = 0; k < B; k++) u1[k] = fr_rng_float(&r), u2[k] = k % 7 ? fr_rng_float(&r) : 0.9999999f;
+  fr_env_sample_batch(&env, B, u1, u2, dir, le, pdf);
+  for (int k = 0; k < B; k++) {
+    vec3 d1 = v3(0, 0, 0);
+    float p1;
+    const vec3 l1 = fr_env_sample(&env, u1[k], u2[k], &d1, &p1);
+    assert_memory_equal(&l1, &le[k], sizeof l1);
+    assert_memory_equal(&p1, &pdf[k], sizeof p1);
+    if (p1 > 0.0f) assert_memory_equal(&d1, &dir[k], sizeof d1);
+    float pe, s, pt;
+    const vec3 a = fr_env_eval_pdf(&env, dir[k], &pe);
+    const float *t = fr_env_texel(&env, dir[k], &s);
+    const vec3 b = fr_env_texel_radiance(&env, t, s, &pt);
+    assert_memory_equal(&a, &b, sizeof a);
+    assert_memory_equal(&pe, &pt, sizeof pe);
+  }
   fr_env_free(&env);
 }
 

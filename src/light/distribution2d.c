@@ -56,14 +56,14 @@ void fr_dist2d_free(fr_dist2d *d) {
   memset(d, 0, sizeof *d);
 }
 
-/* The i with cdf[i] <= u < cdf[i + 1] among n intervals (never an empty
- * one), from its guide: a walk of a step or two. */
 /* The guide slot of u among n intervals. */
 static int guide_slot(int n, float u) {
   const int k = (int)(u * (float)n);
   return k >= n ? n - 1 : k < 0 ? 0 : k;
 }
 
+/* The i with cdf[i] <= u < cdf[i + 1] among n intervals (never an empty
+ * one), from its guide: a walk of a step or two. */
 static int find(const float *cdf, const uint32_t *guide, int n, float u) {
   int i = (int)guide[guide_slot(n, u)];
   while (i < n - 1 && cdf[i + 1] <= u) i++;
