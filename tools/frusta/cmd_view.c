@@ -68,6 +68,13 @@ typedef struct view_app {
   FILE *record;
 } view_app;
 
+/* Abandons the pass under way (on: 1) or lets passes run (0): the flag the
+ * worker reads and the renderer's own. */
+static void set_cancel(view_app *app, int on) {
+  __atomic_store_n(&app->sh.cancel, on, __ATOMIC_RELAXED);
+  view_renderer_cancel(&app->r, on);
+}
+
 static void *worker(void *arg) {
   view_app *app = arg;
   view_shared *sh = &app->sh;
@@ -91,8 +98,7 @@ static void *worker(void *arg) {
     const unsigned gen = sh->gen;
     char step_shot[sizeof sh->step_shot];
     memcpy(step_shot, sh->step_shot, sizeof step_shot);
-    __atomic_store_n(&sh->cancel, 0, __ATOMIC_RELAXED);
-    view_renderer_cancel(&app->r, 0);
+    set_cancel(app, 0);
     pthread_mutex_unlock(&sh->lock);
     int rc = 0, fresh = 0;
     if (!have || applied != gen) {
@@ -238,7 +244,7 @@ static int run_interactive(view_app *app, view_settings init, float speed) {
       sh->want = w;
       sh->gen++;
       if (sh->changed_at == 0.0) sh->changed_at = fr_seconds();
-      __atomic_store_n(&sh->cancel, 1, __ATOMIC_RELAXED), view_renderer_cancel(&app->r, 1);
+      set_cancel(app, 1);
       pthread_cond_signal(&sh->wake);
       pthread_mutex_unlock(&sh->lock);
       if (app->record) view_camera_path_write(app->record, &w.cam);
@@ -256,7 +262,7 @@ static int run_interactive(view_app *app, view_settings init, float speed) {
   }
   pthread_mutex_lock(&sh->lock);
   sh->quit = 1;
-  __atomic_store_n(&sh->cancel, 1, __ATOMIC_RELAXED), view_renderer_cancel(&app->r, 1);
+  set_cancel(app, 1);
   pthread_cond_signal(&sh->wake);
   pthread_mutex_unlock(&sh->lock);
   pthread_join(th, NULL);
@@ -344,7 +350,7 @@ static int run_frames(view_app *app, view_settings s, int frames, const view_cam
   }
   pthread_mutex_lock(&sh->lock);
   sh->quit = 1;
-  __atomic_store_n(&sh->cancel, 1, __ATOMIC_RELAXED), view_renderer_cancel(&app->r, 1); /* a frame asked for and no longer wanted */
+  set_cancel(app, 1); /* a frame asked for and no longer wanted */
   pthread_cond_signal(&sh->wake);
   pthread_mutex_unlock(&sh->lock);
   pthread_join(th, NULL);
