@@ -235,10 +235,11 @@ static int same_image(const fr_render_desc *a, const fr_render_desc *b) {
 
 static int threads_of(const fr_render_desc *d) { return d->threads ? d->threads : omp_get_num_procs(); }
 static int is_progressive(const fr_render_desc *d) { return fr_shade_mode_progressive((fr_shade_mode)d->shade); }
-static int temporal_applies(const fr_renderer *r) {
-  const fr_render_desc *d = &r->d.d;
-  return r->tp && d->temporal && (d->shade == FR_RENDER_PATH || d->shade == FR_RENDER_AO);
+/* Whether d's temporal blend has anything to blend: the noisy shades. */
+static int temporal_wanted(const fr_render_desc *d) {
+  return d->temporal && (d->shade == FR_RENDER_PATH || d->shade == FR_RENDER_AO);
 }
+static int temporal_applies(const fr_renderer *r) { return r->tp && temporal_wanted(&r->d.d); }
 
 /* The denoiser and the temporal blend d asks for, at its size; r's own are
  * kept where they serve. */
@@ -254,7 +255,7 @@ static fr_error ensure_buffers(fr_renderer *r, const fr_render_desc *d) {
     const fr_error e = fr_denoiser_new(W, H, &r->dn);
     if (e) return e;
   }
-  if (d->temporal && (d->shade == FR_RENDER_PATH || d->shade == FR_RENDER_AO) && !r->tp) {
+  if (temporal_wanted(d) && !r->tp) {
     r->frame = malloc((size_t)W * (size_t)H * 10 * sizeof(float));
     if (!r->frame || fr_temporal_new(W, H, &r->tp)) {
       free(r->frame);
@@ -337,7 +338,7 @@ static fr_error rebuild(fr_renderer *r, const fr_render_desc *d) {
   const int new_mats = mode == FR_SM_WHITTED &&
                        !(r->mats && str_eq(r->mats_from.d.mirror, d->mirror) && str_eq(r->mats_from.d.glass, d->glass));
   if ((e = owned_set(&nd, d))) return e;
-  if (!e && new_path && !(e = make_path(s, d, &w.view, &path))) e = owned_set(&path_from, d);
+  if (new_path && !(e = make_path(s, d, &w.view, &path))) e = owned_set(&path_from, d);
   if (!e && new_mats) {
     mats = calloc(1, sizeof *mats);
     e = !mats ? fr_fail(FR_ERR_NOMEM, "out of memory") : fr_whitted_mats_build(s, d->mirror, d->glass, mats);
@@ -420,7 +421,7 @@ fr_error fr_renderer_set_camera(fr_renderer *r, const fr_pinhole *c) {
   r->d.d.camera = *c;
   r->p.w.cam = cam;
   r->p.w.view = v;
-  if (d.shade == FR_RENDER_PATH && d.focus == 0.0f) r->p.path.focus = v3_len(v3_sub(v.at, v.eye));
+  if (d.shade == FR_RENDER_PATH) r->p.path.focus = fr_path_focus(d.focus, &v);
   fr_progressive_restart(&r->p);
   r->frame_ready = 0;
   return FR_OK;
@@ -497,6 +498,12 @@ fr_error fr_renderer_render(fr_renderer *r) {
   fr_error e = FR_OK;
   while (!e && !done) e = fr_renderer_pass(r, &done);
   return e;
+}
+
+int fr_renderer_passes(const fr_renderer *r) {
+  const fr_progressive *p = &r->p;
+  if (p->mode == FR_SM_PATH) return (p->path.spp + p->spp_per_pass - 1) / p->spp_per_pass;
+  return p->max_passes > 0 ? p->max_passes : 1;
 }
 
 int fr_renderer_done(const fr_renderer *r) { return !r || fr_progressive_done(&r->p); }

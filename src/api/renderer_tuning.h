@@ -29,6 +29,8 @@ void fr_renderer_tune(fr_renderer *r, const fr_renderer_tuning *t);
 const fr_path_setup *fr_renderer_path_setup(const fr_renderer *r);
 /* The Whitted materials, or NULL if the shade is not whitted. */
 const fr_whitted_mats *fr_renderer_whitted_mats(const fr_renderer *r);
+/* The passes the image takes from the start (for a progress line). */
+int fr_renderer_passes(const fr_renderer *r);
 /* softshadow: the visibility the image shows (W*H). */
 void fr_renderer_visibility(const fr_renderer *r, float *vis);
 /* Whether passes trace camera rays as multi-frusta. */

@@ -50,10 +50,12 @@ fr_error fr_path_scene_init(fr_path_scene *r, const fr_scene *s, const fr_view *
   P->sampler = o->sampler;
   P->spp = o->spp, P->spp_begin = 0, P->spp_end = o->spp;
   P->aperture = o->aperture;
-  P->focus = o->focus > 0.0f ? o->focus : v3_len(v3_sub(v->at, v->eye));
+  P->focus = fr_path_focus(o->focus, v);
   P->seed = o->seed;
   return FR_OK;
 }
+
+float fr_path_focus(float focus, const fr_view *v) { return focus > 0.0f ? focus : v3_len(v3_sub(v->at, v->eye)); }
 
 void fr_path_scene_free(fr_path_scene *r) {
   fr_env_free(&r->env);

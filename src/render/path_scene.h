@@ -43,4 +43,6 @@ typedef struct fr_path_scene {
  * or glass name), FR_ERR_NOMEM; r is then empty. */
 fr_error fr_path_scene_init(fr_path_scene *r, const fr_scene *s, const fr_view *v, const fr_path_options *o);
 void fr_path_scene_free(fr_path_scene *r);
+/* The distance in focus: focus where positive, else from v's eye to its at. */
+float fr_path_focus(float focus, const fr_view *v);
 #endif

@@ -205,11 +205,23 @@ int cli_whitted_from_args(const cli_args *a, cli_whitted *o) {
   return rc;
 }
 
+void cli_whitted_print(const fr_scene *s, const fr_whitted_mats *m, int depth) {
+  size_t nm, ng;
+  fr_whitted_mats_census(s, m, &nm, &ng);
+  printf("whitted depth=%d mirror_prims=%zu glass_prims=%zu\n", depth, nm, ng);
+}
+
+void cli_desc_view(const fr_view *v, fr_render_desc *d) {
+  v3_store(d->camera.eye, v->eye), v3_store(d->camera.at, v->at), v3_store(d->camera.up, v->up);
+  d->camera.fov_deg = v->fov;
+  d->has_light = 1, v3_store(d->light, v->light);
+  d->has_area = 1;
+  v3_store(d->area_corner, v->area_c), v3_store(d->area_e1, v->area_e1), v3_store(d->area_e2, v->area_e2);
+}
+
 int cli_whitted_setup(const fr_scene *s, const cli_whitted *o, fr_whitted_mats *mats, fr_workload *w) {
   if (fr_whitted_mats_build(s, o->mirror, o->glass, mats)) return cli_error(CLI_USAGE_ERROR, "%s", fr_last_error());
-  size_t nm, ng;
-  fr_whitted_mats_census(s, mats, &nm, &ng);
-  printf("whitted depth=%d mirror_prims=%zu glass_prims=%zu\n", o->depth, nm, ng);
+  cli_whitted_print(s, mats, o->depth);
   w->mats = mats;
   w->max_depth = o->depth;
   return 0;

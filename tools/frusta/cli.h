@@ -72,4 +72,9 @@ int cli_whitted_from_args(const cli_args *a, cli_whitted *o);
 /* Builds the Whitted materials into w (w->mats must point at *mats); reports
  * errors itself and prints how many triangles mirror and refract. */
 int cli_whitted_setup(const fr_scene *s, const cli_whitted *o, struct fr_whitted_mats *mats, struct fr_workload *w);
+/* The line of how many triangles the Whitted materials m make mirror and glass. */
+void cli_whitted_print(const fr_scene *s, const struct fr_whitted_mats *m, int depth);
+/* A renderer description's camera (eye, at, up, fov) and lights (the
+ * point light and the quad light) from v. */
+void cli_desc_view(const fr_view *v, fr_render_desc *d);
 #endif

@@ -46,6 +46,7 @@ typedef struct render_job {
   fr_render_desc d;
   fr_renderer_tuning tune;
   const char *tracer, *mode; /* for the report: frusta or embree; mft, a trace mode or large packets */
+  const cli_path *po;         /* the path flags, for the set-up line */
   int aov;
   const char *out;
 } render_job;
@@ -57,10 +58,7 @@ static int run(fr_renderer *r, const render_job *j, int report, float *img, uint
   const fr_render_desc *d = &j->d;
   const size_t np = (size_t)d->camera.width * (size_t)d->camera.height;
   const int path = d->shade == FR_RENDER_PATH;
-  const int passes = path ? (j->tune.whole_path_passes ? 1 : (d->spp + d->pass_spp - 1) / d->pass_spp)
-                     : d->shade == FR_RENDER_AO ? d->spp / 16
-                     : d->shade == FR_RENDER_SOFTSHADOW ? (d->spp > 16 && j->tune.soft_preview) + d->spp / 16
-                                                        : 1;
+  const int passes = fr_renderer_passes(r);
   const int tty = report && isatty(fileno(stderr)) && cli_cluster_leader() && passes > 1;
   const double t0 = fr_seconds();
   double last = t0;
@@ -107,17 +105,9 @@ static int render(const render_job *j, const char *ref_out) {
   }
   fr_renderer_tune(r, &j->tune);
   const fr_path_setup *P = fr_renderer_path_setup(r);
-  if (P && cli_cluster_leader()) {
-    cli_path p = {.spp = d->spp, .max_depth = d->max_depth, .lights = (int)d->lights, .sampler = d->sampler,
-                  .env_file = d->environment};
-    cli_path_print(&p, P);
-  }
+  if (P && cli_cluster_leader()) cli_path_print(j->po, P);
   const fr_whitted_mats *mats = fr_renderer_whitted_mats(r);
-  if (mats && cli_cluster_leader()) {
-    size_t nm, ng;
-    fr_whitted_mats_census(j->s, mats, &nm, &ng);
-    printf("whitted depth=%d mirror_prims=%zu glass_prims=%zu\n", d->max_depth, nm, ng);
-  }
+  if (mats && cli_cluster_leader()) cli_whitted_print(j->s, mats, d->max_depth);
   uint64_t rays;
   double seconds, denoise_seconds;
   if ((rc = run(r, j, 1, img, &rays, &seconds, &denoise_seconds))) goto done;
@@ -216,15 +206,11 @@ int cmd_render(int argc, char **argv) {
 
   render_job j;
   memset(&j, 0, sizeof j);
-  j.s = s, j.out = out, j.aov = shade == FR_SM_PATH && po.aov;
+  j.s = s, j.out = out, j.aov = shade == FR_SM_PATH && po.aov, j.po = &po;
   fr_render_desc *d = &j.d;
   fr_render_desc_default(d);
-  const fr_view *view = &w.view;
-  v3_store(d->camera.eye, view->eye), v3_store(d->camera.at, view->at), v3_store(d->camera.up, view->up);
-  d->camera.fov_deg = view->fov, d->camera.width = v.width, d->camera.height = v.height;
-  d->has_light = 1, v3_store(d->light, view->light);
-  d->has_area = 1;
-  v3_store(d->area_corner, view->area_c), v3_store(d->area_e1, view->area_e1), v3_store(d->area_e2, view->area_e2);
+  cli_desc_view(&w.view, d);
+  d->camera.width = v.width, d->camera.height = v.height;
   d->shade = (fr_render_shade)shade;
   cli_path_desc(&po, d);
   d->spp = shade == FR_SM_SOFTSHADOW ? light_samples : po.spp;

@@ -33,12 +33,7 @@ static void tell(view_renderer *r) {
   const fr_path_setup *P = fr_renderer_path_setup(r->fr);
   if (P && !r->path_told) cli_path_print(r->po, P), r->path_told = 1;
   const fr_whitted_mats *m = fr_renderer_whitted_mats(r->fr);
-  if (m && !r->whitted_told) {
-    size_t nm, ng;
-    fr_whitted_mats_census(r->scene, m, &nm, &ng);
-    printf("whitted depth=%d mirror_prims=%zu glass_prims=%zu\n", r->whitted_depth, nm, ng);
-    r->whitted_told = 1;
-  }
+  if (m && !r->whitted_told) cli_whitted_print(r->scene, m, r->whitted_depth), r->whitted_told = 1;
 }
 
 static int buffers(view_renderer *r, int W, int H) {
@@ -68,9 +63,7 @@ int view_renderer_init(view_renderer *r, fr_scene *s, const fr_view *view, const
   cli_path_desc(po, d);
   d->spp = po->spp, d->threads = threads;
   d->pass_spp = 1; /* a frame a sample */
-  d->has_light = 1, v3_store(d->light, view->light);
-  d->has_area = 1;
-  v3_store(d->area_corner, view->area_c), v3_store(d->area_e1, view->area_e1), v3_store(d->area_e2, view->area_e2);
+  cli_desc_view(view, d); /* the lights; each setting brings its camera */
   if (!d->mirror) d->mirror = wo->mirror;
   if (!d->glass) d->glass = wo->glass;
   r->path_depth = po->max_depth, r->whitted_depth = wo->depth;
