@@ -19,9 +19,8 @@ void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, 
 /* Making a workload's rays is timed with either tracer, so it does only what
  * the rays need. */
 
-/* shadow: each hit's ray to the point light, [eps, (1 - 1e-4) |L - p|]; no
- * normal and no random numbers (they were a third of the time of frusta's
- * multi-frusta on conference's shadow workload) */
+/* shadow: each hit's ray to the point light, [eps, (1 - 1e-4) |L - p|],
+ * made without the normal and random numbers it does not use */
 static int point_light_rays(const fr_workload *w, fr_tile_buffers *B, int n) {
   float px[TILE_PIX], py[TILE_PIX], pz[TILE_PIX], inv[TILE_PIX], dist[TILE_PIX];
   int m = 0;
