@@ -5,6 +5,7 @@
  */
 #include "render/tile.h"
 #include "base/rng.h"
+#include "base/trig.h"
 #include "render/mft_rays.h"
 
 void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, fr_ray *rays, fr_hit *hits) {
@@ -47,7 +48,8 @@ static int point_light_rays(const fr_workload *w, fr_tile_buffers *B, int n) {
   return m;
 }
 
-/* ao16: 16 cosine-weighted directions about each hit's normal, unbounded */
+/* ao16: 16 cosine-weighted directions about each hit's normal, unbounded;
+ * each pixel's 16 made in one loop the compiler vectorizes */
 static int ao_rays(const fr_workload *w, fr_tile_buffers *B, int n) {
   const int W = w->cam.width;
   int m = 0;
@@ -58,9 +60,19 @@ static int ao_rays(const fr_workload *w, fr_tile_buffers *B, int n) {
     vec3 tu, tv;
     v3_onb(nn, &tu, &tv);
     fr_rng rng = fr_rng_seed(w->seed, (uint64_t)B->py[i] * (uint64_t)W + (uint64_t)B->px[i]);
+    float u1[16], u2[16], dx[16], dy[16], dz[16];
+    for (int k = 0; k < 16; k++) u1[k] = fr_rng_float(&rng), u2[k] = fr_rng_float(&rng);
     for (int k = 0; k < 16; k++) {
-      const float u1 = fr_rng_float(&rng), u2 = fr_rng_float(&rng);
-      B->rays[m] = make_ray(p, cosine_dir_in(nn, tu, tv, u1, u2), w->eps, INFINITY);
+      float sn, cs;
+      fr_sincos_turns(u2[k], &sn, &cs);
+      const float r = sqrtf(u1[k]), one = 1.0f - u1[k], z = sqrtf(one > 0.0f ? one : 0.0f);
+      const float x = r * cs, y = r * sn;
+      dx[k] = tu.x * x + tv.x * y + nn.x * z;
+      dy[k] = tu.y * x + tv.y * y + nn.y * z;
+      dz[k] = tu.z * x + tv.z * y + nn.z * z;
+    }
+    for (int k = 0; k < 16; k++) {
+      B->rays[m] = make_ray(p, v3(dx[k], dy[k], dz[k]), w->eps, INFINITY);
       B->owner[m++] = i;
     }
   }

@@ -68,17 +68,12 @@ static inline vec3 shading_normal(const fr_scene *s, const fr_hit *h, vec3 d, ve
   return v3_dot(n, d) < 0.0f ? n : nf;
 }
 
-/* A cosine-weighted direction about unit n, given n's basis t, b
- * (v3_onb), from two uniform numbers in [0, 1). */
-static inline vec3 cosine_dir_in(vec3 n, vec3 t, vec3 b, float u1, float u2) {
-  const float r = sqrtf(u1), phi = 2.0f * (float)M_PI * u2, z = sqrtf(fmaxf(0.0f, 1.0f - u1));
-  return v3_add(v3_add(v3_scale(t, r * cosf(phi)), v3_scale(b, r * sinf(phi))), v3_scale(n, z));
-}
-
 static inline vec3 cosine_dir(vec3 n, float u1, float u2) {
   vec3 t, b;
   v3_onb(n, &t, &b);
-  return cosine_dir_in(n, t, b, u1, u2);
+  float r = sqrtf(u1), phi = 2.0f * (float)M_PI * u2;
+  float x = r * cosf(phi), y = r * sinf(phi), z = sqrtf(fmaxf(0.0f, 1.0f - u1));
+  return v3_add(v3_add(v3_scale(t, x), v3_scale(b, y)), v3_scale(n, z));
 }
 
 static inline fr_ray make_ray(vec3 o, vec3 d, float tnear, float tfar) {
