@@ -8,8 +8,8 @@ its 16-wide packets; for each workload Embree's best of those and of its two
 coherence flags counts, with its high-quality build. frusta runs in its
 default trace mode (auto) from the same arrays, and through its multi-frusta
 calls where they apply; its fastest call counts. Both return t, triangle,
-u and v (frusta's camera call without normals, as Embree's hits are read
-here; with them it fetches each hit triangle). Workloads per scene:
+u and v (frusta's calls without normals, as Embree's hits are read here;
+its camera call with them fetches each hit triangle). Workloads per scene:
 1024x1024 camera rays (frusta's camera call, and the same rays as arrays, row
 by row), shadow segments between their hits and the scene's point light
 (frusta's point-light call, and arrays from the light and to it), and 1M
@@ -198,7 +198,7 @@ def main():
                                                                        normals=False).t.reshape(-1),
                             "camera call with normals": lambda: fs.intersect_camera(eye, at, up, fov, a.size,
                                                                                     a.size).t.reshape(-1),
-                            "arrays": lambda: fs.intersect(o, d).t},
+                            "arrays": lambda: fs.intersect(o, d, normals=False).t},
                            embree_variants(lambda c, p16: em.intersect(o, d, c, p16)), len(o), agree_hits),
                 "shadow": ({"point-light call": lambda: fs.occluded_point_light(pts, L, eps),
                             "arrays from the light": lambda: fs.occluded(*from_l),
@@ -208,7 +208,7 @@ def main():
                             **{k + " to the light": fn for k, fn in
                                embree_variants(lambda c, p16: em.occluded(*to_l, c, p16)).items()}},
                            len(pts), np.equal),
-                "random": ({"arrays": lambda: fs.intersect(ro, rd).t},
+                "random": ({"arrays": lambda: fs.intersect(ro, rd, normals=False).t},
                            embree_variants(lambda c, p16: em.intersect(ro, rd, c, p16)), len(ro), agree_hits),
             }
             for wl, (f_runs, e_runs, n, same) in work.items():

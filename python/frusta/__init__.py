@@ -64,9 +64,10 @@ class Scene(_Scene):
     never uses them.
     """
 
-    def intersect(self, origins, directions, tnear=0.0, tfar=INF):
-        """The closest hit of each ray in (tnear, tfar), as Hits."""
-        return Hits(*self._intersect(origins, directions, tnear, tfar))
+    def intersect(self, origins, directions, tnear=0.0, tfar=INF, normals=True):
+        """The closest hit of each ray in (tnear, tfar), as Hits.
+        normals=False leaves hits.normal None, sparing that array."""
+        return Hits(*self._intersect(origins, directions, tnear, tfar, normals))
 
     def occluded(self, origins, directions, tnear=0.0, tfar=INF):
         """Whether anything lies on each ray in (tnear, tfar): a bool array."""

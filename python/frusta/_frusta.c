@@ -320,13 +320,19 @@ static PyArrayObject *out_array(const rays_in *r, int extra, int type) {
 }
 
 /* Parses (origins, directions, tnear=0, tfar=inf) and marks the scene busy. */
-static int begin_trace(SceneObject *s, PyObject *args, PyObject *kw, rays_in *r, Py_ssize_t *max_hits) {
+/* The rays of a call (origins, directions[, tnear, tfar]); max_hits, when
+ * not NULL, comes third (intersect_all); normals, when not NULL, last
+ * (intersect). */
+static int begin_trace(SceneObject *s, PyObject *args, PyObject *kw, rays_in *r, Py_ssize_t *max_hits, int *normals) {
   static char *names[] = {"origins", "directions", "tnear", "tfar", NULL};
   static char *names_all[] = {"origins", "directions", "max_hits", "tnear", "tfar", NULL};
+  static char *names_normals[] = {"origins", "directions", "tnear", "tfar", "normals", NULL};
   PyObject *o, *d, *tn = NULL, *tf = NULL;
   if (max_hits) {
     if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|nOO", names_all, &o, &d, max_hits, &tn, &tf)) return 0;
     if (*max_hits < 0) { PyErr_SetString(PyExc_ValueError, "max_hits must be at least 0"); return 0; }
+  } else if (normals) {
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|OOp", names_normals, &o, &d, &tn, &tf, normals)) return 0;
   } else if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|OO", names, &o, &d, &tn, &tf))
     return 0;
   if (!scene_open(s) || !rays_parse(o, d, tn, tf, r)) return 0;
@@ -336,17 +342,20 @@ static int begin_trace(SceneObject *s, PyObject *args, PyObject *kw, rays_in *r,
 
 /* ---- intersect and occluded ------------------------------------------------------ */
 
+/* normals=False: no normal array (None in its place), one output fewer to
+ * allocate and fill */
 static PyObject *scene_intersect(SceneObject *s, PyObject *args, PyObject *kw) {
   rays_in r;
-  if (!begin_trace(s, args, kw, &r, NULL)) return NULL;
+  int normals = 1;
+  if (!begin_trace(s, args, kw, &r, NULL, &normals)) return NULL;
   PyArrayObject *t = out_array(&r, 0, NPY_FLOAT32), *prim = out_array(&r, 0, NPY_UINT32);
   PyArrayObject *u = out_array(&r, 0, NPY_FLOAT32), *v = out_array(&r, 0, NPY_FLOAT32);
-  PyArrayObject *ng = out_array(&r, 3, NPY_FLOAT32);
+  PyArrayObject *ng = normals ? out_array(&r, 3, NPY_FLOAT32) : NULL;
   PyObject *result = NULL;
-  if (!t || !prim || !u || !v || !ng) goto done;
+  if (!t || !prim || !u || !v || (normals && !ng)) goto done;
   size_t bad = (size_t)-1, n = r.n, chunks = (n + CHUNK - 1) / CHUNK;
   const fr_scene *sc = s->scene;
-  float *tp = PyArray_DATA(t), *up = PyArray_DATA(u), *vp = PyArray_DATA(v), *np = PyArray_DATA(ng);
+  float *tp = PyArray_DATA(t), *up = PyArray_DATA(u), *vp = PyArray_DATA(v), *np = ng ? PyArray_DATA(ng) : NULL;
   uint32_t *pp = PyArray_DATA(prim);
   Py_BEGIN_ALLOW_THREADS
 #pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads ? n_threads : omp_get_max_threads())
@@ -363,12 +372,16 @@ static PyObject *scene_intersect(SceneObject *s, PyObject *args, PyObject *kw) {
     for (size_t j = 0; j < k; j++) {
       size_t i = i0 + j;
       tp[i] = hits[j].t; up[i] = hits[j].u; vp[i] = hits[j].v; pp[i] = hits[j].prim;
-      np[3 * i] = hits[j].ng[0]; np[3 * i + 1] = hits[j].ng[1]; np[3 * i + 2] = hits[j].ng[2];
     }
+    if (np)
+      for (size_t j = 0; j < k; j++) {
+        size_t i = i0 + j;
+        np[3 * i] = hits[j].ng[0]; np[3 * i + 1] = hits[j].ng[1]; np[3 * i + 2] = hits[j].ng[2];
+      }
   }
   Py_END_ALLOW_THREADS
   if (bad != (size_t)-1) { bad_ray(bad); goto done; }
-  result = Py_BuildValue("(OOOOO)", t, prim, u, v, ng);
+  result = Py_BuildValue("(OOOOO)", t, prim, u, v, ng ? (PyObject *)ng : Py_None);
 done:
   s->busy--;
   Py_XDECREF(t); Py_XDECREF(prim); Py_XDECREF(u); Py_XDECREF(v); Py_XDECREF(ng);
@@ -378,7 +391,7 @@ done:
 
 static PyObject *scene_occluded(SceneObject *s, PyObject *args, PyObject *kw) {
   rays_in r;
-  if (!begin_trace(s, args, kw, &r, NULL)) return NULL;
+  if (!begin_trace(s, args, kw, &r, NULL, NULL)) return NULL;
   PyArrayObject *occ = out_array(&r, 0, NPY_BOOL);
   PyObject *result = NULL;
   if (!occ) goto done;
@@ -419,7 +432,7 @@ typedef struct chunk_hits {
 static PyObject *scene_intersect_all(SceneObject *s, PyObject *args, PyObject *kw) {
   rays_in r;
   Py_ssize_t max_hits = 16;
-  if (!begin_trace(s, args, kw, &r, &max_hits)) return NULL;
+  if (!begin_trace(s, args, kw, &r, &max_hits, NULL)) return NULL;
   /* a chunk's slots take at most 64 * CHUNK hits, however large max_hits */
   size_t K = (size_t)max_hits, n = r.n, per = K <= 64 ? CHUNK : (K >= 64 * CHUNK ? 1 : 64 * CHUNK / K);
   size_t chunks = (n + per - 1) / per;

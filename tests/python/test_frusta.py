@@ -166,6 +166,10 @@ def test_intersect_equals_c_api(clib, mode):
     np.testing.assert_array_equal(h.u[same], hits["u"][same])
     np.testing.assert_array_equal(h.normal[same], hits["ng"][same])
     np.testing.assert_array_equal(s.occluded(o, d), occ.astype(bool))
+    bare = s.intersect(o, d, normals=False)  # the same answers, without the normal array
+    assert bare.normal is None
+    for a, b in zip(bare[:4], h[:4]):
+        np.testing.assert_array_equal(a, b)
 
 
 def test_camera_rays_equal_c_api(clib):
