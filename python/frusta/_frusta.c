@@ -319,10 +319,9 @@ static PyArrayObject *out_array(const rays_in *r, int extra, int type) {
   return (PyArrayObject *)PyArray_SimpleNew(nd, shape, type);
 }
 
-/* Parses (origins, directions, tnear=0, tfar=inf) and marks the scene busy. */
-/* The rays of a call (origins, directions[, tnear, tfar]); max_hits, when
- * not NULL, comes third (intersect_all); normals, when not NULL, last
- * (intersect). */
+/* Parses (origins, directions, tnear=0, tfar=inf) and marks the scene busy;
+ * max_hits, when not NULL, comes third (intersect_all), normals, when not
+ * NULL, last (intersect). */
 static int begin_trace(SceneObject *s, PyObject *args, PyObject *kw, rays_in *r, Py_ssize_t *max_hits, int *normals) {
   static char *names[] = {"origins", "directions", "tnear", "tfar", NULL};
   static char *names_all[] = {"origins", "directions", "max_hits", "tnear", "tfar", NULL};
