@@ -62,12 +62,17 @@ static int guide_slot(int n, float u) {
   return k >= n ? n - 1 : k < 0 ? 0 : k;
 }
 
-/* The i with cdf[i] <= u < cdf[i + 1] among n intervals (never an empty
- * one), from its guide: a walk of a step or two. */
-static int find(const float *cdf, const uint32_t *guide, int n, float u) {
-  int i = (int)guide[guide_slot(n, u)];
+/* From interval i (a guide's entry, never past the answer) up to the i with
+ * cdf[i] <= u < cdf[i + 1] among n intervals: a walk of a step or two. */
+static int walk(const float *cdf, int n, int i, float u) {
   while (i < n - 1 && cdf[i + 1] <= u) i++;
   return i;
+}
+
+/* The i with cdf[i] <= u < cdf[i + 1] among n intervals (never an empty
+ * one), from its guide. */
+static int find(const float *cdf, const uint32_t *guide, int n, float u) {
+  return walk(cdf, n, (int)guide[guide_slot(n, u)], u);
 }
 
 /* The point in cell (xx, yy) that (u1, u2) maps to. */
@@ -103,13 +108,10 @@ void fr_dist2d_sample_batch(const fr_dist2d *d, size_t n, const float *u1, const
     x[j] = (int)d->guide_row[(size_t)y[j] * w + (size_t)guide_slot(d->w, u1[j])];
     __builtin_prefetch(d->cdf_row + (size_t)y[j] * (w + 1) + (size_t)x[j] + 1);
   }
-  /* the walks from the guides, as find does, and the points */
+  /* the walks from the guides, and the points */
   for (size_t j = 0; j < n; j++) {
-    const float *c = d->cdf_row + (size_t)y[j] * (w + 1);
-    int i = x[j];
-    while (i < d->w - 1 && c[i + 1] <= u1[j]) i++;
-    x[j] = i;
-    cell_point(d, i, y[j], u1[j], u2[j], u + j, v + j);
+    x[j] = walk(d->cdf_row + (size_t)y[j] * (w + 1), d->w, x[j], u1[j]);
+    cell_point(d, x[j], y[j], u1[j], u2[j], u + j, v + j);
   }
 }
 
