@@ -13,7 +13,8 @@ its camera call with them fetches each hit triangle). Workloads per scene:
 1024x1024 camera rays (frusta's camera call, and the same rays as arrays, row
 by row), shadow segments between their hits and the scene's point light
 (frusta's point-light call, and arrays from the light and to it), and 1M
-random rays (origins in the scene's box, uniform directions). Best of REPEAT
+random rays (origins in the scene's box, uniform directions; frusta's arrays
+as given and with reorder=True). Best of REPEAT
 alternating calls each. Each frusta call's answers are compared with Embree's
 on the same rays by the rule of docs/rayfile.md; for shadows, the
 disagreements whose segment meets a surface within the rule's tolerance of
@@ -208,7 +209,8 @@ def main():
                             **{k + " to the light": fn for k, fn in
                                embree_variants(lambda c, p16: em.occluded(*to_l, c, p16)).items()}},
                            len(pts), np.equal),
-                "random": ({"arrays": lambda: fs.intersect(ro, rd, normals=False).t},
+                "random": ({"arrays": lambda: fs.intersect(ro, rd, normals=False).t,
+                            "arrays reordered": lambda: fs.intersect(ro, rd, normals=False, reorder=True).t},
                            embree_variants(lambda c, p16: em.intersect(ro, rd, c, p16)), len(ro), agree_hits),
             }
             for wl, (f_runs, e_runs, n, same) in work.items():

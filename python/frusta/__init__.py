@@ -64,14 +64,19 @@ class Scene(_Scene):
     never uses them.
     """
 
-    def intersect(self, origins, directions, tnear=0.0, tfar=INF, normals=True):
+    def intersect(self, origins, directions, tnear=0.0, tfar=INF, normals=True, reorder=False):
         """The closest hit of each ray in (tnear, tfar), as Hits.
-        normals=False leaves hits.normal None, sparing that array."""
-        return Hits(*self._intersect(origins, directions, tnear, tfar, normals))
+        normals=False leaves hits.normal None, sparing that array.
+        reorder=True traces many incoherent rays (random origins and
+        directions) in the order of their origins' cells, which pays on large
+        scenes; the answers are those of a trace mode (t and the triangle the
+        same, u and v to rounding)."""
+        return Hits(*self._intersect(origins, directions, tnear, tfar, normals, reorder))
 
-    def occluded(self, origins, directions, tnear=0.0, tfar=INF):
-        """Whether anything lies on each ray in (tnear, tfar): a bool array."""
-        return self._occluded(origins, directions, tnear, tfar)
+    def occluded(self, origins, directions, tnear=0.0, tfar=INF, reorder=False):
+        """Whether anything lies on each ray in (tnear, tfar): a bool array.
+        reorder as for intersect."""
+        return self._occluded(origins, directions, tnear, tfar, reorder)
 
     def intersect_all(self, origins, directions, max_hits=16, tnear=0.0, tfar=INF):
         """Every triangle each ray crosses in (tnear, tfar), each once (also

@@ -21,6 +21,7 @@
 #include "frusta.h"
 
 #define CHUNK 1024
+#define GATHER_AHEAD 16 /* rays packed in an order fetch this many ahead */
 
 static int n_threads; /* 0: OpenMP's default */
 
@@ -285,23 +286,35 @@ fail:
   return 0;
 }
 
-/* Rays [i0, i0 + k) packed; 0 and the first bad ray's index in *bad where
- * an origin or direction is not finite or a tnear is NaN. */
-static int rays_pack(const rays_in *r, size_t i0, size_t k, fr_ray *out, size_t *bad) {
-  const float *o = (const float *)PyArray_DATA(r->org) + 3 * i0, *d = (const float *)PyArray_DATA(r->dir) + 3 * i0;
-  const float *tn = r->tnear_a ? (const float *)PyArray_DATA(r->tnear_a) + i0 : NULL;
-  const float *tf = r->tfar_a ? (const float *)PyArray_DATA(r->tfar_a) + i0 : NULL;
+/* Rays [i0, i0 + k) packed, or rays idx[i0 .. i0 + k) where idx is not NULL;
+ * 0 and the least bad ray's index in *bad (which it only lowers) where an
+ * origin or direction is not finite or a range is NaN. */
+static int rays_pack(const rays_in *r, const uint32_t *idx, size_t i0, size_t k, fr_ray *out, size_t *bad) {
+  const float *o = (const float *)PyArray_DATA(r->org), *d = (const float *)PyArray_DATA(r->dir);
+  const float *tn = r->tnear_a ? (const float *)PyArray_DATA(r->tnear_a) : NULL;
+  const float *tf = r->tfar_a ? (const float *)PyArray_DATA(r->tfar_a) : NULL;
   int ok = 1;
   for (size_t j = 0; j < k; j++) {
+    size_t i = idx ? idx[i0 + j] : i0 + j;
+    if (idx && j + GATHER_AHEAD < k) {
+      size_t f = idx[i0 + j + GATHER_AHEAD];
+      __builtin_prefetch(o + 3 * f);
+      __builtin_prefetch(d + 3 * f);
+      if (tn) __builtin_prefetch(tn + f);
+      if (tf) __builtin_prefetch(tf + f);
+    }
     fr_ray *x = &out[j];
-    for (int a = 0; a < 3; a++) { x->org[a] = o[3 * j + a]; x->dir[a] = d[3 * j + a]; }
-    x->tnear = tn ? tn[j] : r->tnear;
-    x->tfar = tf ? tf[j] : r->tfar;
+    for (int a = 0; a < 3; a++) { x->org[a] = o[3 * i + a]; x->dir[a] = d[3 * i + a]; }
+    x->tnear = tn ? tn[i] : r->tnear;
+    x->tfar = tf ? tf[i] : r->tfar;
     float s = x->org[0] + x->org[1] + x->org[2] + x->dir[0] + x->dir[1] + x->dir[2];
-    if (ok && (!isfinite(s) || isnan(x->tnear) || isnan(x->tfar))) {
+    if (!isfinite(s) || isnan(x->tnear) || isnan(x->tfar)) {
       int fine = 1;
       for (int a = 0; a < 3; a++) fine &= isfinite(x->org[a]) && isfinite(x->dir[a]);
-      if (!fine || isnan(x->tnear) || isnan(x->tfar)) { ok = 0; *bad = i0 + j; }
+      if (!fine || isnan(x->tnear) || isnan(x->tfar)) {
+        ok = 0;
+        if (i < *bad) *bad = i;
+      }
     }
   }
   return ok;
@@ -320,19 +333,21 @@ static PyArrayObject *out_array(const rays_in *r, int extra, int type) {
 }
 
 /* Parses (origins, directions, tnear=0, tfar=inf) and marks the scene busy;
- * max_hits, when not NULL, comes third (intersect_all), normals, when not
- * NULL, last (intersect). */
-static int begin_trace(SceneObject *s, PyObject *args, PyObject *kw, rays_in *r, Py_ssize_t *max_hits, int *normals) {
-  static char *names[] = {"origins", "directions", "tnear", "tfar", NULL};
+ * max_hits, when not NULL, comes third (intersect_all); normals (intersect)
+ * and reorder (intersect, occluded) last. */
+static int begin_trace(SceneObject *s, PyObject *args, PyObject *kw, rays_in *r, Py_ssize_t *max_hits, int *normals,
+                       int *reorder) {
+  static char *names[] = {"origins", "directions", "tnear", "tfar", "reorder", NULL};
   static char *names_all[] = {"origins", "directions", "max_hits", "tnear", "tfar", NULL};
-  static char *names_normals[] = {"origins", "directions", "tnear", "tfar", "normals", NULL};
+  static char *names_normals[] = {"origins", "directions", "tnear", "tfar", "normals", "reorder", NULL};
   PyObject *o, *d, *tn = NULL, *tf = NULL;
   if (max_hits) {
     if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|nOO", names_all, &o, &d, max_hits, &tn, &tf)) return 0;
     if (*max_hits < 0) { PyErr_SetString(PyExc_ValueError, "max_hits must be at least 0"); return 0; }
   } else if (normals) {
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|OOp", names_normals, &o, &d, &tn, &tf, normals)) return 0;
-  } else if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|OO", names, &o, &d, &tn, &tf))
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|OOpp", names_normals, &o, &d, &tn, &tf, normals, reorder))
+      return 0;
+  } else if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|OOp", names, &o, &d, &tn, &tf, reorder))
     return 0;
   if (!scene_open(s) || !rays_parse(o, d, tn, tf, r)) return 0;
   s->busy++;
@@ -341,43 +356,220 @@ static int begin_trace(SceneObject *s, PyObject *args, PyObject *kw, rays_in *r,
 
 /* ---- intersect and occluded ------------------------------------------------------ */
 
+/* ---- the order of incoherent rays ---------------------------------------------
+ * Rays with random origins share no nodes with their neighbours in the
+ * array, so each fetches its own path through the tree from memory. With
+ * reorder=True they are traced in the order of the cell of the scene's box
+ * their origin lies in (16 per axis, along a Morton curve), so that rays
+ * traced one after another walk the same nodes while they are in cache:
+ * on large scenes that saves more than the order costs (docs/python.md).
+ * Arrays whose neighbours mostly share a cell already (camera rays, points
+ * in tiles) are traced as given. In single mode a ray's answer does not
+ * depend on its neighbours; in the others, whose packets do, the answers
+ * are those of another trace mode: t and the triangle the same, u and v to
+ * rounding.
+ *
+ * The order is a stable counting sort of 4096 keys, the same on any number
+ * of threads. The rays are fetched in it as they are packed (prefetched
+ * ahead), and the answers, stored in the traced order, are read back in
+ * the arrays' order, so that the outputs are written in runs. */
+#define ORDER_MIN (1u << 15)   /* fewer rays are traced as given */
+#define ORDER_ROUND (1u << 20) /* rays ordered at once, with 26-38 bytes of buffers each */
+#define ORDER_KEYS 4096u       /* 16 cells per axis */
+
+/* Where the answers go: hits (intersect) or occ (occluded). */
+typedef struct answers {
+  float *t, *u, *v, *ng; /* ng NULL without normals */
+  uint32_t *prim;
+  uint8_t *occ;
+} answers;
+
+typedef struct traced_hit {
+  float t, u, v;
+  uint32_t prim;
+} traced_hit;
+
+typedef struct ordered {
+  uint32_t *ray;   /* ray[p]: the index in the arrays of the round's p-th ray to trace */
+  uint32_t *at;    /* at[i]: where the round's ray i is in that order */
+  uint16_t *key;
+  uint32_t *count; /* per thread, ORDER_KEYS each */
+  traced_hit *hit; /* the answers in the traced order */
+  float *ng;
+  uint8_t *occ;
+} ordered;
+
+static void ordered_free(ordered *o) {
+  free(o->ray); free(o->at); free(o->key); free(o->count); free(o->hit); free(o->ng); free(o->occ);
+}
+
+/* Buffers for rounds of n rays and these answers; 0 (and none) where n is
+ * too small to order, or memory is short: the answers are the same. */
+static int ordered_alloc(ordered *o, size_t n, int threads, const answers *out) {
+  memset(o, 0, sizeof *o);
+  if (n < ORDER_MIN || n > UINT32_MAX) return 0;
+  size_t m = n < ORDER_ROUND ? n : ORDER_ROUND;
+  o->ray = malloc(m * sizeof *o->ray);
+  o->at = malloc(m * sizeof *o->at);
+  o->key = malloc(m * sizeof *o->key);
+  o->count = malloc((size_t)threads * ORDER_KEYS * sizeof *o->count);
+  int ok = o->ray && o->at && o->key && o->count;
+  if (out->occ) ok = ok && (o->occ = malloc(m));
+  else ok = ok && (o->hit = malloc(m * sizeof *o->hit)) && (!out->ng || (o->ng = malloc(3 * m * sizeof *o->ng)));
+  if (!ok) ordered_free(o);
+  return ok;
+}
+
+/* A cell coordinate (the scaled origin; NaN and the outside of the box go
+ * to the border cells) with its 4 bits spread three apart. */
+static uint32_t cell_bits(float c) {
+  c = c > 0.0f ? c : 0.0f;
+  uint32_t q = (uint32_t)(int32_t)(c < 15.0f ? c : 15.0f);
+  return (q & 1u) | (q & 2u) << 2 | (q & 4u) << 4 | (q & 8u) << 6;
+}
+
+/* The order of rays [base, base + m) of r by their origins' cells into o,
+ * on `threads` threads; 1 if so, 0 if they are coherent as given. */
+static int rays_order(const rays_in *r, const fr_scene *sc, int threads, size_t base, size_t m, ordered *o) {
+  float lo[3], hi[3], s[3];
+  fr_scene_bounds(sc, lo, hi);
+  for (int a = 0; a < 3; a++) s[a] = hi[a] > lo[a] ? 16.0f / (hi[a] - lo[a]) : 0.0f;
+  const float *org = (const float *)PyArray_DATA(r->org) + 3 * base;
+  size_t same = 0;
+  int sorted = 0;
+#pragma omp parallel num_threads(threads)
+  {
+    int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    size_t a = m * (size_t)t / (size_t)nt, b = m * (size_t)(t + 1) / (size_t)nt, mine = 0;
+    uint32_t *c = o->count + (size_t)t * ORDER_KEYS;
+    uint16_t *key = o->key;
+    for (size_t i = a; i < b; i++)
+      key[i] = (uint16_t)(cell_bits((org[3 * i] - lo[0]) * s[0]) | cell_bits((org[3 * i + 1] - lo[1]) * s[1]) << 1 |
+                          cell_bits((org[3 * i + 2] - lo[2]) * s[2]) << 2);
+    memset(c, 0, ORDER_KEYS * sizeof *c);
+    for (size_t i = a; i < b; i++) c[key[i]]++;
+    for (size_t i = a + 1; i < b; i++) mine += key[i] == key[i - 1];
+#pragma omp atomic
+    same += mine;
+#pragma omp barrier
+#pragma omp single
+    {
+      sorted = 2 * same < m; /* most neighbours in other cells: incoherent */
+      uint32_t at = 0;
+      for (uint32_t k = 0; sorted && k < ORDER_KEYS; k++)
+        for (int u = 0; u < nt; u++) {
+          uint32_t cnt = o->count[(size_t)u * ORDER_KEYS + k];
+          o->count[(size_t)u * ORDER_KEYS + k] = at;
+          at += cnt;
+        }
+    }
+    if (sorted)
+      for (size_t i = a; i < b; i++) {
+        uint32_t p = c[key[i]]++;
+        o->ray[p] = (uint32_t)(base + i);
+        o->at[i] = p;
+      }
+  }
+  return sorted;
+}
+
+/* ---- tracing arrays ---------------------------------------------------------------- */
+
+/* Rays [base, base + m) of r in chunks as given, or, where o is not NULL,
+ * in o's order with the answers put back in the arrays' order. *bad as
+ * rays_pack. */
+static void trace_round(const fr_scene *sc, const rays_in *r, int threads, size_t base, size_t m, const ordered *o,
+                        const answers *out, size_t *bad) {
+  size_t chunks = (m + CHUNK - 1) / CHUNK;
+  int failed = 0;
+#pragma omp parallel num_threads(threads)
+  {
+#pragma omp for schedule(dynamic, 1)
+    for (size_t c = 0; c < chunks; c++) {
+      fr_ray rays[CHUNK];
+      fr_hit hits[CHUNK];
+      size_t c0 = c * CHUNK, k = m - c0 < CHUNK ? m - c0 : CHUNK, b = (size_t)-1;
+      if (!(o ? rays_pack(r, o->ray, c0, k, rays, &b) : rays_pack(r, NULL, base + c0, k, rays, &b))) {
+#pragma omp critical(frusta_bad_ray)
+        {
+          if (b < *bad) *bad = b;
+          failed = 1;
+        }
+        continue;
+      }
+      if (out->occ) {
+        fr_occluded_stream(sc, rays, o ? o->occ + c0 : out->occ + base + c0, k);
+        continue;
+      }
+      fr_intersect_stream(sc, rays, hits, k);
+      for (size_t j = 0; j < k; j++) {
+        if (o) {
+          o->hit[c0 + j] = (traced_hit){hits[j].t, hits[j].u, hits[j].v, hits[j].prim};
+          if (out->ng) for (int a = 0; a < 3; a++) o->ng[3 * (c0 + j) + a] = hits[j].ng[a];
+          continue;
+        }
+        size_t i = base + c0 + j;
+        out->t[i] = hits[j].t; out->u[i] = hits[j].u; out->v[i] = hits[j].v; out->prim[i] = hits[j].prim;
+        if (out->ng) for (int a = 0; a < 3; a++) out->ng[3 * i + a] = hits[j].ng[a];
+      }
+    }
+    /* the loop's closing barrier has made `failed` final */
+    if (o && !failed) {
+#pragma omp for schedule(static)
+      for (size_t i = 0; i < m; i++) {
+        size_t p = o->at[i], q = base + i;
+        if (i + GATHER_AHEAD < m) {
+          size_t f = o->at[i + GATHER_AHEAD];
+          __builtin_prefetch(out->occ ? (const void *)&o->occ[f] : (const void *)&o->hit[f]);
+        }
+        if (out->occ) {
+          out->occ[q] = o->occ[p];
+          continue;
+        }
+        out->t[q] = o->hit[p].t; out->u[q] = o->hit[p].u; out->v[q] = o->hit[p].v; out->prim[q] = o->hit[p].prim;
+        if (out->ng) for (int a = 0; a < 3; a++) out->ng[3 * q + a] = o->ng[3 * p + a];
+      }
+    }
+  }
+}
+
+/* All of r's rays on `threads` threads, in the order of their origins'
+ * cells where `reorder` asks for it and they are enough and incoherent;
+ * *bad as rays_pack. */
+static void trace_arrays(const fr_scene *sc, const rays_in *r, int threads, int reorder, const answers *out,
+                         size_t *bad) {
+  size_t n = r->n;
+  ordered o;
+  int ordering = reorder && ordered_alloc(&o, n, threads, out);
+  for (size_t base = 0; base < n && *bad == (size_t)-1;) {
+    size_t m = ordering ? (n - base < ORDER_ROUND ? n - base : ORDER_ROUND) : n - base;
+    if (ordering && !rays_order(r, sc, threads, base, m, &o)) { /* nor the rounds after */
+      ordered_free(&o);
+      ordering = 0;
+    }
+    trace_round(sc, r, threads, base, m, ordering ? &o : NULL, out, bad);
+    base += m;
+  }
+  if (ordering) ordered_free(&o);
+}
+
 /* normals=False: no normal array (None in its place), one output fewer to
  * allocate and fill */
 static PyObject *scene_intersect(SceneObject *s, PyObject *args, PyObject *kw) {
   rays_in r;
-  int normals = 1;
-  if (!begin_trace(s, args, kw, &r, NULL, &normals)) return NULL;
+  int normals = 1, reorder = 0;
+  if (!begin_trace(s, args, kw, &r, NULL, &normals, &reorder)) return NULL;
   PyArrayObject *t = out_array(&r, 0, NPY_FLOAT32), *prim = out_array(&r, 0, NPY_UINT32);
   PyArrayObject *u = out_array(&r, 0, NPY_FLOAT32), *v = out_array(&r, 0, NPY_FLOAT32);
   PyArrayObject *ng = normals ? out_array(&r, 3, NPY_FLOAT32) : NULL;
   PyObject *result = NULL;
   if (!t || !prim || !u || !v || (normals && !ng)) goto done;
-  size_t bad = (size_t)-1, n = r.n, chunks = (n + CHUNK - 1) / CHUNK;
+  size_t bad = (size_t)-1;
+  answers out = {PyArray_DATA(t), PyArray_DATA(u), PyArray_DATA(v), ng ? PyArray_DATA(ng) : NULL, PyArray_DATA(prim),
+                 NULL};
   const fr_scene *sc = s->scene;
-  float *tp = PyArray_DATA(t), *up = PyArray_DATA(u), *vp = PyArray_DATA(v), *np = ng ? PyArray_DATA(ng) : NULL;
-  uint32_t *pp = PyArray_DATA(prim);
   Py_BEGIN_ALLOW_THREADS
-#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads ? n_threads : omp_get_max_threads())
-  for (size_t c = 0; c < chunks; c++) {
-    fr_ray rays[CHUNK];
-    fr_hit hits[CHUNK];
-    size_t i0 = c * CHUNK, k = n - i0 < CHUNK ? n - i0 : CHUNK, b;
-    if (!rays_pack(&r, i0, k, rays, &b)) {
-#pragma omp critical(frusta_bad_ray)
-      if (b < bad) bad = b;
-      continue;
-    }
-    fr_intersect_stream(sc, rays, hits, k);
-    for (size_t j = 0; j < k; j++) {
-      size_t i = i0 + j;
-      tp[i] = hits[j].t; up[i] = hits[j].u; vp[i] = hits[j].v; pp[i] = hits[j].prim;
-    }
-    if (np)
-      for (size_t j = 0; j < k; j++) {
-        size_t i = i0 + j;
-        np[3 * i] = hits[j].ng[0]; np[3 * i + 1] = hits[j].ng[1]; np[3 * i + 2] = hits[j].ng[2];
-      }
-  }
+  trace_arrays(sc, &r, n_threads ? n_threads : omp_get_max_threads(), reorder, &out, &bad);
   Py_END_ALLOW_THREADS
   if (bad != (size_t)-1) { bad_ray(bad); goto done; }
   result = Py_BuildValue("(OOOOO)", t, prim, u, v, ng ? (PyObject *)ng : Py_None);
@@ -390,25 +582,17 @@ done:
 
 static PyObject *scene_occluded(SceneObject *s, PyObject *args, PyObject *kw) {
   rays_in r;
-  if (!begin_trace(s, args, kw, &r, NULL, NULL)) return NULL;
+  int reorder = 0;
+  if (!begin_trace(s, args, kw, &r, NULL, NULL, &reorder)) return NULL;
   PyArrayObject *occ = out_array(&r, 0, NPY_BOOL);
   PyObject *result = NULL;
   if (!occ) goto done;
-  size_t bad = (size_t)-1, n = r.n, chunks = (n + CHUNK - 1) / CHUNK;
+  size_t bad = (size_t)-1;
+  /* numpy bools are bytes of 0 or 1, as the call writes */
+  answers out = {NULL, NULL, NULL, NULL, NULL, PyArray_DATA(occ)};
   const fr_scene *sc = s->scene;
-  uint8_t *op = PyArray_DATA(occ); /* numpy bools are bytes of 0 or 1, as the call writes */
   Py_BEGIN_ALLOW_THREADS
-#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads ? n_threads : omp_get_max_threads())
-  for (size_t c = 0; c < chunks; c++) {
-    fr_ray rays[CHUNK];
-    size_t i0 = c * CHUNK, k = n - i0 < CHUNK ? n - i0 : CHUNK, b;
-    if (!rays_pack(&r, i0, k, rays, &b)) {
-#pragma omp critical(frusta_bad_ray)
-      if (b < bad) bad = b;
-      continue;
-    }
-    fr_occluded_stream(sc, rays, op + i0, k);
-  }
+  trace_arrays(sc, &r, n_threads ? n_threads : omp_get_max_threads(), reorder, &out, &bad);
   Py_END_ALLOW_THREADS
   if (bad != (size_t)-1) { bad_ray(bad); goto done; }
   result = (PyObject *)occ;
@@ -420,8 +604,6 @@ done:
   return result;
 }
 
-/* ---- all hits ------------------------------------------------------------------- */
-
 /* One chunk's hits, packed: kept[j] of its rays' max_hits slots. */
 typedef struct chunk_hits {
   fr_hit *hits;
@@ -431,7 +613,7 @@ typedef struct chunk_hits {
 static PyObject *scene_intersect_all(SceneObject *s, PyObject *args, PyObject *kw) {
   rays_in r;
   Py_ssize_t max_hits = 16;
-  if (!begin_trace(s, args, kw, &r, &max_hits, NULL)) return NULL;
+  if (!begin_trace(s, args, kw, &r, &max_hits, NULL, NULL)) return NULL;
   /* a chunk's slots take at most 64 * CHUNK hits, however large max_hits */
   size_t K = (size_t)max_hits, n = r.n, per = K <= 64 ? CHUNK : (K >= 64 * CHUNK ? 1 : 64 * CHUNK / K);
   size_t chunks = (n + per - 1) / per;
@@ -450,8 +632,8 @@ static PyObject *scene_intersect_all(SceneObject *s, PyObject *args, PyObject *k
 #pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads ? n_threads : omp_get_max_threads())
   for (size_t c = 0; c < chunks; c++) {
     fr_ray rays[CHUNK];
-    size_t i0 = c * per, k = n - i0 < per ? n - i0 : per, b;
-    if (!rays_pack(&r, i0, k, rays, &b)) {
+    size_t i0 = c * per, k = n - i0 < per ? n - i0 : per, b = (size_t)-1;
+    if (!rays_pack(&r, NULL, i0, k, rays, &b)) {
 #pragma omp critical(frusta_bad_ray)
       if (b < bad) bad = b;
       continue;
