@@ -6,10 +6,11 @@ rtcOccluded1M on ray records packed from numpy arrays, the rays split over
 threads; bench/embree_python.c through ctypes, packing in C), and also with
 its 16-wide packets; for each workload Embree's best of those and of its two
 coherence flags counts, with its high-quality build. frusta runs in its
-default trace mode (auto) from the same arrays, and through its multi-frusta
-calls where they apply; its fastest call counts. Both return t, triangle,
-u and v (frusta's calls without normals, as Embree's hits are read here;
-its camera call with them fetches each hit triangle). Workloads per scene:
+trace modes (auto, single, hybrid16, raystream) from the same arrays, and
+through its multi-frusta calls where they apply; its fastest call counts.
+Both return t, triangle, u and v (frusta's calls without normals, as
+Embree's hits are read here; its camera call with them fetches each hit
+triangle). Workloads per scene:
 1024x1024 camera rays (frusta's camera call, and the same rays as arrays, row
 by row), shadow segments between their hits and the scene's point light
 (frusta's point-light call, and arrays from the light and to it), and 1M
@@ -147,6 +148,24 @@ def embree_variants(call):
             (lambda c=c, p16=p16: call(c, p16)) for c in (1, 0) for p16 in (0, 1)}
 
 
+def in_modes(fs, calls):
+    """The arrays calls in frusta's default trace mode (auto) and in the
+    others that lead somewhere (single, hybrid16, raystream), as Embree's
+    ways and flags are all tried."""
+    def in_mode(mode, fn):
+        fs.trace_mode = mode
+        try:
+            return fn()
+        finally:
+            fs.trace_mode = "auto"
+
+    out = dict(calls)
+    for mode in ("single", "hybrid16", "raystream"):
+        for k, fn in calls.items():
+            out[f"{k} in {mode} mode"] = lambda fn=fn, mode=mode: in_mode(mode, fn)
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=4)
@@ -199,18 +218,19 @@ def main():
                                                                        normals=False).t.reshape(-1),
                             "camera call with normals": lambda: fs.intersect_camera(eye, at, up, fov, a.size,
                                                                                     a.size).t.reshape(-1),
-                            "arrays": lambda: fs.intersect(o, d, normals=False).t},
+                            **in_modes(fs, {"arrays": lambda: fs.intersect(o, d, normals=False).t})},
                            embree_variants(lambda c, p16: em.intersect(o, d, c, p16)), len(o), agree_hits),
                 "shadow": ({"point-light call": lambda: fs.occluded_point_light(pts, L, eps),
-                            "arrays from the light": lambda: fs.occluded(*from_l),
-                            "arrays to the light": lambda: fs.occluded(*to_l)},
+                            **in_modes(fs, {"arrays from the light": lambda: fs.occluded(*from_l),
+                                            "arrays to the light": lambda: fs.occluded(*to_l)})},
                            {**{k + " from the light": fn for k, fn in
                                embree_variants(lambda c, p16: em.occluded(*from_l, c, p16)).items()},
                             **{k + " to the light": fn for k, fn in
                                embree_variants(lambda c, p16: em.occluded(*to_l, c, p16)).items()}},
                            len(pts), np.equal),
-                "random": ({"arrays": lambda: fs.intersect(ro, rd, normals=False).t,
-                            "arrays reordered": lambda: fs.intersect(ro, rd, normals=False, reorder=True).t},
+                "random": (in_modes(fs, {"arrays": lambda: fs.intersect(ro, rd, normals=False).t,
+                                         "arrays reordered": lambda: fs.intersect(ro, rd, normals=False,
+                                                                                  reorder=True).t}),
                            embree_variants(lambda c, p16: em.intersect(ro, rd, c, p16)), len(ro), agree_hits),
             }
             for wl, (f_runs, e_runs, n, same) in work.items():
