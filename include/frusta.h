@@ -225,7 +225,10 @@ unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays);
  * n independent rays. In FR_TRACE_AUTO mode the rays are sorted by direction
  * octant (in chunks of 1024, keeping their order within an octant) and each
  * group of 16 whose directions are coherent is traced as a hybrid packet;
- * the other rays of the octant go as ray streams of up to 64.
+ * the other rays of the octant go as ray streams of up to 64. An occlusion
+ * call whose packets reach most leaves with at most half of their rays
+ * (rays that part at the scale of the triangles) sends its remaining
+ * groups as ray streams too; the choice rests on the call's rays alone.
  * Order rays so that neighbours are coherent to profit (for example, pixels
  * in 4x4 blocks). The other modes trace consecutive rays together, unsorted. */
 void fr_intersect_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n);

@@ -45,6 +45,13 @@ typedef struct fr_stream_fns {
 } fr_stream_fns;
 
 /* How the packet kernels run (the switches exist for measurement). */
+/* How any-hit packets meet the leaves: the leaves they visit, and those of
+ * them that at most half of a packet's rays reach, summed over the packets
+ * that count into it. */
+typedef struct fr_packet_use {
+  uint64_t leaves, sparse_leaves;
+} fr_packet_use;
+
 typedef struct fr_packet_opts {
   int hybrid_threshold;   /* trace a popped subtree ray by ray when at most this many rays are active; 0: never */
   int uniform_threshold;  /* the same for packets whose rays share a direction octant */
@@ -53,6 +60,7 @@ typedef struct fr_packet_opts {
   int ia_cull;            /* cull nodes for the whole packet by interval arithmetic first */
   int quad_leaves;        /* leaves reached by a few rays: four rays by four triangles a test */
   const fr_trace_fns *single; /* the single-ray kernels of the same ISA and width */
+  fr_packet_use *use;     /* where not NULL, any-hit packets add their leaf visits to it */
 } fr_packet_opts;
 
 /* Packet kernels for one ISA, packet size and BVH width. valid: bit i for ray i. */

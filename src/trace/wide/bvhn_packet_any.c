@@ -72,6 +72,7 @@ static unsigned occluded_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigne
    * its rays hit its box and stay active until occluded. */
   stack_entry stack[STACK_SIZE];
   int sp = 0;
+  uint32_t leaves = 0, sparse_leaves = 0;
   unsigned occ = valid && b->planes ? planes_occluded(b->planes, &pk, &R, tfar, valid) : 0;
   if (occ == valid) return occ;
   if (valid) stack[sp++] = (stack_entry){b->root, valid, 0, 0.0f, NULL};
@@ -95,6 +96,8 @@ static unsigned occluded_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigne
         if (o->single->occluded_subtree(b, ref, &r)) occ |= 1u << i;
       }
     } else if (ref & FR_BVHN_LEAF) {
+      leaves++;
+      sparse_leaves += nactive <= P / 2;
       if (quad_wanted(o, QUAD_ANY_MOST, &quad, &pk, valid, nactive)) {
         occ |= quad_occluded(b, ref, &quad, &pk, active);
         goto next;
@@ -134,6 +137,10 @@ static unsigned occluded_rays(const fr_bvhn *b, const fr_packet_opts *o, unsigne
     }
   next:
     if (occ == valid) break;
+  }
+  if (o->use) {
+    o->use->leaves += leaves;
+    o->use->sparse_leaves += sparse_leaves;
   }
   return occ;
 }
