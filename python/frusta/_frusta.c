@@ -354,8 +354,6 @@ static int begin_trace(SceneObject *s, PyObject *args, PyObject *kw, rays_in *r,
   return 1;
 }
 
-/* ---- intersect and occluded ------------------------------------------------------ */
-
 /* ---- the order of incoherent rays ---------------------------------------------
  * Rays with random origins share no nodes with their neighbours in the
  * array, so each fetches its own path through the tree from memory. With
@@ -374,7 +372,7 @@ static int begin_trace(SceneObject *s, PyObject *args, PyObject *kw, rays_in *r,
  * ahead), and the answers, stored in the traced order, are read back in
  * the arrays' order, so that the outputs are written in runs. */
 #define ORDER_MIN (1u << 15)   /* fewer rays are traced as given */
-#define ORDER_ROUND (1u << 20) /* rays ordered at once, with 26-38 bytes of buffers each */
+#define ORDER_ROUND (1u << 20) /* rays ordered at once, with 11-38 bytes of buffers each */
 #define ORDER_KEYS 4096u       /* 16 cells per axis */
 
 /* Where the answers go: hits (intersect) or occ (occluded). */
@@ -552,6 +550,8 @@ static void trace_arrays(const fr_scene *sc, const rays_in *r, int threads, int 
   }
   if (ordering) ordered_free(&o);
 }
+
+/* ---- intersect and occluded ------------------------------------------------------ */
 
 /* normals=False: no normal array (None in its place), one output fewer to
  * allocate and fill */
