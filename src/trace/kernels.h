@@ -44,7 +44,6 @@ typedef struct fr_stream_fns {
   void (*intersect)(const fr_bvhn *b, const fr_ray *rays, const uint32_t *idx, int n, fr_hit *hits);
 } fr_stream_fns;
 
-/* How the packet kernels run (the switches exist for measurement). */
 /* How any-hit packets meet the leaves: the leaves they visit, and those of
  * them that at most half of a packet's rays reach, summed over the packets
  * that count into it. */
@@ -52,6 +51,7 @@ typedef struct fr_packet_use {
   uint64_t leaves, sparse_leaves;
 } fr_packet_use;
 
+/* How the packet kernels run (the switches exist for measurement). */
 typedef struct fr_packet_opts {
   int hybrid_threshold;   /* trace a popped subtree ray by ray when at most this many rays are active; 0: never */
   int uniform_threshold;  /* the same for packets whose rays share a direction octant */
