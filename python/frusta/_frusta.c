@@ -372,7 +372,7 @@ static int begin_trace(SceneObject *s, PyObject *args, PyObject *kw, rays_in *r,
  * ahead), and the answers, stored in the traced order, are read back in
  * the arrays' order, so that the outputs are written in runs. */
 #define ORDER_MIN (1u << 15)   /* fewer rays are traced as given */
-#define ORDER_ROUND (1u << 20) /* rays ordered at once, with 11-38 bytes of buffers each */
+#define ORDER_ROUND (1u << 20) /* rays ordered at once, with 11-42 bytes of buffers each */
 #define ORDER_KEYS 4096u       /* 16 cells per axis */
 
 /* Where the answers go: hits (intersect) or occ (occluded). */
@@ -382,23 +382,23 @@ typedef struct answers {
   uint8_t *occ;
 } answers;
 
-typedef struct traced_hit {
-  float t, u, v;
-  uint32_t prim;
-} traced_hit;
+/* Hit x of ray i into the arrays. */
+static void answer_hit(const answers *out, size_t i, const fr_hit *x) {
+  out->t[i] = x->t; out->u[i] = x->u; out->v[i] = x->v; out->prim[i] = x->prim;
+  if (out->ng) for (int a = 0; a < 3; a++) out->ng[3 * i + a] = x->ng[a];
+}
 
 typedef struct ordered {
   uint32_t *ray;   /* ray[p]: the index in the arrays of the round's p-th ray to trace */
   uint32_t *at;    /* at[i]: where the round's ray i is in that order */
   uint16_t *key;
   uint32_t *count; /* per thread, ORDER_KEYS each */
-  traced_hit *hit; /* the answers in the traced order */
-  float *ng;
+  fr_hit *hit;     /* the answers in the traced order: hits or occ */
   uint8_t *occ;
 } ordered;
 
 static void ordered_free(ordered *o) {
-  free(o->ray); free(o->at); free(o->key); free(o->count); free(o->hit); free(o->ng); free(o->occ);
+  free(o->ray); free(o->at); free(o->key); free(o->count); free(o->hit); free(o->occ);
 }
 
 /* Buffers for rounds of n rays and these answers; 0 (and none) where n is
@@ -413,7 +413,7 @@ static int ordered_alloc(ordered *o, size_t n, int threads, const answers *out) 
   o->count = malloc((size_t)threads * ORDER_KEYS * sizeof *o->count);
   int ok = o->ray && o->at && o->key && o->count;
   if (out->occ) ok = ok && (o->occ = malloc(m));
-  else ok = ok && (o->hit = malloc(m * sizeof *o->hit)) && (!out->ng || (o->ng = malloc(3 * m * sizeof *o->ng)));
+  else ok = ok && (o->hit = malloc(m * sizeof *o->hit));
   if (!ok) ordered_free(o);
   return ok;
 }
@@ -499,17 +499,12 @@ static void trace_round(const fr_scene *sc, const rays_in *r, int threads, size_
         fr_occluded_stream(sc, rays, o ? o->occ + c0 : out->occ + base + c0, k);
         continue;
       }
-      fr_intersect_stream(sc, rays, hits, k);
-      for (size_t j = 0; j < k; j++) {
-        if (o) {
-          o->hit[c0 + j] = (traced_hit){hits[j].t, hits[j].u, hits[j].v, hits[j].prim};
-          if (out->ng) for (int a = 0; a < 3; a++) o->ng[3 * (c0 + j) + a] = hits[j].ng[a];
-          continue;
-        }
-        size_t i = base + c0 + j;
-        out->t[i] = hits[j].t; out->u[i] = hits[j].u; out->v[i] = hits[j].v; out->prim[i] = hits[j].prim;
-        if (out->ng) for (int a = 0; a < 3; a++) out->ng[3 * i + a] = hits[j].ng[a];
+      if (o) {
+        fr_intersect_stream(sc, rays, o->hit + c0, k);
+        continue;
       }
+      fr_intersect_stream(sc, rays, hits, k);
+      for (size_t j = 0; j < k; j++) answer_hit(out, base + c0 + j, &hits[j]);
     }
     /* the loop's closing barrier has made `failed` final */
     if (o && !failed) {
@@ -520,12 +515,8 @@ static void trace_round(const fr_scene *sc, const rays_in *r, int threads, size_
           size_t f = o->at[i + GATHER_AHEAD];
           __builtin_prefetch(out->occ ? (const void *)&o->occ[f] : (const void *)&o->hit[f]);
         }
-        if (out->occ) {
-          out->occ[q] = o->occ[p];
-          continue;
-        }
-        out->t[q] = o->hit[p].t; out->u[q] = o->hit[p].u; out->v[q] = o->hit[p].v; out->prim[q] = o->hit[p].prim;
-        if (out->ng) for (int a = 0; a < 3; a++) out->ng[3 * q + a] = o->ng[3 * p + a];
+        if (out->occ) out->occ[q] = o->occ[p];
+        else answer_hit(out, q, &o->hit[p]);
       }
     }
   }
@@ -603,6 +594,8 @@ done:
   rays_free(&r);
   return result;
 }
+
+/* ---- all hits ------------------------------------------------------------------- */
 
 /* One chunk's hits, packed: kept[j] of its rays' max_hits slots. */
 typedef struct chunk_hits {
