@@ -15,10 +15,8 @@ Writes bench/results/python-reorder.txt and prints a markdown table.
 """
 import argparse
 import os
-import subprocess
 import sys
 import tempfile
-import time
 
 import numpy as np
 
@@ -46,9 +44,7 @@ def main():
     ap.add_argument("scenes", nargs="*", default=["kitchen", "conference", "sibenik", "dragon", "hairball"])
     a = ap.parse_args()
     frusta.set_threads(a.threads)
-    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
-    lines = [f"# commit {commit}", "# bench/python_reorder.py " + " ".join(sys.argv[1:])]
+    lines = pve.results_header("bench/python_reorder.py")
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         lib = pve.embree_library(tmp)
@@ -66,13 +62,7 @@ def main():
                     "frusta_sorted": lambda: fs.intersect(so, sd, normals=False),
                     "embree": lambda: em.intersect(o, d, False, True),
                     "embree_sorted": lambda: em.intersect(so, sd, False, True)}
-            best = {k: np.inf for k in runs}
-            for _ in range(a.repeat):
-                for k, f in runs.items():
-                    t0 = time.perf_counter()
-                    f()
-                    best[k] = min(best[k], time.perf_counter() - t0)
-            mr = {k: len(o) / t / 1e6 for k, t in best.items()}
+            mr = {k: len(o) / t / 1e6 for k, t in pve.timed(runs, a.repeat).items()}
             line = f"scene={name} rays={len(o)} threads={a.threads} " + " ".join(f"{k}={v:.2f}" for k, v in mr.items())
             print(line, flush=True)
             lines.append(line)

@@ -141,6 +141,13 @@ def timed(runs, repeat):
     return best
 
 
+def results_header(script):
+    """A results file's first lines: the commit and the command."""
+    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
+                            text=True).stdout.strip()
+    return [f"# commit {commit}", f"# {script} " + " ".join(sys.argv[1:])]
+
+
 def embree_variants(call):
     """Embree's four ways from Python: rtcIntersect1M / rtcOccluded1M or
     16-wide packets, each with the coherent and the incoherent flag."""
@@ -175,9 +182,7 @@ def main():
     ap.add_argument("scenes", nargs="*", default=["conference", "dragon"])
     a = ap.parse_args()
     frusta.set_threads(a.threads)
-    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
-    lines = [f"# commit {commit}", "# bench/python_vs_embree.py " + " ".join(sys.argv[1:])]
+    lines = results_header("bench/python_vs_embree.py")
     table = []
     with tempfile.TemporaryDirectory() as tmp:
         lib = embree_library(tmp)
