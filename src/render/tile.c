@@ -85,8 +85,14 @@ static uint64_t point_or_ao_rays(const fr_workload *w, const fr_tracer *t, fr_ti
   const int per = w->kind == FR_WL_SHADOW ? 1 : 16;
   const int m = w->kind == FR_WL_SHADOW ? point_light_rays(w, B, n) : ao_rays(w, B, n);
   t->occluded(t->ctx, B->rays, B->occ, (size_t)m, 0);
+  /* each pixel's rays are consecutive: summed per pixel, not counted ray by
+   * ray into its pixel (a chain through memory) */
   int cnt[TILE_PIX] = {0};
-  for (int k = 0; k < m; k++) cnt[B->owner[k]] += !B->occ[k];
+  for (int k = 0; k < m; k += per) {
+    int c = 0;
+    for (int j = 0; j < per; j++) c += !B->occ[k + j];
+    cnt[B->owner[k]] = c;
+  }
   for (int i = 0; i < n; i++) lit[i] = (float)cnt[i] / (float)per;
   return (uint64_t)m;
 }
