@@ -157,26 +157,43 @@ static void environment_sampling(void **st) {
   print_message("environment: exact %.4f\n", exact);
   assert_true(fabs(imp - exact) < 4.0 * se_imp + 1e-4 * exact);
   assert_true(se_imp < se_uni); /* and it pays */
-  /* the batched samples and the two-step lookups are the one-at-a-time bits */
-  enum { B = 200 };
-  float u1[B], u2[B], pdf[B];
+  /* the batched samples and lookups, in every ISA, and the two-step
+   * lookups are the one-at-a-time bits */
+  enum { B = 200 }; /* more than three chunks of 64, and a part */
+  float u1[B], u2[B], pdf[B], dx[B], dy[B], dz[B], sin_b[B];
   vec3 dir[B], le[B];
+  const float *tex[B];
   for (int k = 0; k < B; k++) u1[k] = fr_rng_float(&r), u2[k] = k % 7 ? fr_rng_float(&r) : 0.9999999f;
-  fr_env_sample_batch(&env, B, u1, u2, dir, le, pdf);
-  for (int k = 0; k < B; k++) {
-    vec3 d1 = v3(0, 0, 0);
-    float p1;
-    const vec3 l1 = fr_env_sample(&env, u1[k], u2[k], &d1, &p1);
-    assert_memory_equal(&l1, &le[k], sizeof l1);
-    assert_memory_equal(&p1, &pdf[k], sizeof p1);
-    if (p1 > 0.0f) assert_memory_equal(&d1, &dir[k], sizeof d1);
-    float pe, s, pt;
-    const vec3 a = fr_env_eval_pdf(&env, dir[k], &pe);
-    const float *t = fr_env_texel(&env, dir[k], &s);
-    const vec3 b = fr_env_texel_radiance(&env, t, s, &pt);
-    assert_memory_equal(&a, &b, sizeof a);
-    assert_memory_equal(&pe, &pt, sizeof pe);
+  const fr_isa best = fr_get_isa();
+  for (int isa = FR_ISA_SCALAR; isa <= (int)best; isa++) {
+    assert_int_equal(fr_set_isa((fr_isa)isa), FR_OK);
+    fr_env_sample_batch(&env, B, u1, u2, dir, le, pdf);
+    for (int k = 0; k < B; k++) {
+      vec3 d1 = v3(0, 0, 0);
+      float p1;
+      const vec3 l1 = fr_env_sample(&env, u1[k], u2[k], &d1, &p1);
+      assert_memory_equal(&l1, &le[k], sizeof l1);
+      assert_memory_equal(&p1, &pdf[k], sizeof p1);
+      if (p1 > 0.0f) assert_memory_equal(&d1, &dir[k], sizeof d1);
+      float pe, s, pt;
+      const vec3 a = fr_env_eval_pdf(&env, dir[k], &pe);
+      const float *t = fr_env_texel(&env, dir[k], &s);
+      const vec3 b = fr_env_texel_radiance(&env, t, s, &pt);
+      assert_memory_equal(&a, &b, sizeof a);
+      assert_memory_equal(&pe, &pt, sizeof pe);
+      /* the batch lookup's directions: the samples', and the poles and seams */
+      const vec3 q = k % 5 ? dir[k] : v3(k % 2 ? 0.0f : 1.0f, k % 3 ? 1.0f : -1.0f, 0.0f);
+      dx[k] = q.x, dy[k] = q.y, dz[k] = q.z;
+    }
+    fr_env_texel_batch(&env, B, dx, dy, dz, tex, sin_b);
+    for (int k = 0; k < B; k++) {
+      float s;
+      const float *t = fr_env_texel(&env, v3(dx[k], dy[k], dz[k]), &s);
+      assert_ptr_equal(t, tex[k]);
+      assert_memory_equal(&s, &sin_b[k], sizeof s);
+    }
   }
+  fr_set_isa(best);
   fr_env_free(&env);
 }
 

@@ -1,5 +1,6 @@
 #include "light/environment.h"
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include "base/alloc.h"
@@ -8,7 +9,6 @@
 #include "base/trig.h"
 #include "io/image_read.h"
 
-#define PI_F 3.14159265358979323846f
 
 void fr_env_constant(fr_env *e, vec3 color) {
   memset(e, 0, sizeof *e);
@@ -20,10 +20,14 @@ void fr_env_constant(fr_env *e, vec3 color) {
 fr_error fr_env_from_image(fr_env *e, float *rgb, int w, int h) {
   memset(e, 0, sizeof *e);
   e->rgb = rgb, e->w = w, e->h = h;
+  if (w <= 0 || h <= 0 || (int64_t)w * h > (INT64_C(1) << 29)) { /* texel indices (4 floats each) are ints */
+    fr_env_free(e);
+    return fr_fail(FR_ERR_ARG, "an environment image of %dx%d pixels: at most 2^29 pixels", w, h);
+  }
   float *weight = malloc(fr_mul_size(fr_mul_size((size_t)w, (size_t)h), sizeof(float)));
   if (!weight) { fr_env_free(e); return fr_fail(FR_ERR_NOMEM, "out of memory for the environment's distribution"); }
   for (int y = 0; y < h; y++) {
-    const float s = sinf(PI_F * ((float)y + 0.5f) / (float)h);
+    const float s = sinf(FR_ENV_PI * ((float)y + 0.5f) / (float)h);
     for (int x = 0; x < w; x++) {
       const float *c = rgb + 3 * ((size_t)y * w + x);
       weight[(size_t)y * w + x] = (0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]) * s;
@@ -70,24 +74,12 @@ void fr_env_free(fr_env *e) {
   memset(e, 0, sizeof *e);
 }
 
-/* dir to image coordinates (u, v) in [0, 1)^2 and sin(theta): theta =
- * acos(z) is atan2(sin theta, z), both angles in turns (base/trig.h) */
 static void to_uv(const fr_env *e, vec3 d, float *u, float *v, float *sin_t) {
-  const float z = fr_maxf(-1.0f, fr_minf(1.0f, v3_dot(d, e->az))), st = sqrtf(fr_maxf(0.0f, 1.0f - z * z));
-  float uu = fr_atan2_turns(v3_dot(d, e->ay), v3_dot(d, e->ax)) - e->rotate;
-  uu -= floorf(uu);
-  *u = uu < 1.0f ? uu : 0.0f;
-  *v = fr_minf(2.0f * fr_atan2_turns(st, z), 0.99999994f);
-  *sin_t = st;
+  fr_env_to_uv(e, d.x, d.y, d.z, u, v, sin_t);
 }
 
 /* The texel at (u, v): its r, g, b and density */
-static const float *texel(const fr_env *e, float u, float v) {
-  int x = (int)(u * (float)e->w), y = (int)(v * (float)e->h);
-  if (x >= e->w) x = e->w - 1;
-  if (y >= e->h) y = e->h - 1;
-  return e->texels + 4 * ((size_t)y * e->w + x);
-}
+static const float *texel(const fr_env *e, float u, float v) { return e->texels + 4 * (size_t)fr_env_texel_index(e, u, v); }
 
 vec3 fr_env_eval(const fr_env *e, vec3 dir) {
   if (!e->rgb) return v3_scale(e->color, e->intensity);
@@ -98,15 +90,10 @@ vec3 fr_env_eval(const fr_env *e, vec3 dir) {
 
 /* The light sample at image point (u, v) in texel (x, y). */
 static vec3 sample_at(const fr_env *e, float u, float v, int x, int y, vec3 *dir, float *pdf) {
-  const float *t = e->texels + 4 * ((size_t)y * e->w + x), puv = t[3];
-  /* theta = pi v, phi = 2 pi u + rotate: both in turns */
-  float st, ct, sp, cp, turns = u + e->rotate;
-  fr_sincos_turns(0.5f * v, &st, &ct);
-  fr_sincos_turns(turns < 1.0f ? turns : turns - 1.0f, &sp, &cp);
-  if (!(puv > 0.0f) || !(st > 0.0f)) { *pdf = 0.0f; return v3(0, 0, 0); }
-  const vec3 l = v3(st * cp, st * sp, ct);
-  *dir = v3_add(v3_add(v3_scale(e->ax, l.x), v3_scale(e->ay, l.y)), v3_scale(e->az, l.z));
-  *pdf = puv / (2.0f * PI_F * PI_F * st);
+  const float *t = e->texels + 4 * ((size_t)y * e->w + x);
+  float d[3];
+  if (!fr_env_sample_dir(e, u, v, t[3], d, pdf)) return v3(0, 0, 0);
+  *dir = v3_load(d);
   return v3_scale(v3_load(t), e->intensity);
 }
 
@@ -117,7 +104,7 @@ vec3 fr_env_sample(const fr_env *e, float u1, float u2, vec3 *dir, float *pdf) {
     float s, c;
     fr_sincos_turns(u2, &s, &c);
     *dir = v3(r * c, r * s, z);
-    *pdf = 1.0f / (4.0f * PI_F);
+    *pdf = 1.0f / (4.0f * FR_ENV_PI);
     return v3_scale(e->color, e->intensity);
   }
   float u, v;
@@ -127,21 +114,27 @@ vec3 fr_env_sample(const fr_env *e, float u1, float u2, vec3 *dir, float *pdf) {
 }
 
 void fr_env_sample_batch(const fr_env *e, size_t n, const float *u1, const float *u2, vec3 *dir, vec3 *le, float *pdf) {
+  if (e->black || !e->rgb) {
+    for (size_t j = 0; j < n; j++) le[j] = fr_env_sample(e, u1[j], u2[j], dir + j, pdf + j);
+    return;
+  }
+  const fr_isa isa = fr_get_isa();
+  if (isa == FR_ISA_AVX512) fr_env_sample_batch_avx512(e, n, u1, u2, dir, le, pdf);
+  else if (isa == FR_ISA_AVX2) fr_env_sample_batch_avx2(e, n, u1, u2, dir, le, pdf);
+  else fr_env_sample_batch_scalar(e, n, u1, u2, dir, le, pdf);
+}
+
+void fr_env_texel_batch(const fr_env *e, size_t n, const float *x, const float *y, const float *z,
+                        const float **texel, float *sin_t) {
   enum { CHUNK = 64 };
+  int at[CHUNK];
+  const fr_isa isa = fr_get_isa();
   for (size_t a = 0; a < n; a += CHUNK) {
     const size_t m = n - a < CHUNK ? n - a : CHUNK;
-    if (e->black || !e->rgb) {
-      for (size_t j = a; j < a + m; j++) le[j] = fr_env_sample(e, u1[j], u2[j], dir + j, pdf + j);
-      continue;
-    }
-    float u[CHUNK], v[CHUNK];
-    int x[CHUNK], y[CHUNK];
-    fr_dist2d_sample_batch(&e->dist, m, u1 + a, u2 + a, u, v, x, y);
-    for (size_t j = 0; j < m; j++) {
-      __builtin_prefetch(e->texels + 4 * ((size_t)y[j] * e->w + x[j]));
-      dir[a + j] = v3(0, 0, 0); /* where the sample is void */
-    }
-    for (size_t j = 0; j < m; j++) le[a + j] = sample_at(e, u[j], v[j], x[j], y[j], dir + a + j, pdf + a + j);
+    if (isa == FR_ISA_AVX512) fr_env_texel_batch_avx512(e, m, x + a, y + a, z + a, at, sin_t + a);
+    else if (isa == FR_ISA_AVX2) fr_env_texel_batch_avx2(e, m, x + a, y + a, z + a, at, sin_t + a);
+    else fr_env_texel_batch_scalar(e, m, x + a, y + a, z + a, at, sin_t + a);
+    for (size_t j = 0; j < m; j++) texel[a + j] = e->texels + 4 * (size_t)at[j];
   }
 }
 
@@ -158,13 +151,13 @@ const float *fr_env_texel(const fr_env *e, vec3 dir, float *sin_t) {
 }
 
 vec3 fr_env_texel_radiance(const fr_env *e, const float *t, float sin_t, float *pdf) {
-  if (pdf) *pdf = !(sin_t > 0.0f) ? 0.0f : t[3] / (2.0f * PI_F * PI_F * sin_t); /* 0 where black */
+  if (pdf) *pdf = !(sin_t > 0.0f) ? 0.0f : t[3] / (2.0f * FR_ENV_PI * FR_ENV_PI * sin_t); /* 0 where black */
   return v3_scale(v3_load(t), e->intensity);
 }
 
 vec3 fr_env_eval_pdf(const fr_env *e, vec3 dir, float *pdf) {
   if (!e->rgb) {
-    *pdf = e->black ? 0.0f : 1.0f / (4.0f * PI_F);
+    *pdf = e->black ? 0.0f : 1.0f / (4.0f * FR_ENV_PI);
     return v3_scale(e->color, e->intensity);
   }
   float s;

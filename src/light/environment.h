@@ -9,6 +9,8 @@
 #ifndef FR_LIGHT_ENVIRONMENT_H
 #define FR_LIGHT_ENVIRONMENT_H
 #include "base/vec3.h"
+#include <math.h>
+#include "base/trig.h"
 #include "light/distribution2d.h"
 
 typedef struct fr_env {
@@ -56,4 +58,63 @@ vec3 fr_env_texel_radiance(const fr_env *e, const float *texel, float sin_t, flo
 vec3 fr_env_eval_smooth(const fr_env *e, vec3 dir);
 /* fr_env_eval and fr_env_pdf at once (one lookup). */
 vec3 fr_env_eval_pdf(const fr_env *e, vec3 dir, float *pdf);
+/* fr_env_texel for n directions (x, y, z arrays): texel[i] and sin_t[i]
+ * the same as fr_env_texel gives for direction i, made as vector code
+ * (light/environment_batch.c). An image environment. */
+void fr_env_texel_batch(const fr_env *e, size_t n, const float *x, const float *y, const float *z,
+                        const float **texel, float *sin_t);
+
+#define FR_ENV_BATCH_FNS(isa)                                                                                     \
+  void fr_env_sample_batch_##isa(const fr_env *e, size_t n, const float *u1, const float *u2, vec3 *dir, vec3 *le,  \
+                                 float *pdf);                                                                        \
+  void fr_env_texel_batch_##isa(const fr_env *e, size_t n, const float *x, const float *y, const float *z,          \
+                                int *texel, float *sin_t);
+FR_ENV_BATCH_FNS(scalar)
+FR_ENV_BATCH_FNS(avx2)
+FR_ENV_BATCH_FNS(avx512)
+
+/* The arithmetic of the lookups and samples, inline so that the scalar
+ * calls and the batch code compiled per ISA make the same bits. */
+
+#define FR_ENV_PI 3.14159265358979323846f
+
+/* dir to image coordinates (u, v) in [0, 1)^2 and sin(theta): theta =
+ * acos(z) is atan2(sin theta, z), both angles in turns (base/trig.h). */
+static inline void fr_env_to_uv(const fr_env *e, float dx, float dy, float dz, float *u, float *v, float *sin_t) {
+  const float dotz = dx * e->az.x + dy * e->az.y + dz * e->az.z;
+  const float z = fr_maxf(-1.0f, fr_minf(1.0f, dotz)), st = sqrtf(fr_maxf(0.0f, 1.0f - z * z));
+  float uu = fr_atan2_turns(dx * e->ay.x + dy * e->ay.y + dz * e->ay.z, dx * e->ax.x + dy * e->ax.y + dz * e->ax.z) -
+             e->rotate;
+  uu -= floorf(uu);
+  *u = uu < 1.0f ? uu : 0.0f;
+  *v = fr_minf(2.0f * fr_atan2_turns(st, z), 0.99999994f);
+  *sin_t = st;
+}
+
+/* The index of the texel at (u, v) (4 w h < 2^31: fr_env_from_image). */
+static inline int fr_env_texel_index(const fr_env *e, float u, float v) {
+  int x = (int)(u * (float)e->w), y = (int)(v * (float)e->h);
+  x = x >= e->w ? e->w - 1 : x;
+  y = y >= e->h ? e->h - 1 : y;
+  return y * e->w + x;
+}
+
+/* The light sample at image point (u, v) in a texel of density puv (its
+ * fourth float): its direction (d[3]) and pdf, and whether there is one
+ * (0 where the density or sin theta is 0: then pdf 0, radiance 0 and d
+ * meaningless). Its radiance: the texel's colour times the intensity. */
+static inline int fr_env_sample_dir(const fr_env *e, float u, float v, float puv, float d[3], float *pdf) {
+  /* theta = pi v, phi = 2 pi u + rotate: both in turns */
+  float st, ct, sp, cp, turns = u + e->rotate;
+  fr_sincos_turns(0.5f * v, &st, &ct);
+  fr_sincos_turns(turns < 1.0f ? turns : turns - 1.0f, &sp, &cp);
+  const float lx = st * cp, ly = st * sp;
+  d[0] = e->ax.x * lx + e->ay.x * ly + e->az.x * ct;
+  d[1] = e->ax.y * lx + e->ay.y * ly + e->az.y * ct;
+  d[2] = e->ax.z * lx + e->ay.z * ly + e->az.z * ct;
+  const int some = (puv > 0.0f) & (st > 0.0f);
+  const float p = puv / (2.0f * FR_ENV_PI * FR_ENV_PI * st);
+  *pdf = some ? p : 0.0f;
+  return some;
+}
 #endif

@@ -204,16 +204,15 @@ static void env_block_sample(const fr_path_setup *P, const float (*pts)[POINT_BL
   const fr_env *e = P->lights.env;
   const int n = light_count(&P->lights);
   if (e->black || !e->rgb) return; /* nothing to fetch */
-  float u1[POINT_BLOCK], u2[POINT_BLOCK], pdf[POINT_BLOCK];
+  float u1[POINT_BLOCK], u2[POINT_BLOCK], pdf[POINT_BLOCK], sx[POINT_BLOCK], sy[POINT_BLOCK], sz[POINT_BLOCK];
+  float sin_t[POINT_BLOCK];
+  const float *tex[POINT_BLOCK];
   vec3 dir[POINT_BLOCK], le[POINT_BLOCK];
-  uint8_t idx[POINT_BLOCK];
-  size_t c = 0;
+  uint8_t idx[POINT_BLOCK], sky[POINT_BLOCK];
+  size_t c = 0, ns = 0;
   for (size_t j = 0; j < m; j++) {
     if (hit[j].prim == FR_INVALID_ID) { /* a bounce into the sky (the camera's see it filtered) */
-      if (st[j].depth > 0) {
-        eb->sky[j] = fr_env_texel(e, v3_load(ray[j].dir), &eb->sky_sin[j]);
-        __builtin_prefetch(eb->sky[j]);
-      }
+      if (st[j].depth > 0) sx[ns] = ray[j].dir[0], sy[ns] = ray[j].dir[1], sz[ns] = ray[j].dir[2], sky[ns++] = (uint8_t)j;
       continue;
     }
     float uc, ul;
@@ -221,6 +220,11 @@ static void env_block_sample(const fr_path_setup *P, const float (*pts)[POINT_BL
     if (light_pick(n, uc) != 0) continue; /* the environment is light 0 */
     path_point(P, pts, j, st + j, dim, 1, &u1[c], &u2[c]);
     idx[c++] = (uint8_t)j;
+  }
+  fr_env_texel_batch(e, ns, sx, sy, sz, tex, sin_t);
+  for (size_t q = 0; q < ns; q++) {
+    eb->sky[sky[q]] = tex[q], eb->sky_sin[sky[q]] = sin_t[q];
+    __builtin_prefetch(tex[q]);
   }
   fr_env_sample_batch(e, c, u1, u2, dir, le, pdf);
   for (size_t q = 0; q < c; q++) {
