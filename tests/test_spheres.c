@@ -201,16 +201,20 @@ static void test_packets_and_streams(void **state) {
   static fr_hit ref[N], h[N];
   static uint8_t occ_ref[N], occ[N];
   for (int i = 0; i < N; i++) rays[i] = scene_ray(&g, s, v3(0, 0, 0), 1.0f);
+  /* a few rays no call may trace: NaN, an empty range, no direction */
+  rays[5].dir[1] = NAN, rays[21].tnear = 2.0f, rays[21].tfar = 1.0f, rays[37].dir[0] = rays[37].dir[1] = rays[37].dir[2] = 0.0f;
   for (int i = 0; i < N; i++) {
     fr_intersect1(s, &rays[i], &ref[i]);
     occ_ref[i] = (uint8_t)fr_occluded1(s, &rays[i]);
   }
-  static const fr_trace_mode modes[] = {FR_TRACE_SINGLE, FR_TRACE_PACKET8, FR_TRACE_PACKET16, FR_TRACE_HYBRID16, FR_TRACE_AUTO};
+  static const fr_trace_mode modes[] = {FR_TRACE_SINGLE,   FR_TRACE_PACKET8, FR_TRACE_PACKET16,
+                                        FR_TRACE_HYBRID16, FR_TRACE_AUTO,    FR_TRACE_RAYSTREAM};
+  enum { MODES = sizeof modes / sizeof modes[0] };
   uint32_t base = (uint32_t)fr_scene_triangle_count(s);
   for (int isa = 0; isa < 3; isa++) {
     if (!fr_isa_supported((fr_isa)isa)) continue;
     fr_set_isa((fr_isa)isa);
-    for (int m = 0; m < 5; m++) {
+    for (int m = 0; m < MODES; m++) {
       fr_tuning o;
       fr_tuning_default(&o);
       o.mode = modes[m];

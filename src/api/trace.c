@@ -38,17 +38,69 @@ static const fr_packet_fns *packet_fns(const fr_scene *s, int size, int threshol
   return w8 ? k->p16w8 : k->p16w4;
 }
 
-/* Spheres are traced after the triangles, ray by ray, their closest hit
- * bounded by the triangles'; a scene without spheres skips this. */
+/* Spheres are traced after the triangles, 16 consecutive rays at a time
+ * (trace/sphere_packet.c), each ray's closest hit bounded by the
+ * triangles'; a scene without spheres skips this. */
 static inline int has_spheres(const fr_scene *s) { return s->sphere_bvh.nprims != 0; }
 
+/* Lane i of R gets ray r, bounded by tfar. */
+static void sphere_lane(fr_sphere_rays16 *R, int i, const fr_ray *r, float tfar) {
+  for (int a = 0; a < 3; a++) R->o[a][i] = r->org[a], R->d[a][i] = r->dir[a];
+  R->tnear[i] = r->tnear, R->tfar[i] = tfar;
+}
+
+/* rays[idx[0..m)] (m <= 16) and their hits so far; hits nearer on a sphere
+ * are overwritten. */
+static void spheres_group(const fr_scene *s, const fr_ray *rays, const uint32_t *idx, int m, fr_hit *hits) {
+  fr_sphere_rays16 R;
+  memset(&R, 0, sizeof R);
+  unsigned active = 0;
+  for (int i = 0; i < m; i++) {
+    const fr_ray *r = &rays[idx[i]];
+    const fr_hit *h = &hits[idx[i]];
+    if (fr_ray_invalid(r)) continue;
+    sphere_lane(&R, i, r, h->prim == FR_INVALID_ID ? r->tfar : h->t);
+    active |= 1u << i;
+  }
+  unsigned found = fr_kernels_active()->spheres16(&s->sphere_bvh, &R, active, 0);
+  for (; found; found &= found - 1) {
+    const int i = __builtin_ctz(found);
+    fr_spheres_hit(&s->sphere_bvh, fr_scene_sphere_base(s), &rays[idx[i]], R.li[i], R.tfar[i], &hits[idx[i]]);
+  }
+}
+
+/* The same for any hits: the rays not yet occluded; returns those a sphere
+ * occludes (bit i for idx[i]). */
+static unsigned spheres_group_occluded(const fr_scene *s, const fr_ray *rays, const uint32_t *idx, int m,
+                                       unsigned done) {
+  fr_sphere_rays16 R;
+  memset(&R, 0, sizeof R);
+  unsigned active = 0;
+  for (int i = 0; i < m; i++) {
+    const fr_ray *r = &rays[idx[i]];
+    if ((done >> i) & 1 || fr_ray_invalid(r)) continue;
+    sphere_lane(&R, i, r, r->tfar);
+    active |= 1u << i;
+  }
+  return fr_kernels_active()->spheres16(&s->sphere_bvh, &R, active, 1);
+}
+
+static const uint32_t identity_idx[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
+
 static void spheres_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
-  for (size_t i = 0; i < n; i++) fr_spheres_intersect1(&s->sphere_bvh, fr_scene_sphere_base(s), &rays[i], &hits[i]);
+  for (size_t g = 0; g < n; g += 16)
+    spheres_group(s, rays + g, identity_idx, n - g < 16 ? (int)(n - g) : 16, hits + g);
 }
 
 static void spheres_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
-  for (size_t i = 0; i < n; i++)
-    if (!occ[i]) occ[i] = (uint8_t)fr_spheres_occluded1(&s->sphere_bvh, &rays[i]);
+  for (size_t g = 0; g < n; g += 16) {
+    const int m = n - g < 16 ? (int)(n - g) : 16;
+    unsigned done = 0;
+    for (int i = 0; i < m; i++) done |= (unsigned)(occ[g + (size_t)i] != 0) << i;
+    if (done == (1u << m) - 1u) continue;
+    const unsigned o = spheres_group_occluded(s, rays + g, identity_idx, m, done);
+    for (int i = 0; i < m; i++) occ[g + (size_t)i] |= (uint8_t)((o >> i) & 1);
+  }
 }
 
 static fr_ray lane_ray(const fr_ray16 *r, int i) {
@@ -125,13 +177,16 @@ void fr_intersect16(const fr_scene *s, unsigned valid, const fr_ray16 *rays, fr_
     hit16_set(hits, i, &h);
   }
   if (!has_spheres(s)) return;
-  for (unsigned m = valid & 0xFFFF; m; m &= m - 1) {
-    int i = __builtin_ctz(m);
-    fr_ray r = lane_ray(rays, i);
-    fr_hit h = {hits->t[i], hits->u[i], hits->v[i], hits->prim[i], {hits->ng_x[i], hits->ng_y[i], hits->ng_z[i]}};
-    fr_spheres_intersect1(&s->sphere_bvh, fr_scene_sphere_base(s), &r, &h);
-    hit16_set(hits, i, &h);
+  fr_ray r[16];
+  fr_hit h[16];
+  int lane[16], k = 0;
+  for (unsigned m = valid & 0xFFFF; m; m &= m - 1, k++) {
+    const int i = lane[k] = __builtin_ctz(m);
+    r[k] = lane_ray(rays, i);
+    h[k] = (fr_hit){hits->t[i], hits->u[i], hits->v[i], hits->prim[i], {hits->ng_x[i], hits->ng_y[i], hits->ng_z[i]}};
   }
+  spheres_group(s, r, identity_idx, k, h);
+  for (int j = 0; j < k; j++) hit16_set(hits, lane[j], &h[j]);
 }
 
 unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays) {
@@ -145,12 +200,19 @@ unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays) 
     fr_ray r = lane_ray(rays, i);
     occ |= (unsigned)occluded_behind(s, &r) << i;
   }
-  if (has_spheres(s))
-    for (unsigned m = valid & 0xFFFF & ~occ; m; m &= m - 1) {
-      int i = __builtin_ctz(m);
-      fr_ray r = lane_ray(rays, i);
-      occ |= (unsigned)fr_spheres_occluded1(&s->sphere_bvh, &r) << i;
+  if (has_spheres(s)) {
+    fr_ray r[16];
+    memset(r, 0, sizeof r);
+    int lane[16], k = 0;
+    unsigned done = 0;
+    for (unsigned m = valid & 0xFFFF; m; m &= m - 1, k++) {
+      const int i = lane[k] = __builtin_ctz(m);
+      r[k] = lane_ray(rays, i);
+      done |= ((occ >> i) & 1u) << k;
     }
+    const unsigned o = spheres_group_occluded(s, r, identity_idx, k, done);
+    for (int j = 0; j < k; j++) occ |= ((o >> j) & 1u) << lane[j];
+  }
   return occ;
 }
 
@@ -216,8 +278,6 @@ static int chunk_order(const fr_ray *rays, const uint32_t *sel, size_t n, uint32
     }
   return runs;
 }
-
-static const uint32_t identity_idx[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
 
 /* Whether a packet of these rays pays: their unit directions lie within
  * chord length spread of the first ray's. A packet's rays then visit nearly

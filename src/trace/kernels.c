@@ -43,7 +43,7 @@ const char *fr_isa_name(fr_isa isa) {
   static const fr_kernels kernels_##isa = {ISA, &fr_trace_w4_##isa, &fr_trace_w8_##isa,              \
                                            &fr_packet_p8_w4_##isa, &fr_packet_p16_w4_##isa,         \
                                            &fr_packet_p8_w8_##isa, &fr_packet_p16_w8_##isa,        \
-                                           &fr_stream_w4_##isa, &fr_stream_w8_##isa};
+                                           &fr_stream_w4_##isa, &fr_stream_w8_##isa, fr_spheres16_##isa};
 FR_KERNELS(avx512, FR_ISA_AVX512)
 FR_KERNELS(avx2, FR_ISA_AVX2)
 FR_KERNELS(scalar, FR_ISA_SCALAR)

@@ -75,11 +75,20 @@ typedef struct fr_packet_fns {
   unsigned (*occluded_idx)(const fr_bvhn *b, const fr_packet_opts *o, const fr_ray *rays, const uint32_t *idx, int n);
 } fr_packet_fns;
 
+/* Sixteen rays through the sphere tree (trace/sphere_packet.c): the lanes
+ * of active (valid rays) that hit a sphere in (tnear, tfar); for closest
+ * hits (any 0) their tfar lowered to the hit and li set, each lane the
+ * single-ray walk's answer. */
+struct fr_bvh2;
+struct fr_sphere_rays16;
+typedef unsigned (*fr_spheres16_fn)(const struct fr_bvh2 *b, struct fr_sphere_rays16 *r, unsigned active, int any);
+
 typedef struct fr_kernels {
   fr_isa isa;
   const fr_trace_fns *w4, *w8;
   const fr_packet_fns *p8w4, *p16w4, *p8w8, *p16w8;
   const fr_stream_fns *s4, *s8;
+  fr_spheres16_fn spheres16;
 } fr_kernels;
 
 extern const fr_trace_fns fr_trace_w4_avx512, fr_trace_w4_avx2, fr_trace_w4_scalar;
@@ -95,6 +104,10 @@ FR_DECLARE_PACKET(scalar)
 
 /* The kernels in use: the best the CPU has, unless FRUSTA_ISA or fr_set_isa
  * chose another. */
+unsigned fr_spheres16_avx512(const struct fr_bvh2 *b, struct fr_sphere_rays16 *r, unsigned active, int any);
+unsigned fr_spheres16_avx2(const struct fr_bvh2 *b, struct fr_sphere_rays16 *r, unsigned active, int any);
+unsigned fr_spheres16_scalar(const struct fr_bvh2 *b, struct fr_sphere_rays16 *r, unsigned active, int any);
+
 const fr_kernels *fr_kernels_active(void);
 
 /* Shared by the kernels and the reference path: the hit of a miss. */

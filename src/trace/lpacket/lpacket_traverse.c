@@ -16,6 +16,7 @@
 #include "base/simd_packet.h"
 #include "trace/counters.h"
 #include "trace/lpacket/lpacket.h"
+#include "trace/sphere16.h"
 #include "trace/tri_edges16.h"
 
 #if P != 16
@@ -90,26 +91,12 @@ FR_INLINE unsigned tri16(fr_lpacket *p, int c, const fr_bvh2_tri *r, edges16 *e,
  * operations lane by lane, so the answers are fr_intersect1's bit for bit. */
 FR_INLINE unsigned sphere16(fr_lpacket *p, int c, const fr_sphere *s, uint32_t li, unsigned m, int closest) {
   const int i = 16 * c;
-  vpf dx = vp_load(p->d[0] + i), dy = vp_load(p->d[1] + i), dz = vp_load(p->d[2] + i);
-  vpf fx = vp_sub(vp_load(p->o[0] + i), vp(s->c[0]));
-  vpf fy = vp_sub(vp_load(p->o[1] + i), vp(s->c[1]));
-  vpf fz = vp_sub(vp_load(p->o[2] + i), vp(s->c[2]));
+  const vpf o[3] = {vp_load(p->o[0] + i), vp_load(p->o[1] + i), vp_load(p->o[2] + i)};
+  const vpf d[3] = {vp_load(p->d[0] + i), vp_load(p->d[1] + i), vp_load(p->d[2] + i)};
+  const vpf tf = vp_load(p->tfar + i);
+  vpf t;
   FR_COUNT(lp_sph_chunks, 1);
-  vpf a = vp_add(vp_add(vp_mul(dx, dx), vp_mul(dy, dy)), vp_mul(dz, dz));
-  vpf b = vp_xor(vp_add(vp_add(vp_mul(fx, dx), vp_mul(fy, dy)), vp_mul(fz, dz)), vp(-0.0f));
-  vpf tc = vp_div(b, a);
-  vpf lx = vp_add(fx, vp_mul(tc, dx)), ly = vp_add(fy, vp_mul(tc, dy)), lz = vp_add(fz, vp_mul(tc, dz));
-  vpf r2 = vp(s->r * s->r);
-  vpf h = vp_sub(r2, vp_add(vp_add(vp_mul(lx, lx), vp_mul(ly, ly)), vp_mul(lz, lz)));
-  m &= vpm_bits(vp_ge(h, vp(0.0f)));
-  if (!m) return 0;
-  vpf cc = vp_sub(vp_add(vp_add(vp_mul(fx, fx), vp_mul(fy, fy)), vp_mul(fz, fz)), r2);
-  vpf q = vp_add(b, vp_copysign(vp_sqrt(vp_mul(a, h)), b));
-  vpf t1 = vp_div(q, a), t2 = vp_select(vp_eq(q, vp(0.0f)), t1, vp_div(cc, q));
-  vpf tn = vp_load(p->tnear + i), tf = vp_load(p->tfar + i);
-  vpf near = vp_min(t1, t2), far = vp_max(t2, t1);
-  vpf t = vp_select(vp_gt(near, tn), near, far);
-  m &= vpm_bits(vpm_and(vp_gt(t, tn), vp_lt(t, tf)));
+  m = fr_sphere16_hit(s, o, d, vp_load(p->tnear + i), tf, m, &t);
   if (!m || !closest) return m;
   vpm hm = vpm_bits_to(m);
   vp_store(p->tfar + i, vp_select(hm, t, tf));
