@@ -19,7 +19,7 @@ static inline void fr_sincos_turns(float u, float *s, float *c) {
   const int k = q & 3;
   const float a = k & 1 ? cs : sn, b = k & 1 ? sn : cs;
   *s = k & 2 ? -a : a;
-  *c = (k == 1 || k == 2) ? -b : b;
+  *c = (k == 1) | (k == 2) ? -b : b;
 }
 
 /* atan2(y, x) / (2 pi), in [-1/2, 1/2] (atan2's signs and zeros): the
@@ -28,7 +28,7 @@ static inline void fr_sincos_turns(float u, float *s, float *c) {
  * toward the largest errors), then placed in its octant. */
 static inline float fr_atan2_turns(float y, float x) {
   const float ax = fabsf(x), ay = fabsf(y), mx = ax > ay ? ax : ay, mn = ax > ay ? ay : ax;
-  const float t = mx > 0.0f ? mn / mx : 0.0f, t2 = t * t;
+  const float q = mn / mx, t = mx > 0.0f ? q : 0.0f, t2 = t * t; /* divided first: a select, no branch */
   float a = t * (9.999993443e-01f +
                  t2 * (-3.332986236e-01f +
                        t2 * (1.994656920e-01f +
