@@ -49,15 +49,15 @@ static void sphere_lane(fr_sphere_rays16 *R, int i, const fr_ray *r, float tfar)
   R->tnear[i] = r->tnear, R->tfar[i] = tfar;
 }
 
-/* rays[idx[0..m)] (m <= 16) and their hits so far; hits nearer on a sphere
- * are overwritten. */
-static void spheres_group(const fr_scene *s, const fr_ray *rays, const uint32_t *idx, int m, fr_hit *hits) {
+/* rays[0..m) (m <= 16) and their hits so far; hits nearer on a sphere are
+ * overwritten. */
+static void spheres_group(const fr_scene *s, const fr_ray *rays, int m, fr_hit *hits) {
   fr_sphere_rays16 R;
   memset(&R, 0, sizeof R);
   unsigned active = 0;
   for (int i = 0; i < m; i++) {
-    const fr_ray *r = &rays[idx[i]];
-    const fr_hit *h = &hits[idx[i]];
+    const fr_ray *r = &rays[i];
+    const fr_hit *h = &hits[i];
     if (fr_ray_invalid(r)) continue;
     sphere_lane(&R, i, r, h->prim == FR_INVALID_ID ? r->tfar : h->t);
     active |= 1u << i;
@@ -65,19 +65,18 @@ static void spheres_group(const fr_scene *s, const fr_ray *rays, const uint32_t 
   unsigned found = fr_kernels_active()->spheres16(&s->sphere_bvh, &R, active, 0);
   for (; found; found &= found - 1) {
     const int i = __builtin_ctz(found);
-    fr_spheres_hit(&s->sphere_bvh, fr_scene_sphere_base(s), &rays[idx[i]], R.li[i], R.tfar[i], &hits[idx[i]]);
+    fr_spheres_hit(&s->sphere_bvh, fr_scene_sphere_base(s), &rays[i], R.li[i], R.tfar[i], &hits[i]);
   }
 }
 
-/* The same for any hits: the rays not yet occluded; returns those a sphere
- * occludes (bit i for idx[i]). */
-static unsigned spheres_group_occluded(const fr_scene *s, const fr_ray *rays, const uint32_t *idx, int m,
-                                       unsigned done) {
+/* The same for any hits: the rays not done (bit i) yet; returns those a
+ * sphere occludes. */
+static unsigned spheres_group_occluded(const fr_scene *s, const fr_ray *rays, int m, unsigned done) {
   fr_sphere_rays16 R;
   memset(&R, 0, sizeof R);
   unsigned active = 0;
   for (int i = 0; i < m; i++) {
-    const fr_ray *r = &rays[idx[i]];
+    const fr_ray *r = &rays[i];
     if ((done >> i) & 1 || fr_ray_invalid(r)) continue;
     sphere_lane(&R, i, r, r->tfar);
     active |= 1u << i;
@@ -85,11 +84,9 @@ static unsigned spheres_group_occluded(const fr_scene *s, const fr_ray *rays, co
   return fr_kernels_active()->spheres16(&s->sphere_bvh, &R, active, 1);
 }
 
-static const uint32_t identity_idx[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
-
 static void spheres_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
   for (size_t g = 0; g < n; g += 16)
-    spheres_group(s, rays + g, identity_idx, n - g < 16 ? (int)(n - g) : 16, hits + g);
+    spheres_group(s, rays + g, n - g < 16 ? (int)(n - g) : 16, hits + g);
 }
 
 static void spheres_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
@@ -98,7 +95,7 @@ static void spheres_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8
     unsigned done = 0;
     for (int i = 0; i < m; i++) done |= (unsigned)(occ[g + (size_t)i] != 0) << i;
     if (done == (1u << m) - 1u) continue;
-    const unsigned o = spheres_group_occluded(s, rays + g, identity_idx, m, done);
+    const unsigned o = spheres_group_occluded(s, rays + g, m, done);
     for (int i = 0; i < m; i++) occ[g + (size_t)i] |= (uint8_t)((o >> i) & 1);
   }
 }
@@ -185,7 +182,7 @@ void fr_intersect16(const fr_scene *s, unsigned valid, const fr_ray16 *rays, fr_
     r[k] = lane_ray(rays, i);
     h[k] = (fr_hit){hits->t[i], hits->u[i], hits->v[i], hits->prim[i], {hits->ng_x[i], hits->ng_y[i], hits->ng_z[i]}};
   }
-  spheres_group(s, r, identity_idx, k, h);
+  spheres_group(s, r, k, h);
   for (int j = 0; j < k; j++) hit16_set(hits, lane[j], &h[j]);
 }
 
@@ -210,7 +207,7 @@ unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays) 
       r[k] = lane_ray(rays, i);
       done |= ((occ >> i) & 1u) << k;
     }
-    const unsigned o = spheres_group_occluded(s, r, identity_idx, k, done);
+    const unsigned o = spheres_group_occluded(s, r, k, done);
     for (int j = 0; j < k; j++) occ |= ((o >> j) & 1u) << lane[j];
   }
   return occ;
@@ -278,6 +275,8 @@ static int chunk_order(const fr_ray *rays, const uint32_t *sel, size_t n, uint32
     }
   return runs;
 }
+
+static const uint32_t identity_idx[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
 
 /* Whether a packet of these rays pays: their unit directions lie within
  * chord length spread of the first ray's. A packet's rays then visit nearly

@@ -9,7 +9,6 @@
 #include "base/trig.h"
 #include "io/image_read.h"
 
-
 void fr_env_constant(fr_env *e, vec3 color) {
   memset(e, 0, sizeof *e);
   e->color = color;
