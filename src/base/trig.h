@@ -19,7 +19,7 @@ static inline void fr_sincos_turns(float u, float *s, float *c) {
   const int k = q & 3;
   const float a = k & 1 ? cs : sn, b = k & 1 ? sn : cs;
   *s = k & 2 ? -a : a;
-  *c = (k == 1) | (k == 2) ? -b : b;
+  *c = ((k == 1) | (k == 2)) ? -b : b;
 }
 
 /* atan2(y, x) / (2 pi), in [-1/2, 1/2] (atan2's signs and zeros): the
