@@ -32,7 +32,7 @@ void fr_dist2d_sample(const fr_dist2d *d, float u1, float u2, float *u, float *v
 float fr_dist2d_pdf(const fr_dist2d *d, int x, int y);
 
 /* The searches' steps, inline so that the batch code (light/
- * environment_batch.c, compiled per ISA) makes the same bits. */
+ * environment_lanes.c, compiled per ISA) makes the same bits. */
 
 /* The guide slot of u among n intervals. */
 static inline int fr_dist2d_slot(int n, float u) {

@@ -112,31 +112,6 @@ vec3 fr_env_sample(const fr_env *e, float u1, float u2, vec3 *dir, float *pdf) {
   return sample_at(e, u, v, x, y, dir, pdf);
 }
 
-void fr_env_sample_batch(const fr_env *e, size_t n, const float *u1, const float *u2, vec3 *dir, vec3 *le, float *pdf) {
-  if (e->black || !e->rgb) {
-    for (size_t j = 0; j < n; j++) le[j] = fr_env_sample(e, u1[j], u2[j], dir + j, pdf + j);
-    return;
-  }
-  const fr_isa isa = fr_get_isa();
-  if (isa == FR_ISA_AVX512) fr_env_sample_batch_avx512(e, n, u1, u2, dir, le, pdf);
-  else if (isa == FR_ISA_AVX2) fr_env_sample_batch_avx2(e, n, u1, u2, dir, le, pdf);
-  else fr_env_sample_batch_scalar(e, n, u1, u2, dir, le, pdf);
-}
-
-void fr_env_texel_batch(const fr_env *e, size_t n, const float *x, const float *y, const float *z,
-                        const float **texel, float *sin_t) {
-  enum { CHUNK = 64 };
-  int at[CHUNK];
-  const fr_isa isa = fr_get_isa();
-  for (size_t a = 0; a < n; a += CHUNK) {
-    const size_t m = n - a < CHUNK ? n - a : CHUNK;
-    if (isa == FR_ISA_AVX512) fr_env_texel_batch_avx512(e, m, x + a, y + a, z + a, at, sin_t + a);
-    else if (isa == FR_ISA_AVX2) fr_env_texel_batch_avx2(e, m, x + a, y + a, z + a, at, sin_t + a);
-    else fr_env_texel_batch_scalar(e, m, x + a, y + a, z + a, at, sin_t + a);
-    for (size_t j = 0; j < m; j++) texel[a + j] = e->texels + 4 * (size_t)at[j];
-  }
-}
-
 float fr_env_pdf(const fr_env *e, vec3 dir) {
   float pdf;
   fr_env_eval_pdf(e, dir, &pdf);

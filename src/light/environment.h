@@ -60,7 +60,7 @@ vec3 fr_env_eval_smooth(const fr_env *e, vec3 dir);
 vec3 fr_env_eval_pdf(const fr_env *e, vec3 dir, float *pdf);
 /* fr_env_texel for n directions (x, y, z arrays): texel[i] and sin_t[i]
  * the same as fr_env_texel gives for direction i, made as vector code
- * (light/environment_batch.c). An image environment. */
+ * (light/environment_lanes.c). An image environment. */
 void fr_env_texel_batch(const fr_env *e, size_t n, const float *x, const float *y, const float *z,
                         const float **texel, float *sin_t);
 

@@ -101,13 +101,12 @@ extern const fr_stream_fns fr_stream_w8_avx512, fr_stream_w8_avx2, fr_stream_w8_
 FR_DECLARE_PACKET(avx512)
 FR_DECLARE_PACKET(avx2)
 FR_DECLARE_PACKET(scalar)
-
-/* The kernels in use: the best the CPU has, unless FRUSTA_ISA or fr_set_isa
- * chose another. */
 unsigned fr_spheres16_avx512(const struct fr_bvh2 *b, struct fr_sphere_rays16 *r, unsigned active, int any);
 unsigned fr_spheres16_avx2(const struct fr_bvh2 *b, struct fr_sphere_rays16 *r, unsigned active, int any);
 unsigned fr_spheres16_scalar(const struct fr_bvh2 *b, struct fr_sphere_rays16 *r, unsigned active, int any);
 
+/* The kernels in use: the best the CPU has, unless FRUSTA_ISA or fr_set_isa
+ * chose another. */
 const fr_kernels *fr_kernels_active(void);
 
 /* Shared by the kernels and the reference path: the hit of a miss. */
