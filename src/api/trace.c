@@ -239,6 +239,7 @@ static inline unsigned ray_octant(const fr_ray *r) {
  * run_end[r] ends the r-th run, the rays of one octant. Returns the number
  * of runs. */
 static int chunk_order(const fr_ray *rays, const uint32_t *sel, size_t n, uint32_t *order, size_t *run_end) {
+  size_t start[9] = {0};
   uint8_t oct[STREAM_CHUNK];
   unsigned some = 0, every = 7;
   for (size_t i = 0; i < n; i++) {
@@ -251,28 +252,15 @@ static int chunk_order(const fr_ray *rays, const uint32_t *sel, size_t n, uint32
     run_end[0] = n;
     return 1;
   }
-  /* The rays fall into four quarters, each counted and placed with its own
-   * counters (in order, so the sort stays stable): a single counter
-   * incremented ray after ray is a chain through memory, four are
-   * independent. */
-  size_t cnt[4][8] = {{0}}, pos[4][8];
-  const size_t len = (n + 3) / 4;
-  for (size_t i = 0; i < len; i++)
-    for (int q = 0; q < 4; q++) {
-      const size_t j = (size_t)q * len + i;
-      if (j < n) cnt[q][oct[j]]++;
-    }
+  /* counted apart from the scan above: one counter incremented ray after ray
+   * is a chain through memory, and most chunks never need the counts */
+  for (size_t i = 0; i < n; i++) start[oct[i] + 1]++;
   int runs = 0;
-  size_t at = 0;
   for (int o = 0; o < 8; o++) {
-    for (int q = 0; q < 4; q++) pos[q][o] = at, at += cnt[q][o];
-    if (at > (runs ? run_end[runs - 1] : 0)) run_end[runs++] = at;
+    start[o + 1] += start[o];
+    if (start[o + 1] > start[o]) run_end[runs++] = start[o + 1];
   }
-  for (size_t i = 0; i < len; i++)
-    for (int q = 0; q < 4; q++) {
-      const size_t j = (size_t)q * len + i;
-      if (j < n) order[pos[q][oct[j]]++] = sel ? sel[j] : (uint32_t)j;
-    }
+  for (size_t i = 0; i < n; i++) order[start[oct[i]]++] = sel ? sel[i] : (uint32_t)i;
   return runs;
 }
 
