@@ -49,44 +49,31 @@ static void sphere_lane(fr_sphere_rays16 *R, int i, const fr_ray *r, float tfar)
   R->tnear[i] = r->tnear, R->tfar[i] = tfar;
 }
 
-/* rays[0..m) (m <= 16) and their hits so far; hits nearer on a sphere are
- * overwritten. */
-static void spheres_group(const fr_scene *s, const fr_ray *rays, int m, fr_hit *hits) {
-  fr_sphere_rays16 R;
-  memset(&R, 0, sizeof R);
-  unsigned active = 0;
-  for (int i = 0; i < m; i++) {
-    const fr_ray *r = &rays[i];
-    const fr_hit *h = &hits[i];
-    if (fr_ray_invalid(r)) continue;
-    sphere_lane(&R, i, r, h->prim == FR_INVALID_ID ? r->tfar : h->t);
-    active |= 1u << i;
-  }
-  unsigned found = fr_kernels_active()->spheres16(&s->sphere_bvh, &R, active, 0);
-  for (; found; found &= found - 1) {
-    const int i = __builtin_ctz(found);
-    fr_spheres_hit(&s->sphere_bvh, fr_scene_sphere_base(s), &rays[i], R.li[i], R.tfar[i], &hits[i]);
-  }
-}
-
-/* The same for any hits: the rays not done (bit i) yet; returns those a
- * sphere occludes. */
-static unsigned spheres_group_occluded(const fr_scene *s, const fr_ray *rays, int m, unsigned done) {
+/* rays[0..m) (m <= 16) but those of `done` against the spheres: closest
+ * hits where hits is not NULL (each ray bounded by its hit so far, which a
+ * nearer sphere overwrites), else any hits, the rays occluded returned. */
+static unsigned spheres_group(const fr_scene *s, const fr_ray *rays, int m, unsigned done, fr_hit *hits) {
   fr_sphere_rays16 R;
   memset(&R, 0, sizeof R);
   unsigned active = 0;
   for (int i = 0; i < m; i++) {
     const fr_ray *r = &rays[i];
     if ((done >> i) & 1 || fr_ray_invalid(r)) continue;
-    sphere_lane(&R, i, r, r->tfar);
+    sphere_lane(&R, i, r, hits && hits[i].prim != FR_INVALID_ID ? hits[i].t : r->tfar);
     active |= 1u << i;
   }
-  return fr_kernels_active()->spheres16(&s->sphere_bvh, &R, active, 1);
+  const unsigned found = fr_kernels_active()->spheres16(&s->sphere_bvh, &R, active, !hits);
+  if (hits)
+    for (unsigned f = found; f; f &= f - 1) {
+      const int i = __builtin_ctz(f);
+      fr_spheres_hit(&s->sphere_bvh, fr_scene_sphere_base(s), &rays[i], R.li[i], R.tfar[i], &hits[i]);
+    }
+  return found;
 }
 
 static void spheres_stream(const fr_scene *s, const fr_ray *rays, fr_hit *hits, size_t n) {
   for (size_t g = 0; g < n; g += 16)
-    spheres_group(s, rays + g, n - g < 16 ? (int)(n - g) : 16, hits + g);
+    spheres_group(s, rays + g, n - g < 16 ? (int)(n - g) : 16, 0, hits + g);
 }
 
 static void spheres_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8_t *occ, size_t n) {
@@ -95,7 +82,7 @@ static void spheres_occluded_stream(const fr_scene *s, const fr_ray *rays, uint8
     unsigned done = 0;
     for (int i = 0; i < m; i++) done |= (unsigned)(occ[g + (size_t)i] != 0) << i;
     if (done == (1u << m) - 1u) continue;
-    const unsigned o = spheres_group_occluded(s, rays + g, m, done);
+    const unsigned o = spheres_group(s, rays + g, m, done, NULL);
     for (int i = 0; i < m; i++) occ[g + (size_t)i] |= (uint8_t)((o >> i) & 1);
   }
 }
@@ -182,7 +169,7 @@ void fr_intersect16(const fr_scene *s, unsigned valid, const fr_ray16 *rays, fr_
     r[k] = lane_ray(rays, i);
     h[k] = (fr_hit){hits->t[i], hits->u[i], hits->v[i], hits->prim[i], {hits->ng_x[i], hits->ng_y[i], hits->ng_z[i]}};
   }
-  spheres_group(s, r, k, h);
+  spheres_group(s, r, k, 0, h);
   for (int j = 0; j < k; j++) hit16_set(hits, lane[j], &h[j]);
 }
 
@@ -207,7 +194,7 @@ unsigned fr_occluded16(const fr_scene *s, unsigned valid, const fr_ray16 *rays) 
       r[k] = lane_ray(rays, i);
       done |= ((occ >> i) & 1u) << k;
     }
-    const unsigned o = spheres_group_occluded(s, r, k, done);
+    const unsigned o = spheres_group(s, r, k, done, NULL);
     for (int j = 0; j < k; j++) occ |= ((o >> j) & 1u) << lane[j];
   }
   return occ;
