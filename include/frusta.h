@@ -302,6 +302,25 @@ typedef struct fr_pinhole {
 fr_error fr_intersect_camera(const fr_scene *s, const fr_pinhole *camera, int y0, int rows, unsigned flags,
                              fr_ray *rays, fr_hit *hits);
 
+/* Answers as arrays, element i for ray or pixel i: the layout numpy and
+ * other array code hold. A NULL member is not written. */
+typedef struct fr_hit_arrays {
+  float *t;        /* +inf on a miss */
+  float *u, *v;    /* as fr_hit's */
+  uint32_t *prim;  /* FR_INVALID_ID on a miss */
+  float *ng;       /* 3 per element: fr_hit's ng, zero on a miss */
+  float *dir;      /* 3 per element: the ray's unit direction (its origin is the eye) */
+} fr_hit_arrays;
+
+/* fr_intersect_camera's answers written as arrays: element
+ * (y - y0) * width + x of each member of out is pixel (x, y). The same
+ * rays, answers and bands as fr_intersect_camera, without the records in
+ * between; normals are fetched only where out->ng is set. Caller-owned
+ * arrays; may be called from several threads at once (on different
+ * arrays). Errors: as fr_intersect_camera's (FR_ERR_ARG for a NULL out). */
+fr_error fr_intersect_camera_arrays(const fr_scene *s, const fr_pinhole *camera, int y0, int rows,
+                                    const fr_hit_arrays *out);
+
 /* Whether each of n points (xyz, 3 floats each) is in shadow of a point
  * light: occluded[i] = 1 if a triangle or sphere lies on the segment from
  * light to points[i], leaving out its last eps (scene units; for a point on

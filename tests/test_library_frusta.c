@@ -30,6 +30,38 @@ static void check_hit(const fr_scene *s, const mesh_ref *m, const fr_ray *r, con
   tl->excused++;
 }
 
+/* fr_intersect_camera_arrays gives fr_intersect_camera's answers (rays and
+ * hits of rows [y0, y0 + rows), normals or not) bit for bit, with every
+ * array and with some left NULL, which it must not write. */
+static void arrays_match_records(const fr_scene *s, const fr_pinhole *p, int y0, int rows, const fr_ray *rays,
+                                 const fr_hit *hits) {
+  size_t n = (size_t)rows * (size_t)p->width;
+  float *t = malloc((n + 1) * sizeof *t), *u = malloc((n + 1) * sizeof *u), *v = malloc((n + 1) * sizeof *v);
+  float *ng = malloc((3 * n + 1) * sizeof *ng), *dir = malloc((3 * n + 1) * sizeof *dir);
+  uint32_t *prim = malloc((n + 1) * sizeof *prim);
+  fr_hit_arrays all = {t, u, v, prim, ng, dir};
+  assert_int_equal(fr_intersect_camera_arrays(s, p, y0, rows, &all), FR_OK);
+  for (size_t i = 0; i < n; i++) {
+    assert_memory_equal(&t[i], &hits[i].t, sizeof(float));
+    assert_memory_equal(&u[i], &hits[i].u, sizeof(float));
+    assert_memory_equal(&v[i], &hits[i].v, sizeof(float));
+    assert_int_equal(prim[i], hits[i].prim);
+    assert_memory_equal(ng + 3 * i, hits[i].ng, 3 * sizeof(float));
+    assert_memory_equal(dir + 3 * i, rays[i].dir, 3 * sizeof(float));
+  }
+  /* t and prim alone: the same, and nothing else written */
+  memset(u, 0x7f, n * sizeof *u);
+  for (size_t i = 0; i < n; i++) t[i] = -1.0f, prim[i] = 7u;
+  fr_hit_arrays some = {t, NULL, NULL, prim, NULL, NULL};
+  assert_int_equal(fr_intersect_camera_arrays(s, p, y0, rows, &some), FR_OK);
+  for (size_t i = 0; i < n; i++) {
+    assert_memory_equal(&t[i], &hits[i].t, sizeof(float));
+    assert_int_equal(prim[i], hits[i].prim);
+    assert_int_equal(((const uint32_t *)u)[i], 0x7f7f7f7fu);
+  }
+  free(t); free(u); free(v); free(ng); free(dir); free(prim);
+}
+
 static void camera_against_rays(const fr_scene *s, const fr_pinhole *p, tally *tl) {
   mesh_ref m = scene_mesh(s);
   size_t n = (size_t)p->width * (size_t)p->height;
@@ -49,12 +81,14 @@ static void camera_against_rays(const fr_scene *s, const fr_pinhole *p, tally *t
       }
       check_hit(s, &m, &rays[i], &hits[i], tl);
     }
+  arrays_match_records(s, p, 0, p->height, rays, hits);
   /* a band starting off the tiles' grid: its own frusta, the same answers */
   int y0 = 5, rows = p->height - 9 < 37 ? p->height - 9 : 37;
   fr_ray *br = malloc((size_t)rows * (size_t)p->width * sizeof *br);
   fr_hit *bh = malloc((size_t)rows * (size_t)p->width * sizeof *bh);
   assert_int_equal(fr_intersect_camera(s, p, y0, rows, 0, br, bh), FR_OK);
   for (size_t i = 0; i < (size_t)rows * (size_t)p->width; i++) check_hit(s, &m, &br[i], &bh[i], tl);
+  arrays_match_records(s, p, y0, rows, br, bh);
   /* rays may be NULL; without normals, the same hits and ng zero */
   fr_hit *nn = malloc((size_t)rows * (size_t)p->width * sizeof *nn);
   assert_int_equal(fr_intersect_camera(s, p, y0, rows, FR_CAMERA_NO_NORMALS, NULL, nn), FR_OK);
@@ -181,7 +215,10 @@ static void errors(void **state) {
   fr_hit h[64];
   float light[3] = {0.2f, 0.2f, 5.0f}, pts[6] = {0.2f, 0.2f, -1.0f, 0.2f, 0.2f, 1.0f};
   uint8_t occ[2];
+  float tt[64];
+  const fr_hit_arrays ta = {tt, NULL, NULL, NULL, NULL, NULL};
   assert_int_equal(fr_intersect_camera(s, &cam, 0, 8, 0, NULL, h), FR_ERR_STATE);
+  assert_int_equal(fr_intersect_camera_arrays(s, &cam, 0, 8, &ta), FR_ERR_STATE);
   assert_int_equal(fr_occluded_point_light(s, light, pts, 2, 0.0f, occ), FR_ERR_STATE);
   {
     float v1, c[3] = {0, 0, 5}, e[3] = {1, 0, 0}, f[3] = {0, 1, 0};
@@ -191,6 +228,10 @@ static void errors(void **state) {
   assert_int_equal(fr_intersect_camera(s, &cam, 0, 8, 0, NULL, h), FR_OK);
   assert_true(h[27].prim == 0 && fabsf(h[27].t - 2.0f) < 0.01f); /* the middle sees the triangle */
   assert_int_equal(fr_intersect_camera(NULL, &cam, 0, 8, 0, NULL, h), FR_ERR_ARG);
+  assert_int_equal(fr_intersect_camera_arrays(s, &cam, 0, 8, NULL), FR_ERR_ARG);
+  assert_int_equal(fr_intersect_camera_arrays(s, &cam, 4, 5, &ta), FR_ERR_ARG);
+  assert_int_equal(fr_intersect_camera_arrays(s, &cam, 0, 8, &ta), FR_OK);
+  assert_true(tt[27] == h[27].t);
   assert_int_equal(fr_intersect_camera(s, &cam, 4, 5, 0, NULL, h), FR_ERR_ARG);
   assert_int_equal(fr_intersect_camera(s, &cam, -1, 2, 0, NULL, h), FR_ERR_ARG);
   cam.fov_deg = 180.0f;
@@ -231,6 +272,7 @@ static void errors(void **state) {
   assert_int_equal(fr_scene_commit(s), FR_OK);
   cam.fov_deg = 30.0f;
   assert_int_equal(fr_intersect_camera(s, &cam, 0, 8, 0, NULL, h), FR_ERR_UNSUPPORTED);
+  assert_int_equal(fr_intersect_camera_arrays(s, &cam, 0, 8, &ta), FR_ERR_UNSUPPORTED);
   float l2[3] = {0.0f, 0.0f, 5.0f}, behind[3] = {0.0f, 0.0f, -5.0f};
   assert_int_equal(fr_occluded_point_light(s, l2, behind, 1, 0.0f, occ), FR_OK);
   assert_int_equal(occ[0], 1);

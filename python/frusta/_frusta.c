@@ -735,29 +735,13 @@ static PyObject *scene_intersect_camera(SceneObject *s, PyObject *args, PyObject
 #pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads ? n_threads : omp_get_max_threads())
   for (int band = 0; band < bands; band++) {
     int y0 = 16 * band, rows = cam.height - y0 < 16 ? cam.height - y0 : 16;
-    fr_ray *rb = dp ? malloc((size_t)cam.width * 16 * sizeof *rb) : NULL;
-    fr_hit *hb = malloc((size_t)cam.width * 16 * sizeof *hb);
-    fr_error e = (rb || !dp) && hb ? fr_intersect_camera(sc, &cam, y0, rows, want_normals ? 0 : FR_CAMERA_NO_NORMALS, rb, hb) : FR_ERR_NOMEM;
+    const size_t i0 = (size_t)y0 * (size_t)cam.width;
+    const fr_hit_arrays out = {tp + i0, up + i0, vp + i0, pp + i0, np ? np + 3 * i0 : NULL, dp ? dp + 3 * i0 : NULL};
+    fr_error e = fr_intersect_camera_arrays(sc, &cam, y0, rows, &out);
     if (e != FR_OK) {
 #pragma omp critical(frusta_error)
-      if (err == FR_OK) { err = e; snprintf(msg, sizeof msg, "%s", e == FR_ERR_NOMEM ? "out of memory" : fr_last_error()); }
-    } else {
-      const size_t i0 = (size_t)y0 * (size_t)cam.width, m = (size_t)rows * (size_t)cam.width;
-      for (size_t j = 0; j < m; j++) {
-        size_t i = i0 + j;
-        tp[i] = hb[j].t; up[i] = hb[j].u; vp[i] = hb[j].v; pp[i] = hb[j].prim;
-      }
-      if (want_normals)
-        for (size_t j = 0; j < m; j++) {
-          size_t i = i0 + j;
-          np[3 * i] = hb[j].ng[0]; np[3 * i + 1] = hb[j].ng[1]; np[3 * i + 2] = hb[j].ng[2];
-        }
-      if (dp)
-        for (size_t j = 0; j < m; j++)
-          for (int a = 0; a < 3; a++) dp[3 * (i0 + j) + a] = rb[j].dir[a];
+      if (err == FR_OK) { err = e; snprintf(msg, sizeof msg, "%s", fr_last_error()); }
     }
-    free(rb);
-    free(hb);
   }
   Py_END_ALLOW_THREADS
   s->busy--;

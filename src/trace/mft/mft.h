@@ -176,12 +176,22 @@ typedef struct fr_mft_fns {
    * rounding, over t in (the least tnear / tfar, 1). Returns the frusta made
    * (batch->valid); the rest are for the caller to trace as rays. */
   unsigned (*from_rays)(fr_mft_batch *batch, fr_mft_sets *sets, const fr_ray *rays, size_t n);
+  /* expand's answers for the frusta in batch->valid as arrays (t, u, v,
+   * prim, dir of out; ng is the caller's): ray k of frustum f is pixel
+   * (4 (f & 3) + (k & 3), 4 (f >> 2) + (k >> 2)) of a 16x16 tile whose
+   * top-left pixel is element `at`, `width` elements a row; only the
+   * tile's first `rows` rows are written */
+  void (*expand_arrays)(const fr_mft_batch *batch, const fr_mft_sets *sets, const fr_mft_hits *hits,
+                        const fr_hit_arrays *out, size_t at, size_t width, int rows);
 } fr_mft_fns;
 
 extern const fr_mft_fns fr_mft_avx512, fr_mft_avx2, fr_mft_scalar;
 #define FR_MFT_EXPAND_DECL(isa)                                                                            \
   void fr_mft_expand_##isa(const fr_mft_batch *batch, const fr_mft_sets *sets, const fr_mft_hits *hits, fr_ray *rays_out, \
                            fr_hit *hits_out);
+#define FR_MFT_EXPAND_ARRAYS_DECL(isa)                                                                   \
+  void fr_mft_expand_arrays_##isa(const fr_mft_batch *batch, const fr_mft_sets *sets, const fr_mft_hits *hits,   \
+                                  const fr_hit_arrays *out, size_t at, size_t width, int rows);
 #define FR_MFT_FROM_RAYS_DECL(isa) \
   unsigned fr_mft_from_rays_##isa(fr_mft_batch *batch, fr_mft_sets *sets, const fr_ray *rays, size_t n);
 #define FR_MFT_OCCLUDED_DECL(isa)                                                                          \
@@ -197,6 +207,9 @@ FR_MFT_FROM_RAYS_DECL(scalar)
 FR_MFT_EXPAND_DECL(avx512)
 FR_MFT_EXPAND_DECL(avx2)
 FR_MFT_EXPAND_DECL(scalar)
+FR_MFT_EXPAND_ARRAYS_DECL(avx512)
+FR_MFT_EXPAND_ARRAYS_DECL(avx2)
+FR_MFT_EXPAND_ARRAYS_DECL(scalar)
 
 /* The kernels of the active ISA. */
 const fr_mft_fns *fr_mft_active(void);
