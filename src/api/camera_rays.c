@@ -91,7 +91,7 @@ static fr_error trace_camera(const char *fn, const fr_scene *s, const fr_pinhole
   /* Arrays go through a tile of them, 16 elements a row, and out a row at
    * a time: the user's rows lie a page apart, and written 4 pixels at a
    * time straight into them, a tile's 64 or more lines thrashed the cache. */
-  static _Thread_local struct {
+  struct {
     float t[256], u[256], v[256], ng[768], dir[768];
     uint32_t prim[256];
   } tile;
