@@ -2,9 +2,11 @@
  * Multi-frusta for library users, against the ray calls ray by ray, at
  * every ISA: fr_intersect_camera (whole images and odd bands, image sizes
  * that cut 4x4 blocks and 16x16 tiles) against fr_intersect1 on the rays it
- * returns and on the camera's own rays; fr_occluded_point_light against
- * fr_occluded1 on the same segments. A disagreement must be a ray within
- * rounding of an edge or of its range's ends (rayfile.md's rule). Errors.
+ * returns and on the camera's own rays, and fr_intersect_camera_arrays
+ * against it bit for bit; fr_occluded_point_light against fr_occluded1 on
+ * the same segments, and those segments as each ISA makes them against the
+ * scalar formula bit for bit. A disagreement must be a ray within rounding
+ * of an edge or of its range's ends (rayfile.md's rule). Errors.
  */
 #include "test_util.h"
 #include "render/camera.h"
@@ -111,6 +113,27 @@ static void camera_against_rays(const fr_scene *s, const fr_pinhole *p, tally *t
     if (hits[i].prim == FR_INVALID_ID) continue;
     for (int k = 0; k < 3; k++) pts[3 * np + k] = rays[i].org[k] + hits[i].t * rays[i].dir[k];
     np++;
+  }
+  /* the segments, 16 at a time in this ISA, are the scalar ones bit for bit;
+     a point at the light or not finite makes an empty ray */
+  {
+    float odd[3 * 37];
+    for (int i = 0; i < 37; i++)
+      for (int k = 0; k < 3; k++) odd[3 * i + k] = pts[3 * ((size_t)i * 7 % (np ? np : 1)) + k];
+    memcpy(odd + 3 * 5, light, sizeof light);
+    odd[3 * 9 + 1] = NAN;
+    odd[3 * 36 + 2] = INFINITY;
+    fr_ray got[37];
+    fr_mft_active()->rays_to_points(light, odd, 37, eps, got);
+    for (int i = 0; i < 37; i++) {
+      const float *q = odd + 3 * i;
+      float d[3] = {q[0] - light[0], q[1] - light[1], q[2] - light[2]};
+      float dist = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      fr_ray want = {{light[0], light[1], light[2]}, 1e-4f * dist, {d[0] / dist, d[1] / dist, d[2] / dist}, dist - eps};
+      if (!(want.tfar > want.tnear)) want.tnear = want.tfar = want.dir[0] = want.dir[1] = want.dir[2] = 0.0f;
+      assert_memory_equal(&got[i], &want, sizeof want);
+      if (i == 5 || i == 9 || i == 36) assert_true(got[i].tfar == 0.0f);
+    }
   }
   uint8_t *occ = malloc(np + 1);
   assert_int_equal(fr_occluded_point_light(s, light, pts, np, eps, occ), FR_OK);

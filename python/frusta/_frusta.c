@@ -752,20 +752,39 @@ done:
   return result;
 }
 
-/* Points of shape (..., 3) in r->org (r->dir unused), every coordinate finite. */
+/* Points of shape (..., 3) in r->org (r->dir unused); whether they are
+ * finite is for first_bad_point, on the threads. */
 static int points_parse(PyObject *po, rays_in *r) {
   memset(r, 0, sizeof *r);
   if (!(r->org = vec3_array(po, "points"))) return 0;
   rays_shape(r);
-  const float *pts = PyArray_DATA(r->org);
-  for (size_t i = 0; i < 3 * r->n; i++)
-    if (!isfinite(pts[i])) {
-      PyErr_Format(PyExc_ValueError, "point %zu is NaN or infinite", i / 3);
-      rays_free(r);
-      return 0;
-    }
   return 1;
 }
+
+/* The first of n points (3 floats each) with a coordinate NaN or infinite,
+ * or SIZE_MAX: a pass over the bits that compilers vectorize, and a search
+ * only where it found one. */
+static size_t first_bad_point(const float *p, size_t n) {
+  uint32_t any = 0;
+  for (size_t i = 0; i < 3 * n; i++) {
+    uint32_t b;
+    memcpy(&b, p + i, sizeof b);
+    any |= (uint32_t)((b & 0x7f800000u) == 0x7f800000u);
+  }
+  if (!any) return SIZE_MAX;
+  for (size_t i = 0; i < 3 * n; i++)
+    if (!isfinite(p[i])) return i / 3;
+  return SIZE_MAX;
+}
+
+/* Keeps the smallest point index a thread found bad. */
+static void note_bad_point(size_t *bad, size_t found) {
+  if (found == SIZE_MAX) return;
+#pragma omp critical(frusta_bad_point)
+  if (found < *bad) *bad = found;
+}
+
+static PyObject *bad_point(size_t i) { return PyErr_Format(PyExc_ValueError, "point %zu is NaN or infinite", i); }
 
 /* The distance left out at a point's end of a shadow ray. */
 static int eps_arg(float eps) {
@@ -789,16 +808,21 @@ static PyObject *scene_occluded_point_light(SceneObject *s, PyObject *args, PyOb
   s->busy++;
   const fr_scene *sc = s->scene;
   uint8_t *op = PyArray_DATA(occ);
-  size_t n = r.n, per = 4 * CHUNK, chunks = (n + per - 1) / per;
+  size_t n = r.n, per = 4 * CHUNK, chunks = (n + per - 1) / per, bad = SIZE_MAX;
   Py_BEGIN_ALLOW_THREADS
 #pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads ? n_threads : omp_get_max_threads())
   for (size_t c = 0; c < chunks; c++) {
-    size_t i0 = c * per, k = n - i0 < per ? n - i0 : per;
+    size_t i0 = c * per, k = n - i0 < per ? n - i0 : per, b = first_bad_point(pts + 3 * i0, k);
+    if (b != SIZE_MAX) { note_bad_point(&bad, i0 + b); continue; }
     fr_occluded_point_light(sc, light, pts + 3 * i0, k, eps, op + i0); /* arguments checked above */
   }
   Py_END_ALLOW_THREADS
   s->busy--;
   rays_free(&r);
+  if (bad != SIZE_MAX) {
+    Py_DECREF(occ);
+    return bad_point(bad);
+  }
   return (PyObject *)occ;
 }
 
@@ -824,10 +848,12 @@ static PyObject *scene_visibility_area_light(SceneObject *s, PyObject *args, PyO
   float *vp = PyArray_DATA(vis);
   size_t n = r.n, per = 16 * 256, chunks = (n + per - 1) / per; /* whole batches of 256 points */
   int failed = 0;
+  size_t bad = SIZE_MAX;
   Py_BEGIN_ALLOW_THREADS
 #pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads ? n_threads : omp_get_max_threads())
   for (size_t ch = 0; ch < chunks; ch++) {
-    size_t i0 = ch * per, k = n - i0 < per ? n - i0 : per;
+    size_t i0 = ch * per, k = n - i0 < per ? n - i0 : per, b = first_bad_point(pts + 3 * i0, k);
+    if (b != SIZE_MAX) { note_bad_point(&bad, i0 + b); continue; }
     if (fr_visibility_area_light(sc, c, e1, e2, pts + 3 * i0, k, samples, seed, eps, vp + i0) != FR_OK) {
 #pragma omp atomic write
       failed = 1;
@@ -836,6 +862,10 @@ static PyObject *scene_visibility_area_light(SceneObject *s, PyObject *args, PyO
   Py_END_ALLOW_THREADS
   s->busy--;
   rays_free(&r);
+  if (bad != SIZE_MAX) {
+    Py_DECREF(vis);
+    return bad_point(bad);
+  }
   if (failed) { /* arguments were checked: only memory can fail */
     Py_DECREF(vis);
     return PyErr_NoMemory();

@@ -22,18 +22,7 @@ fr_error fr_occluded_point_light(const fr_scene *s, const float light[3], const 
   fr_ray rays[RUN];
   for (size_t a = 0; a < n; a += RUN) {
     size_t k = n - a < RUN ? n - a : RUN;
-    for (size_t j = 0; j < k; j++) {
-      const float *p = points + 3 * (a + j);
-      float d[3] = {p[0] - light[0], p[1] - light[1], p[2] - light[2]};
-      float dist = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-      fr_ray *r = &rays[j];
-      for (int i = 0; i < 3; i++) { r->org[i] = light[i]; r->dir[i] = dist > 0.0f ? d[i] / dist : 0.0f; }
-      /* the light's end skips 1e-4 of the way, for a light on a surface; a
-         point closer than eps (or not finite) has nothing in between */
-      r->tnear = 1e-4f * dist;
-      r->tfar = dist - eps;
-      if (!(r->tfar > r->tnear)) r->tnear = r->tfar = 0.0f, r->dir[0] = r->dir[1] = r->dir[2] = 0.0f;
-    }
+    fr_mft_active()->rays_to_points(light, points + 3 * a, k, eps, rays);
     if (t.occluded_frusta) fr_shadow_frusta_occluded(&t, rays, occluded + a, k, 1);
     else fr_occluded_stream(s, rays, occluded + a, k);
   }

@@ -557,6 +557,12 @@ def test_occluded_point_light_equals_rays():
     assert (occ != ref).sum() <= len(p) // 1000
     with pytest.raises(ValueError, match="point 1"):
         s.occluded_point_light(np.array([[0, 0, 0], [np.inf, 0, 0]], np.float32), light)
+    many = np.zeros((100000, 3), np.float32)  # checked chunk by chunk on the threads: the first bad one counts
+    many[90000, 2], many[70001, 1] = np.nan, -np.inf
+    for call in (lambda q: s.occluded_point_light(q, light),
+                 lambda q: s.visibility_area_light(q, light, (1.0, 0.0, 0.0), (0.0, 0.0, 1.0))):
+        with pytest.raises(ValueError, match="point 70001 "):
+            call(many)
     with pytest.raises(ValueError, match="eps"):
         s.occluded_point_light(p, light, eps=-1.0)
 

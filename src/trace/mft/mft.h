@@ -183,6 +183,9 @@ typedef struct fr_mft_fns {
    * tile's first `rows` rows are written */
   void (*expand_arrays)(const fr_mft_batch *batch, const fr_mft_sets *sets, const fr_mft_hits *hits,
                         const fr_hit_arrays *out, size_t at, size_t width, int rows);
+  /* rays[j]: the segment from light to points[j] (3 floats each) that a
+   * point-light shadow ray tests, or an empty ray (src/trace/mft_from_rays.c) */
+  void (*rays_to_points)(const float light[3], const float *points, size_t n, float eps, fr_ray *rays);
 } fr_mft_fns;
 
 extern const fr_mft_fns fr_mft_avx512, fr_mft_avx2, fr_mft_scalar;
@@ -207,6 +210,11 @@ FR_MFT_FROM_RAYS_DECL(scalar)
 FR_MFT_EXPAND_DECL(avx512)
 FR_MFT_EXPAND_DECL(avx2)
 FR_MFT_EXPAND_DECL(scalar)
+#define FR_MFT_RAYS_TO_POINTS_DECL(isa) \
+  void fr_mft_rays_to_points_##isa(const float light[3], const float *points, size_t n, float eps, fr_ray *rays);
+FR_MFT_RAYS_TO_POINTS_DECL(avx512)
+FR_MFT_RAYS_TO_POINTS_DECL(avx2)
+FR_MFT_RAYS_TO_POINTS_DECL(scalar)
 FR_MFT_EXPAND_ARRAYS_DECL(avx512)
 FR_MFT_EXPAND_ARRAYS_DECL(avx2)
 FR_MFT_EXPAND_ARRAYS_DECL(scalar)

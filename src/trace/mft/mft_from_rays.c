@@ -16,7 +16,8 @@
  * rounded, so the corner rays bound exactly the rays traced, and the box
  * gets a margin far above the rounding of a and b.
  *
- * One frustum per 16-wide pass; compiled once per ISA.
+ * One frustum per 16-wide pass; compiled once per ISA. So are the segments
+ * from a light to points (fr_mft_rays_to_points), 16 at a time.
  */
 #include <math.h>
 #include <string.h>
@@ -170,4 +171,34 @@ unsigned FR_ISA_FN(fr_mft_from_rays)(fr_mft_batch *b, fr_mft_sets *t, const fr_r
     else memset(&t->set[f], 0, sizeof t->set[f]); /* what the kernels read of a frustum left out */
   }
   return b->valid;
+}
+
+/* Ray j from the light towards point j: unit direction, tnear 1e-4 of the
+ * way (for a light on a surface), tfar eps short of the point; an empty ray
+ * (all zero but the origin) where that leaves nothing, or the point is not
+ * finite. The same rounded operations in every lane, so every ISA gives the
+ * same bits. */
+void FR_ISA_FN(fr_mft_rays_to_points)(const float light[3], const float *points, size_t n, float eps, fr_ray *rays) {
+  const vpf zero = vp(0.0f);
+  for (size_t j = 0; j < n; j += FR_MFT_RAYS) {
+    const size_t m = n - j < FR_MFT_RAYS ? n - j : FR_MFT_RAYS;
+    float x[3][FR_MFT_RAYS] __attribute__((aligned(64)));
+    for (size_t k = 0; k < FR_MFT_RAYS; k++) /* a last, partial group repeats its last point */
+      for (int a = 0; a < 3; a++) x[a][k] = points[3 * (j + (k < m ? k : m - 1)) + (size_t)a];
+    vpf d[3];
+    for (int a = 0; a < 3; a++) d[a] = vp_sub(vp_load(x[a]), vp(light[a]));
+    const vpf dist = vp_sqrt(vp_add(vp_add(vp_mul(d[0], d[0]), vp_mul(d[1], d[1])), vp_mul(d[2], d[2])));
+    const vpf tnear = vp_mul(vp(1e-4f), dist), tfar = vp_sub(dist, vp(eps));
+    const vpm keep = vp_gt(tfar, tnear);
+    vpf f[8] = {vp(light[0]), vp(light[1]), vp(light[2]), vp_select(keep, tnear, zero),
+                vp_select(keep, vp_div(d[0], dist), zero), vp_select(keep, vp_div(d[1], dist), zero),
+                vp_select(keep, vp_div(d[2], dist), zero), vp_select(keep, tfar, zero)};
+    if (m == FR_MFT_RAYS) {
+      vp_store_records((float *)(rays + j), f, 8);
+    } else {
+      fr_ray part[FR_MFT_RAYS];
+      vp_store_records((float *)part, f, 8);
+      memcpy(rays + j, part, m * sizeof *part);
+    }
+  }
 }
