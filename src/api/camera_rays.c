@@ -2,8 +2,8 @@
  * rays traced as multi-frusta (trace/mft): 16 frusta of 4x4 pixels per
  * 16x16 tile, made on demand from the camera, never stored as rays; the
  * pixels of 4x4 blocks the image cuts off go as single rays. The two calls
- * differ only in where the answers go: records, or arrays written a row of
- * a block at a time. */
+ * differ only in where the answers go: records, or arrays, through a tile
+ * of them copied out a whole row at a time. */
 #include <string.h>
 #include "base/error.h"
 #include "render/camera.h"
@@ -48,8 +48,8 @@ static void put_single(const camera_out *o, size_t i, const fr_ray *r, const fr_
 }
 
 /* The first min(n, 16) of a tile row's 4-byte elements (floats or ids): a
- * whole row in fixed-size moves (a copy of n bytes became `rep movs`, a
- * fifth of the call's time). */
+ * whole row as one fixed-size copy, because a copy of a variable size
+ * compiles to `rep movs`, slow at this size. */
 static void copy_row(void *to, const void *from, int n) {
   if (n >= 16)
     memcpy(to, from, 16 * 4);

@@ -8,9 +8,9 @@
  * per float, this step took a sixth of sibenik's primary-ray time, and
  * records made the whole workload 24% faster.
  *
- * fr_mft_expand_arrays writes the same answers as arrays instead, straight
- * where a library user's pixels go (fr_intersect_camera_arrays): rows of 4
- * pixels at a time, without records in between.
+ * fr_mft_expand_arrays writes the same answers as arrays instead, rows of
+ * 4 pixels at a time into a tile of them (fr_intersect_camera_arrays),
+ * without records in between.
  *
  * Compiled once per ISA; every level gives the same bits (sqrt and division
  * are correctly rounded, and the operations are those of the scalar loop in
