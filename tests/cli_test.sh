@@ -200,6 +200,16 @@ printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 100000 +X 100000\n' >"$T/liar.h
 expect 1 "$F" render --builtin --shade path --env "$T/liar.hdr" --out "$T/q.png"
 head -c 300 "$SHARED/hdri/city.exr" >"$T/cut.exr"
 expect 1 "$F" render --builtin --shade path --env "$T/cut.exr" --out "$T/q.png"
+# OpenEXR headers that would have the library take gigabytes before any
+# check: a channel list longer than its attribute claims, a data window
+# 16 million pixels wide; refused before OpenEXR reads them
+tail -c +2 "$SRC/tests/fuzz/corpus/b566163560a48d3ea4d3bceabb3d804d633f6c3c" >"$T/chlist.exr"
+expect 1 "$F" render --builtin --shade path --env "$T/chlist.exr" --out "$T/q.png"
+at=$(grep -obUa dataWindow "$T/p.exr" | head -1 | cut -d: -f1)
+cp "$T/p.exr" "$T/wide.exr"
+printf '\007\000\377\000' | dd of="$T/wide.exr" bs=1 seek=$((at + 29)) conv=notrunc 2>/dev/null
+expect 1 "$F" render --builtin --shade path --env "$T/wide.exr" --out "$T/q.png"
+grep -q 'out of range' "$T/err" && ok || bad "a 16M-pixel-wide EXR: $(cat "$T/err")"
 expect 2 "$F" render --builtin --shade path --spp 0 --out "$T/q.png"
 expect 2 "$F" render --builtin --shade path --aperture -1 --out "$T/q.png"
 expect 2 "$F" render --builtin --shade path --max-depth 0 --out "$T/q.png"

@@ -2,6 +2,7 @@
 #include <OpenEXR/ImfCRgbaFile.h>
 #include <stb_image.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -31,7 +32,100 @@ static fr_error check_values(const char *what, float *rgb, size_t n) {
   return FR_OK;
 }
 
+/* OpenEXR sizes its line and tile buffers from the header as it opens a
+ * file, before a caller can look at the header: so the header is read
+ * here first, and files whose buffers would be out of proportion are
+ * refused before OpenEXR sees them. OpenEXR reads a value of a type it
+ * knows by its type, whatever size the attribute claims, and a channel
+ * list up to its end mark: an attribute whose claimed size differs is
+ * refused, so that both readers see the same attributes. */
+#define EXR_HEADER_MAX 65536          /* bytes of attributes read */
+#define EXR_LINE_SAMPLES (1u << 20)   /* width times channels */
+#define EXR_TILE_SAMPLES (1u << 22)   /* tile width times height times channels */
+
+static uint32_t le32(const unsigned char *p) {
+  return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+/* The size OpenEXR reads for a value of this type given `size` bytes of it
+ * (v, within the buffer): a fixed size, the channel list's up to its end
+ * mark, a preview's from its width and height; `size` for the rest (read
+ * as claimed). channels gets a channel list's count. */
+static uint64_t exr_value_size(const char *type, const unsigned char *v, uint32_t size, uint32_t *channels) {
+  static const struct { const char *type; uint32_t size; } fixed[] = {
+      {"box2i", 16}, {"box2f", 16}, {"chromaticities", 32}, {"compression", 1}, {"double", 8}, {"envmap", 1},
+      {"float", 4}, {"int", 4}, {"keycode", 28}, {"lineOrder", 1}, {"m33f", 36}, {"m44f", 64}, {"m33d", 72},
+      {"m44d", 128}, {"rational", 8}, {"tiledesc", 9}, {"timecode", 8}, {"v2i", 8}, {"v2f", 8}, {"v2d", 16},
+      {"v3i", 12}, {"v3f", 12}, {"v3d", 24}, {"deepImageState", 1}};
+  for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++)
+    if (!strcmp(type, fixed[i].type)) return fixed[i].size;
+  if (!strcmp(type, "chlist")) { /* entries of a name and 16 bytes, then an empty name */
+    uint32_t q = 0;
+    while (q < size && v[q]) {
+      const unsigned char *z = memchr(v + q, 0, size - q);
+      if (!z) return (uint64_t)size + 1;
+      q = (uint32_t)(z - v) + 17;
+      ++*channels;
+    }
+    return (uint64_t)q + 1;
+  }
+  if (!strcmp(type, "preview")) return size < 8 ? 8 : 8 + 4 * (uint64_t)le32(v) * le32(v + 4);
+  return size;
+}
+
+static fr_error exr_header_check(const char *path, size_t bytes) {
+  unsigned char *h = malloc(EXR_HEADER_MAX);
+  FILE *f = h ? fopen(path, "rb") : NULL;
+  if (!f) { free(h); return h ? fr_fail(FR_ERR_IO, "%s: cannot open", path) : fr_fail(FR_ERR_NOMEM, "%s: out of memory", path); }
+  const size_t n = fread(h, 1, EXR_HEADER_MAX, f);
+  fclose(f);
+  fr_error err = FR_OK;
+  if (n < 8 || le32(h) != 20000630u) {
+    err = fr_fail(FR_ERR_FORMAT, "%s: not an OpenEXR file", path);
+  } else if (le32(h + 4) & 0x1800u) { /* deep data, several parts */
+    err = fr_fail(FR_ERR_UNSUPPORTED, "%s: deep and multi-part OpenEXR files are not read", path);
+  }
+  long w = 0, hgt = 0;
+  uint32_t channels = 0, tile_w = 1, tile_h = 1;
+  int window = 0, ended = 0;
+  size_t p = 8;
+  while (!err && p < n) { /* attributes: name, type, size, value; an empty name ends them */
+    const unsigned char *name = h + p, *z1 = memchr(name, 0, n - p);
+    if (!z1) break;
+    if (z1 == name) { ended = 1; break; }
+    const unsigned char *type = z1 + 1, *z2 = type < h + n ? memchr(type, 0, (size_t)(h + n - type)) : NULL;
+    if (!z2 || (size_t)(h + n - (z2 + 1)) < 4) break;
+    const uint32_t size = le32(z2 + 1);
+    const unsigned char *v = z2 + 5;
+    if (size > (size_t)(h + n - v)) break;
+    if (exr_value_size((const char *)type, v, size, &channels) != size) {
+      err = fr_fail(FR_ERR_FORMAT, "%s: OpenEXR attribute '%s' of type %s claims %u bytes, not what its value takes", path,
+                    (const char *)name, (const char *)type, size);
+      break;
+    }
+    if (!strcmp((const char *)name, "dataWindow") && !strcmp((const char *)type, "box2i")) {
+      w = (long)(int32_t)le32(v + 8) - (long)(int32_t)le32(v) + 1;
+      hgt = (long)(int32_t)le32(v + 12) - (long)(int32_t)le32(v + 4) + 1;
+      window = 1;
+    } else if (!strcmp((const char *)name, "tiles") && !strcmp((const char *)type, "tiledesc")) {
+      tile_w = le32(v), tile_h = le32(v + 4);
+    }
+    p = (size_t)(v - h) + size;
+  }
+  if (!err && (!ended || !window))
+    err = fr_fail(FR_ERR_FORMAT, "%s: an OpenEXR header %s", path, ended ? "without a data window" : "cut short or over 64 KiB");
+  if (!err) err = check_size(path, w, hgt, bytes);
+  if (!err && (channels == 0 || (uint64_t)w * channels > EXR_LINE_SAMPLES ||
+               (uint64_t)tile_w * tile_h * channels > EXR_TILE_SAMPLES))
+    err = fr_fail(FR_ERR_UNSUPPORTED, "%s: %u channels of %ld pixels a line (tiles %ux%u) are out of proportion", path,
+                  channels, w, tile_w, tile_h);
+  free(h);
+  return err;
+}
+
 static fr_error read_exr(const char *path, size_t bytes, int *width, int *height, float **out) {
+  fr_error checked = exr_header_check(path, bytes);
+  if (checked) return checked;
   ImfInputFile *in = ImfOpenInputFile(path);
   if (!in) return fr_fail(FR_ERR_FORMAT, "%s: not a readable OpenEXR file (%s)", path, ImfErrorMessage());
   int x0, y0, x1, y1;
