@@ -4,9 +4,11 @@
  * that cut 4x4 blocks and 16x16 tiles) against fr_intersect1 on the rays it
  * returns and on the camera's own rays, and fr_intersect_camera_arrays
  * against it bit for bit; fr_occluded_point_light against fr_occluded1 on
- * the same segments, and those segments as each ISA makes them against the
- * scalar formula bit for bit. A disagreement must be a ray within rounding
- * of an edge or of its range's ends (rayfile.md's rule). Errors.
+ * the same segments, those segments as each ISA makes them against the
+ * scalar formula bit for bit, and the frusta made straight from the points
+ * against those made from the segments. A disagreement must be a ray
+ * within rounding of an edge or of its range's ends (rayfile.md's rule).
+ * Errors.
  */
 #include "test_util.h"
 #include "render/camera.h"
@@ -119,7 +121,7 @@ static void camera_against_rays(const fr_scene *s, const fr_pinhole *p, tally *t
   {
     float odd[3 * 37];
     for (int i = 0; i < 37; i++)
-      for (int k = 0; k < 3; k++) odd[3 * i + k] = pts[3 * ((size_t)i * 7 % (np ? np : 1)) + k];
+      for (int k = 0; k < 3; k++) odd[3 * i + k] = pts[3 * ((size_t)i % (np ? np : 1)) + k]; /* neighbours */
     memcpy(odd + 3 * 5, light, sizeof light);
     odd[3 * 9 + 1] = NAN;
     odd[3 * 36 + 2] = INFINITY;
@@ -134,6 +136,17 @@ static void camera_against_rays(const fr_scene *s, const fr_pinhole *p, tally *t
       assert_memory_equal(&got[i], &want, sizeof want);
       if (i == 5 || i == 9 || i == 36) assert_true(got[i].tfar == 0.0f);
     }
+    /* frusta made straight from the points are those made from the segments */
+    static fr_mft_sets ta, tb;
+    fr_mft_batch ba, bb;
+    memset(&ta, 0, sizeof ta);
+    memset(&tb, 0, sizeof tb);
+    const unsigned va = fr_mft_active()->from_rays(&ba, &ta, got, 37);
+    const unsigned vb = fr_mft_active()->from_points(&bb, &tb, light, odd, 37, eps);
+    assert_int_equal(va, vb);
+    assert_true(va != 0); /* some frusta made */
+    assert_memory_equal(&ba, &bb, sizeof ba);
+    assert_memory_equal(&ta, &tb, sizeof ta);
   }
   uint8_t *occ = malloc(np + 1);
   assert_int_equal(fr_occluded_point_light(s, light, pts, np, eps, occ), FR_OK);

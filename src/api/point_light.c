@@ -22,9 +22,13 @@ fr_error fr_occluded_point_light(const fr_scene *s, const float light[3], const 
   fr_ray rays[RUN];
   for (size_t a = 0; a < n; a += RUN) {
     size_t k = n - a < RUN ? n - a : RUN;
+    if (t.occluded_frusta) { /* the segments made as rays only where they go as rays */
+      const fr_shadow_rays src = {NULL, light, points + 3 * a, eps};
+      fr_shadow_frusta_occluded(&t, &src, occluded + a, k, 1);
+      continue;
+    }
     fr_mft_active()->rays_to_points(light, points + 3 * a, k, eps, rays);
-    if (t.occluded_frusta) fr_shadow_frusta_occluded(&t, rays, occluded + a, k, 1);
-    else fr_occluded_stream(s, rays, occluded + a, k);
+    fr_occluded_stream(s, rays, occluded + a, k);
   }
   return FR_OK;
 }

@@ -9,6 +9,13 @@
  * shadow rays to the streams. */
 #define SHADOW_FRUSTA_MAX_NODES 6u
 
+/* Rays [first, first + n) of src: its own, or made into buf (n <= 1024). */
+static const fr_ray *rays_of(const fr_shadow_rays *src, size_t first, size_t n, fr_ray *buf) {
+  if (src->rays) return src->rays + first;
+  fr_mft_active()->rays_to_points(src->light, src->points + 3 * first, n, src->eps, buf);
+  return buf;
+}
+
 /* Shadow rays [0, n) of a generation through a multi-frusta tracer: 16
  * consecutive rays from the light make a frustum (the rays of a 4x4 block
  * and, past its mirrors and unlit pixels, of the next: full frusta measured
@@ -16,15 +23,19 @@
  * What makes no frustum (see fr_mft_fns.from_rays) goes as rays; a batch
  * over its node budget goes as rays, and so does the rest of the
  * generation. */
-void fr_shadow_frusta_occluded(const fr_tracer *t, const fr_ray *rays, uint8_t *occ, size_t n, int budgeted) {
+void fr_shadow_frusta_occluded(const fr_tracer *t, const fr_shadow_rays *src, uint8_t *occ, size_t n, int budgeted) {
+  enum { PIECE = 1024 };
+  const fr_mft_fns *k = fr_mft_active();
   fr_mft_batch b;
   static _Thread_local fr_mft_sets T;
   uint16_t bits[FR_MFT_FRUSTA];
+  fr_ray buf[FR_MFT_RAYS];
   const size_t per = FR_MFT_FRUSTA * FR_MFT_RAYS;
   size_t a = 0;
   while (a < n) {
     const size_t m = n - a < per ? n - a : per;
-    const unsigned valid = fr_mft_active()->from_rays(&b, &T, rays + a, m);
+    const unsigned valid = src->rays ? k->from_rays(&b, &T, src->rays + a, m)
+                                     : k->from_points(&b, &T, src->light, src->points + 3 * a, m, src->eps);
     fr_mft_budget budget = {!budgeted ? 0 : SHADOW_FRUSTA_MAX_NODES * (unsigned)__builtin_popcount(valid), 0, 0,
                             0, 0};
     /* no occluder cache: point-light frusta are thin and end at their first
@@ -34,13 +45,20 @@ void fr_shadow_frusta_occluded(const fr_tracer *t, const fr_ray *rays, uint8_t *
     for (size_t f = 0; f * FR_MFT_RAYS < m; f++) {
       size_t first = a + f * FR_MFT_RAYS, cnt = m - f * FR_MFT_RAYS < FR_MFT_RAYS ? m - f * FR_MFT_RAYS : FR_MFT_RAYS;
       if (!((valid >> f) & 1)) {
-        t->occluded(t->ctx, rays + first, occ + first, cnt, 1);
+        t->occluded(t->ctx, rays_of(src, first, cnt, buf), occ + first, cnt, 1);
         continue;
       }
-      for (size_t k = 0; k < cnt; k++) occ[first + k] = (uint8_t)((bits[f] >> k) & 1);
+      for (size_t j = 0; j < cnt; j++) occ[first + j] = (uint8_t)((bits[f] >> j) & 1);
     }
     a += m;
   }
-  if (a < n) t->occluded(t->ctx, rays + a, occ + a, n - a, 1);
+  if (a < n && src->rays) {
+    t->occluded(t->ctx, src->rays + a, occ + a, n - a, 1);
+  } else if (a < n) { /* made a piece at a time */
+    fr_ray piece[PIECE];
+    for (; a < n; a += PIECE) {
+      const size_t m = n - a < PIECE ? n - a : PIECE;
+      t->occluded(t->ctx, rays_of(src, a, m, piece), occ + a, m, 1);
+    }
+  }
 }
-

@@ -331,8 +331,12 @@ uint64_t fr_whitted_tile(const fr_workload *w, const fr_tracer *t, fr_whitted_sc
     const size_t ns = shadow.n, nn = next.n;
     /* shadow rays, packet by packet (they follow their block's order) */
     const double t_shadow = fr_seconds();
-    if (t->occluded_frusta && depth == 0) fr_shadow_frusta_occluded(t, S->shadow.r, S->occ, ns, !w->mft_no_fallback);
-    else trace_runs(t, S->shadow, NULL, S->occ, ns);
+    if (t->occluded_frusta && depth == 0) {
+      const fr_shadow_rays src = {S->shadow.r, NULL, NULL, 0.0f};
+      fr_shadow_frusta_occluded(t, &src, S->occ, ns, !w->mft_no_fallback);
+    } else {
+      trace_runs(t, S->shadow, NULL, S->occ, ns);
+    }
     const double ds = fr_seconds() - t_shadow;
     S->stage[FR_STAGE_SHADOW] += ds;
     traced_s += ds;

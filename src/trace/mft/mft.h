@@ -186,6 +186,9 @@ typedef struct fr_mft_fns {
   /* rays[j]: the segment from light to points[j] (3 floats each) that a
    * point-light shadow ray tests, or an empty ray (src/trace/mft_from_rays.c) */
   void (*rays_to_points)(const float light[3], const float *points, size_t n, float eps, fr_ray *rays);
+  /* from_rays on those segments, without making them as rays */
+  unsigned (*from_points)(fr_mft_batch *batch, fr_mft_sets *sets, const float light[3], const float *points,
+                          size_t n, float eps);
 } fr_mft_fns;
 
 extern const fr_mft_fns fr_mft_avx512, fr_mft_avx2, fr_mft_scalar;
@@ -212,6 +215,12 @@ FR_MFT_EXPAND_DECL(avx2)
 FR_MFT_EXPAND_DECL(scalar)
 #define FR_MFT_RAYS_TO_POINTS_DECL(isa) \
   void fr_mft_rays_to_points_##isa(const float light[3], const float *points, size_t n, float eps, fr_ray *rays);
+#define FR_MFT_FROM_POINTS_DECL(isa)                                                                      \
+  unsigned fr_mft_from_points_##isa(fr_mft_batch *batch, fr_mft_sets *sets, const float light[3], const float *points, \
+                                    size_t n, float eps);
+FR_MFT_FROM_POINTS_DECL(avx512)
+FR_MFT_FROM_POINTS_DECL(avx2)
+FR_MFT_FROM_POINTS_DECL(scalar)
 FR_MFT_RAYS_TO_POINTS_DECL(avx512)
 FR_MFT_RAYS_TO_POINTS_DECL(avx2)
 FR_MFT_RAYS_TO_POINTS_DECL(scalar)

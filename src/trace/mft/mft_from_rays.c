@@ -45,13 +45,18 @@ FR_INLINE vpf dot3v(const vpf a[3], const float b[3]) {
   return vp_add(vp_add(vp_mul(a[0], vp(b[0])), vp_mul(a[1], vp(b[1]))), vp_mul(a[2], vp(b[2])));
 }
 
-/* Frustum f from the 16 rays at r; returns 0 where they make none. */
-static int frustum_of(fr_mft_batch *b, fr_mft_set *S, int f, const fr_ray *r, const frame *F) {
-  vpf x[8]; /* org x y z, tnear, dir x y z, tfar */
-  vp_load_records8((const float *)r, x);
+/* 256 rays as lanes: field k (org x y z, tnear, dir x y z, tfar) of ray i
+ * in f[k][i]; a last, partial frustum repeats its last ray. */
+typedef struct ray_lanes {
+  float f[8][FR_MFT_FRUSTA * FR_MFT_RAYS] __attribute__((aligned(64)));
+} ray_lanes;
+
+/* Frustum f from its 16 rays x (fields as ray_lanes', origin org the
+ * first's); returns 0 where they make none. */
+static int frustum_of(fr_mft_batch *b, fr_mft_set *S, int f, const vpf x[8], const float org[3], const frame *F) {
   const vpf zero = vp(0.0f), inf = vp(INFINITY);
   /* one origin, finite values, 0 <= tnear <= tfar < inf, tfar > 0 */
-  unsigned ok = vpm_bits(vpm_and(vp_eq(x[0], vp(r[0].org[0])), vpm_and(vp_eq(x[1], vp(r[0].org[1])), vp_eq(x[2], vp(r[0].org[2])))));
+  unsigned ok = vpm_bits(vpm_and(vp_eq(x[0], vp(org[0])), vpm_and(vp_eq(x[1], vp(org[1])), vp_eq(x[2], vp(org[2])))));
   ok &= vpm_bits(vpm_and(vp_lt(vp_abs(x[0]), inf), vpm_and(vp_lt(vp_abs(x[1]), inf), vp_lt(vp_abs(x[2]), inf))));
   ok &= vpm_bits(vpm_and(vp_ge(x[3], zero), vpm_and(vp_le(x[3], x[7]), vpm_and(vp_gt(x[7], zero), vp_lt(x[7], inf)))));
   vpf d[3] = {vp_mul(x[4], x[7]), vp_mul(x[5], x[7]), vp_mul(x[6], x[7])};
@@ -89,7 +94,7 @@ static int frustum_of(fr_mft_batch *b, fr_mft_set *S, int f, const fr_ray *r, co
   if (!(pad < INFINITY)) return 0;
   S->amin -= pad; S->amax += pad; S->bmin -= pad; S->bmax += pad;
   for (int a = 0; a < 3; a++) {
-    b->org[a][f] = r[0].org[a];
+    b->org[a][f] = org[a];
     b->start[a][f] = s[a];
   }
   b->tnear[f] = vp_reduce_min(vp_div(x[3], x[7]));
@@ -104,9 +109,33 @@ static void cross_d(const double a[3], const double b[3], double out[3]) {
   out[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-unsigned FR_ISA_FN(fr_mft_from_rays)(fr_mft_batch *b, fr_mft_sets *t, const fr_ray *rays, size_t n) {
+/* The segments from light to points[0..m) (m <= 16) as 16 lanes of ray
+ * fields (ray_lanes'): unit direction, tnear 1e-4 of the way (for a light
+ * on a surface), tfar eps short of the point; an empty ray (all zero but
+ * the origin) where that leaves nothing or the point is not finite; lanes
+ * past m repeat the last point. The same rounded operations in every lane,
+ * so every ISA gives the same bits. */
+static void point_lanes(const float light[3], const float *points, size_t m, float eps, vpf f[8]) {
+  const vpf zero = vp(0.0f);
+  float x[3][FR_MFT_RAYS] __attribute__((aligned(64)));
+  for (size_t k = 0; k < FR_MFT_RAYS; k++)
+    for (int a = 0; a < 3; a++) x[a][k] = points[3 * (k < m ? k : m - 1) + (size_t)a];
+  vpf d[3];
+  for (int a = 0; a < 3; a++) d[a] = vp_sub(vp_load(x[a]), vp(light[a]));
+  const vpf dist = vp_sqrt(vp_add(vp_add(vp_mul(d[0], d[0]), vp_mul(d[1], d[1])), vp_mul(d[2], d[2])));
+  const vpf tnear = vp_mul(vp(1e-4f), dist), tfar = vp_sub(dist, vp(eps));
+  const vpm keep = vp_gt(tfar, tnear);
+  for (int a = 0; a < 3; a++) {
+    f[a] = vp(light[a]);
+    f[4 + a] = vp_select(keep, vp_div(d[a], dist), zero);
+  }
+  f[3] = vp_select(keep, tnear, zero);
+  f[7] = vp_select(keep, tfar, zero);
+}
+
+/* Frusta from n <= 256 rays as lanes (fr_mft_fns.from_rays). */
+static unsigned frusta_of_lanes(fr_mft_batch *b, fr_mft_sets *t, const ray_lanes *L, size_t n) {
   memset(b, 0, sizeof *b);
-  if (n > FR_MFT_FRUSTA * FR_MFT_RAYS) n = FR_MFT_FRUSTA * FR_MFT_RAYS;
   /* The axis: the mean direction (unit directions, for the renderers' rays).
    * Sixteen running sums, ray i in sum i % 16, then those in double in lane
    * order: the same additions on every ISA, so the same frusta, at a tenth
@@ -115,27 +144,23 @@ unsigned FR_ISA_FN(fr_mft_from_rays)(fr_mft_batch *b, fr_mft_sets *t, const fr_r
   float sum[3][FR_MFT_RAYS] __attribute__((aligned(64)));
   {
     vpf acc[3] = {vp(0.0f), vp(0.0f), vp(0.0f)};
-    size_t i = 0;
-    for (; i + FR_MFT_RAYS <= n; i += FR_MFT_RAYS) {
-      vpf x[8];
-      vp_load_records8((const float *)(rays + i), x);
-      const vpf inf = vp(INFINITY);
-      vpm fin = vpm_and(vp_lt(vp_abs(x[4]), inf), vpm_and(vp_lt(vp_abs(x[5]), inf), vp_lt(vp_abs(x[6]), inf)));
-      for (int a = 0; a < 3; a++) acc[a] = vp_add(acc[a], vp_select(fin, x[4 + a], vp(0.0f)));
+    const vpf inf = vp(INFINITY);
+    for (size_t i = 0; i < n; i += FR_MFT_RAYS) {
+      const unsigned in = n - i >= FR_MFT_RAYS ? 0xFFFFu : (1u << (n - i)) - 1u;
+      vpf d[3];
+      for (int a = 0; a < 3; a++) d[a] = vp_load(L->f[4 + a] + i);
+      vpm fin = vpm_and(vp_lt(vp_abs(d[0]), inf), vpm_and(vp_lt(vp_abs(d[1]), inf), vp_lt(vp_abs(d[2]), inf)));
+      fin = vpm_and(fin, vpm_bits_to(in));
+      for (int a = 0; a < 3; a++) acc[a] = vp_add(acc[a], vp_select(fin, d[a], vp(0.0f)));
     }
     for (int a = 0; a < 3; a++) vp_store(sum[a], acc[a]);
-    for (; i < n; i++) {
-      const float *d = rays[i].dir;
-      if (fabsf(d[0]) < INFINITY && fabsf(d[1]) < INFINITY && fabsf(d[2]) < INFINITY)
-        for (int a = 0; a < 3; a++) sum[a][i % FR_MFT_RAYS] += d[a];
-    }
   }
   double m[3] = {0.0, 0.0, 0.0};
   for (int a = 0; a < 3; a++)
     for (int k = 0; k < FR_MFT_RAYS; k++) m[a] += sum[a][k];
   double ml = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
   int ok_axis = ml > 0.0 && ml < INFINITY;
-  frame F;
+  frame F = {{0.0f}, {0.0f}, {0.0f}, 0.0f}; /* set where ok_axis */
   if (ok_axis) {
     for (int a = 0; a < 3; a++) m[a] /= ml;
     /* e1, e2 across it, orthonormal in double and rounded once */
@@ -160,12 +185,12 @@ unsigned FR_ISA_FN(fr_mft_from_rays)(fr_mft_batch *b, fr_mft_sets *t, const fr_r
     const size_t first = (size_t)f * FR_MFT_RAYS;
     const size_t cnt = first >= n ? 0 : n - first < FR_MFT_RAYS ? n - first : FR_MFT_RAYS;
     int made = 0;
-    if (ok_axis && cnt == FR_MFT_RAYS) {
-      made = frustum_of(b, &t->set[f], f, rays + first, &F);
-    } else if (ok_axis && cnt) {
-      fr_ray pad[FR_MFT_RAYS]; /* a partial frustum repeats its last ray */
-      for (size_t k = 0; k < FR_MFT_RAYS; k++) pad[k] = rays[first + (k < cnt ? k : cnt - 1)];
-      made = frustum_of(b, &t->set[f], f, pad, &F);
+    if (ok_axis && cnt) {
+      vpf x[8];
+      float org[3];
+      for (int k = 0; k < 8; k++) x[k] = vp_load(L->f[k] + first);
+      for (int a = 0; a < 3; a++) org[a] = L->f[a][first];
+      made = frustum_of(b, &t->set[f], f, x, org, &F);
     }
     if (made) b->valid |= 1u << f;
     else memset(&t->set[f], 0, sizeof t->set[f]); /* what the kernels read of a frustum left out */
@@ -173,26 +198,41 @@ unsigned FR_ISA_FN(fr_mft_from_rays)(fr_mft_batch *b, fr_mft_sets *t, const fr_r
   return b->valid;
 }
 
-/* Ray j from the light towards point j: unit direction, tnear 1e-4 of the
- * way (for a light on a surface), tfar eps short of the point; an empty ray
- * (all zero but the origin) where that leaves nothing, or the point is not
- * finite. The same rounded operations in every lane, so every ISA gives the
- * same bits. */
+unsigned FR_ISA_FN(fr_mft_from_rays)(fr_mft_batch *b, fr_mft_sets *t, const fr_ray *rays, size_t n) {
+  if (n > FR_MFT_FRUSTA * FR_MFT_RAYS) n = FR_MFT_FRUSTA * FR_MFT_RAYS;
+  ray_lanes L;
+  for (size_t i = 0; i < n; i += FR_MFT_RAYS) {
+    const size_t m = n - i < FR_MFT_RAYS ? n - i : FR_MFT_RAYS;
+    vpf x[8];
+    if (m == FR_MFT_RAYS) {
+      vp_load_records8((const float *)(rays + i), x);
+    } else {
+      fr_ray pad[FR_MFT_RAYS]; /* a partial frustum repeats its last ray */
+      for (size_t k = 0; k < FR_MFT_RAYS; k++) pad[k] = rays[i + (k < m ? k : m - 1)];
+      vp_load_records8((const float *)pad, x);
+    }
+    for (int k = 0; k < 8; k++) vp_store(L.f[k] + i, x[k]);
+  }
+  return frusta_of_lanes(b, t, &L, n);
+}
+
+unsigned FR_ISA_FN(fr_mft_from_points)(fr_mft_batch *b, fr_mft_sets *t, const float light[3], const float *points,
+                                       size_t n, float eps) {
+  if (n > FR_MFT_FRUSTA * FR_MFT_RAYS) n = FR_MFT_FRUSTA * FR_MFT_RAYS;
+  ray_lanes L;
+  for (size_t i = 0; i < n; i += FR_MFT_RAYS) {
+    vpf x[8];
+    point_lanes(light, points + 3 * i, n - i < FR_MFT_RAYS ? n - i : FR_MFT_RAYS, eps, x);
+    for (int k = 0; k < 8; k++) vp_store(L.f[k] + i, x[k]);
+  }
+  return frusta_of_lanes(b, t, &L, n);
+}
+
 void FR_ISA_FN(fr_mft_rays_to_points)(const float light[3], const float *points, size_t n, float eps, fr_ray *rays) {
-  const vpf zero = vp(0.0f);
   for (size_t j = 0; j < n; j += FR_MFT_RAYS) {
     const size_t m = n - j < FR_MFT_RAYS ? n - j : FR_MFT_RAYS;
-    float x[3][FR_MFT_RAYS] __attribute__((aligned(64)));
-    for (size_t k = 0; k < FR_MFT_RAYS; k++) /* a last, partial group repeats its last point */
-      for (int a = 0; a < 3; a++) x[a][k] = points[3 * (j + (k < m ? k : m - 1)) + (size_t)a];
-    vpf d[3];
-    for (int a = 0; a < 3; a++) d[a] = vp_sub(vp_load(x[a]), vp(light[a]));
-    const vpf dist = vp_sqrt(vp_add(vp_add(vp_mul(d[0], d[0]), vp_mul(d[1], d[1])), vp_mul(d[2], d[2])));
-    const vpf tnear = vp_mul(vp(1e-4f), dist), tfar = vp_sub(dist, vp(eps));
-    const vpm keep = vp_gt(tfar, tnear);
-    vpf f[8] = {vp(light[0]), vp(light[1]), vp(light[2]), vp_select(keep, tnear, zero),
-                vp_select(keep, vp_div(d[0], dist), zero), vp_select(keep, vp_div(d[1], dist), zero),
-                vp_select(keep, vp_div(d[2], dist), zero), vp_select(keep, tfar, zero)};
+    vpf f[8];
+    point_lanes(light, points + 3 * j, m, eps, f);
     if (m == FR_MFT_RAYS) {
       vp_store_records((float *)(rays + j), f, 8);
     } else {

@@ -90,4 +90,4 @@ static unsigned intersect_mft(const fr_bvh2 *b, const fr_mft_opts *opt, const fr
 
 const fr_mft_fns FR_ISA_FN(fr_mft) = {FR_ISA_FN(fr_mft_occluded), intersect_mft, FR_ISA_FN(fr_mft_expand),
                                    FR_ISA_FN(fr_mft_from_rays), FR_ISA_FN(fr_mft_expand_arrays),
-                                   FR_ISA_FN(fr_mft_rays_to_points)};
+                                   FR_ISA_FN(fr_mft_rays_to_points), FR_ISA_FN(fr_mft_from_points)};
