@@ -9,7 +9,7 @@
  * shadow rays to the streams. */
 #define SHADOW_FRUSTA_MAX_NODES 6u
 
-/* Rays [first, first + n) of src: its own, or made into buf (n <= 1024). */
+/* Rays [first, first + n) of src: its own, or made into buf (n rays long). */
 static const fr_ray *rays_of(const fr_shadow_rays *src, size_t first, size_t n, fr_ray *buf) {
   if (src->rays) return src->rays + first;
   fr_mft_active()->rays_to_points(src->light, src->points + 3 * first, n, src->eps, buf);
