@@ -190,6 +190,36 @@ FR_INLINE vpf vp_abs(vpf a) {
 }
 FR_INLINE vpf vp_copysign(vpf mag, vpf sgn) { return vp_or(vp_abs(mag), vp_and(sgn, vp(-0.0f))); }
 
+/* P points of 3 floats each at p (3 P floats, any alignment) as their x, y
+ * and z lanes: with AVX-512 three loads and two permutes per coordinate,
+ * elsewhere a loop. Plain moves, the same bits on every level. */
+#if defined(FR_BUILD_ISA_AVX512) && P == 16
+FR_INLINE void vp_load_xyz(const float *p, vpf xyz[3]) {
+  /* coordinate c of point k is float 3 k + c: from the first two loads
+   * where that is below 32, then from the third */
+  static const int32_t from_ab[3][16] __attribute__((aligned(64))) = {
+      {0, 3, 6, 9, 12, 15, 18, 21, 24, 27, 30, 0, 0, 0, 0, 0},
+      {1, 4, 7, 10, 13, 16, 19, 22, 25, 28, 31, 0, 0, 0, 0, 0},
+      {2, 5, 8, 11, 14, 17, 20, 23, 26, 29, 0, 0, 0, 0, 0, 0}};
+  static const int32_t from_c[3][16] __attribute__((aligned(64))) = {
+      {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 17, 20, 23, 26, 29},
+      {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 18, 21, 24, 27, 30},
+      {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 16, 19, 22, 25, 28, 31}};
+  const __m512 a = _mm512_loadu_ps(p), b = _mm512_loadu_ps(p + 16), c = _mm512_loadu_ps(p + 32);
+  for (int k = 0; k < 3; k++) {
+    const __m512 ab = _mm512_permutex2var_ps(a, _mm512_load_si512((const void *)from_ab[k]), b);
+    xyz[k].v = _mm512_permutex2var_ps(ab, _mm512_load_si512((const void *)from_c[k]), c);
+  }
+}
+#else
+FR_INLINE void vp_load_xyz(const float *p, vpf xyz[3]) {
+  float t[3][P] __attribute__((aligned(64)));
+  for (int k = 0; k < P; k++)
+    for (int c = 0; c < 3; c++) t[c][k] = p[3 * k + c];
+  for (int c = 0; c < 3; c++) xyz[c] = vp_load(t[c]);
+}
+#endif
+
 /* Memory by lane: vp_gather reads base[idx[i]] (idx: P aligned int32, each a
  * valid index), vp_store_mask writes lane i of a to p[i] where bit i of mask is
  * set, vp_scatter writes it to base[idx[i]] (distinct indices). Plain moves,

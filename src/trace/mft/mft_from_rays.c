@@ -117,11 +117,16 @@ static void cross_d(const double a[3], const double b[3], double out[3]) {
  * so every ISA gives the same bits. */
 static void point_lanes(const float light[3], const float *points, size_t m, float eps, vpf f[8]) {
   const vpf zero = vp(0.0f);
-  float x[3][FR_MFT_RAYS] __attribute__((aligned(64)));
-  for (size_t k = 0; k < FR_MFT_RAYS; k++)
-    for (int a = 0; a < 3; a++) x[a][k] = points[3 * (k < m ? k : m - 1) + (size_t)a];
   vpf d[3];
-  for (int a = 0; a < 3; a++) d[a] = vp_sub(vp_load(x[a]), vp(light[a]));
+  if (m == FR_MFT_RAYS) {
+    vp_load_xyz(points, d);
+  } else {
+    float pad[3 * FR_MFT_RAYS];
+    for (size_t k = 0; k < FR_MFT_RAYS; k++)
+      for (int a = 0; a < 3; a++) pad[3 * k + (size_t)a] = points[3 * (k < m ? k : m - 1) + (size_t)a];
+    vp_load_xyz(pad, d);
+  }
+  for (int a = 0; a < 3; a++) d[a] = vp_sub(d[a], vp(light[a]));
   const vpf dist = vp_sqrt(vp_add(vp_add(vp_mul(d[0], d[0]), vp_mul(d[1], d[1])), vp_mul(d[2], d[2])));
   const vpf tnear = vp_mul(vp(1e-4f), dist), tfar = vp_sub(dist, vp(eps));
   const vpm keep = vp_gt(tfar, tnear);
