@@ -25,22 +25,31 @@
 _Static_assert(FR_PACKET == FR_MFT_RAYS, "one lane per ray of a frustum");
 _Static_assert(sizeof(fr_ray) == 8 * sizeof(float) && sizeof(fr_hit) == 7 * sizeof(float), "records of 8 and 7 floats");
 
+/* Frustum f's 16 directions d (start + delta, as the kernels traced them)
+ * and their lengths; returns its hits' t in units of the unit directions
+ * (+inf on a miss). */
+FR_INLINE vpf frustum_t(const fr_mft_batch *b, const fr_mft_sets *sets, const fr_mft_hits *h, int f, vpf d[3],
+                        vpf *len) {
+  const fr_mft_set *s = &sets->set[b->set[f]];
+  const float *dl[3] = {s->dx, s->dy, s->dz};
+  for (int a = 0; a < 3; a++) d[a] = vp_add(vp(b->start[a][f]), vp_load(dl[a]));
+  *len = vp_sqrt(vp_add(vp_add(vp_mul(d[0], d[0]), vp_mul(d[1], d[1])), vp_mul(d[2], d[2])));
+  unsigned miss = 0;
+  for (int k = 0; k < FR_MFT_RAYS; k++) miss |= (unsigned)(h->prim[f][k] == FR_INVALID_ID) << k;
+  return vp_select(vpm_bits_to(miss), vp(INFINITY), vp_mul(vp_load(h->t[f]), *len));
+}
+
 void FR_ISA_FN(fr_mft_expand)(const fr_mft_batch *b, const fr_mft_sets *sets, const fr_mft_hits *h, fr_ray *rays,
                               fr_hit *hits) {
   const vpf zero = vp(0.0f), inf = vp(INFINITY);
   for (int f = 0; f < FR_MFT_FRUSTA; f++) {
-    const fr_mft_set *s = &sets->set[b->set[f]];
-    vpf d[3] = {vp_add(vp(b->start[0][f]), vp_load(s->dx)), vp_add(vp(b->start[1][f]), vp_load(s->dy)),
-                vp_add(vp(b->start[2][f]), vp_load(s->dz))};
-    vpf len = vp_sqrt(vp_add(vp_add(vp_mul(d[0], d[0]), vp_mul(d[1], d[1])), vp_mul(d[2], d[2])));
-    unsigned miss = 0;
-    for (int k = 0; k < FR_MFT_RAYS; k++) miss |= (unsigned)(h->prim[f][k] == FR_INVALID_ID) << k;
+    vpf d[3], len;
+    const vpf t = frustum_t(b, sets, h, f, d, &len);
     vpf ray[8] = {vp(b->org[0][f]), vp(b->org[1][f]), vp(b->org[2][f]), zero,
                   vp_div(d[0], len), vp_div(d[1], len), vp_div(d[2], len), inf};
     float prim[FR_MFT_RAYS] __attribute__((aligned(64))); /* ids as float bit patterns: copied, never cast */
     memcpy(prim, h->prim[f], sizeof prim);
-    vpf hit[7] = {vp_select(vpm_bits_to(miss), inf, vp_mul(vp_load(h->t[f]), len)), vp_load(h->u[f]), vp_load(h->v[f]),
-                  vp_load(prim), zero, zero, zero};
+    vpf hit[7] = {t, vp_load(h->u[f]), vp_load(h->v[f]), vp_load(prim), zero, zero, zero};
     vp_store_records((float *)(rays + FR_MFT_RAYS * f), ray, 8);
     vp_store_records((float *)(hits + FR_MFT_RAYS * f), hit, 7);
   }
@@ -48,17 +57,11 @@ void FR_ISA_FN(fr_mft_expand)(const fr_mft_batch *b, const fr_mft_sets *sets, co
 
 void FR_ISA_FN(fr_mft_expand_arrays)(const fr_mft_batch *b, const fr_mft_sets *sets, const fr_mft_hits *h,
                                      const fr_hit_arrays *out, size_t at, size_t width, int rows) {
-  const vpf inf = vp(INFINITY);
   for (unsigned todo = b->valid; todo; todo &= todo - 1) {
     const int f = __builtin_ctz(todo);
-    const fr_mft_set *s = &sets->set[b->set[f]];
-    vpf d[3] = {vp_add(vp(b->start[0][f]), vp_load(s->dx)), vp_add(vp(b->start[1][f]), vp_load(s->dy)),
-                vp_add(vp(b->start[2][f]), vp_load(s->dz))};
-    vpf len = vp_sqrt(vp_add(vp_add(vp_mul(d[0], d[0]), vp_mul(d[1], d[1])), vp_mul(d[2], d[2])));
-    unsigned miss = 0;
-    for (int k = 0; k < FR_MFT_RAYS; k++) miss |= (unsigned)(h->prim[f][k] == FR_INVALID_ID) << k;
+    vpf d[3], len;
     float t[FR_MFT_RAYS] __attribute__((aligned(64))), dir[3][FR_MFT_RAYS] __attribute__((aligned(64)));
-    vp_store(t, vp_select(vpm_bits_to(miss), inf, vp_mul(vp_load(h->t[f]), len)));
+    vp_store(t, frustum_t(b, sets, h, f, d, &len));
     if (out->dir)
       for (int a = 0; a < 3; a++) vp_store(dir[a], vp_div(d[a], len));
     /* ray k is pixel (k & 3, k >> 2) of the frustum's 4x4 block */
