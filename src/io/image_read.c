@@ -73,12 +73,11 @@ static uint64_t exr_value_size(const char *type, const unsigned char *v, uint32_
   return size;
 }
 
-static fr_error exr_header_check(const char *path, size_t bytes) {
+/* The header of the open file f (bytes long) of path. */
+static fr_error exr_header_check(const char *path, FILE *f, size_t bytes) {
   unsigned char *h = malloc(EXR_HEADER_MAX);
-  FILE *f = h ? fopen(path, "rb") : NULL;
-  if (!f) { free(h); return h ? fr_fail(FR_ERR_IO, "%s: cannot open", path) : fr_fail(FR_ERR_NOMEM, "%s: out of memory", path); }
-  const size_t n = fread(h, 1, EXR_HEADER_MAX, f);
-  fclose(f);
+  if (!h) return fr_fail(FR_ERR_NOMEM, "%s: out of memory", path);
+  const size_t n = fseek(f, 0, SEEK_SET) == 0 ? fread(h, 1, EXR_HEADER_MAX, f) : 0;
   fr_error err = FR_OK;
   if (n < 8 || le32(h) != 20000630u) {
     err = fr_fail(FR_ERR_FORMAT, "%s: not an OpenEXR file", path);
@@ -123,9 +122,8 @@ static fr_error exr_header_check(const char *path, size_t bytes) {
   return err;
 }
 
+/* path, bytes long, whose header exr_header_check has passed */
 static fr_error read_exr(const char *path, size_t bytes, int *width, int *height, float **out) {
-  fr_error checked = exr_header_check(path, bytes);
-  if (checked) return checked;
   ImfInputFile *in = ImfOpenInputFile(path);
   if (!in) return fr_fail(FR_ERR_FORMAT, "%s: not a readable OpenEXR file (%s)", path, ImfErrorMessage());
   int x0, y0, x1, y1;
@@ -252,9 +250,9 @@ fr_error fr_image_read(const char *path, int *width, int *height, float **rgb) {
   FILE *f = fopen(path, "rb");
   if (!f) return fr_fail(FR_ERR_IO, "%s: cannot open", path);
   long bytes = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+  fr_error err = bytes < 0 ? fr_fail(FR_ERR_IO, "%s: cannot read", path) : exr_header_check(path, f, (size_t)bytes);
   fclose(f);
-  if (bytes < 0) return fr_fail(FR_ERR_IO, "%s: cannot read", path);
-  return read_exr(path, (size_t)bytes, width, height, rgb);
+  return err ? err : read_exr(path, (size_t)bytes, width, height, rgb);
 }
 
 static float srgb_to_linear(unsigned char c) {
