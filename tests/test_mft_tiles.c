@@ -10,6 +10,7 @@
 #include "render/mft_rays.h"
 #include "render/softshadow.h"
 #include "render/views.h"
+#include "render/workload.h"
 #include "test_util.h"
 #include "trace/kernels.h"
 #include "trace/mft/mft.h"
@@ -201,6 +202,56 @@ static void soft_fallback(void **state) {
   fr_scene_release(s);
 }
 
+/* The shadow workload through the multi-frusta tracer: tiles over few
+ * triangles send their point-light shadow rays as frusta from the light,
+ * the others as rays from the points (tile.c, POINT_FRUSTA_MAX_TRIS). Both
+ * kinds of tile must occur, and every pixel's verdict must be the rays'
+ * but where the segment's occluder lies at one of its ends, within the
+ * rounding of where the two tracers place the end (counted, and few). */
+static void point_shadow_tiles(void **state) {
+  (void)state;
+  char path[1024];
+  shared_scene_path(path, sizeof path, "kitchen/kitchen.ply.zst");
+  fr_scene *s;
+  if (fr_scene_load(path, &s) != FR_OK) fail_msg("%s: %s", path, fr_last_error());
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  enum { SZ = 256 };
+  fr_workload w;
+  memset(&w, 0, sizeof w);
+  w.kind = FR_WL_SHADOW;
+  w.scene = s;
+  assert_true(fr_view_lookup(s->name, &w.view));
+  assert_int_equal(fr_camera_setup(&w.cam, w.view.eye, w.view.at, w.view.up, w.view.fov, SZ, SZ), FR_OK);
+  float lo[3], hi[3];
+  fr_scene_bounds(s, lo, hi);
+  w.eps = 1e-4f * v3_len(v3_sub(v3_load(hi), v3_load(lo)));
+  w.threads = 1;
+  static float vis_mft[SZ * SZ], vis_rays[SZ * SZ], depth[SZ * SZ], normal[3 * SZ * SZ], albedo[3 * SZ * SZ];
+  w.gbuf_depth = depth;
+  w.gbuf_normal = normal;
+  w.gbuf_albedo = albedo;
+  fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
+  ray_counter c = {fr_tracer_mft(&mctx), 0, 0, 0, 0, 0};
+  fr_tracer counted = {&c, counted_intersect, counted_occluded, counted_intersect_frusta, counted_occluded_frusta, 0,
+                       counted_shaft_tree};
+  w.gbuf_vis = vis_mft;
+  fr_workload_run(&w, &counted);
+  fr_tracer rays = fr_tracer_frusta(s);
+  w.gbuf_vis = vis_rays;
+  fr_workload_run(&w, &rays);
+  size_t differ = 0, lit = 0;
+  for (int i = 0; i < SZ * SZ; i++) {
+    differ += vis_mft[i] != vis_rays[i];
+    lit += vis_rays[i] == 1.0f;
+  }
+  print_message("kitchen shadow workload: %zu frusta batches (%zu over their budget), %zu rays as rays; %zu of %d "
+                "pixels lit, %zu differ\n", c.batches, c.stopped, c.rays, lit, SZ * SZ, differ);
+  assert_true(c.batches > 0 && c.rays > 0);
+  assert_true(lit > SZ * SZ / 8 && lit < SZ * SZ * 7 / 8);
+  assert_true(differ <= SZ * SZ / 2000);
+  fr_scene_release(s);
+}
+
 /* Whether segment p + t (q - p), t in [0, 1], meets box [lo, hi], in
  * double precision. */
 static int segment_meets(const double p[3], const double q[3], const float lo[3], const float hi[3]) {
@@ -316,6 +367,7 @@ int main(void) {
       cmocka_unit_test(bvh2_leaves_by_sah),
       cmocka_unit_test(shaft_covers),
       cmocka_unit_test(soft_fallback),
+      cmocka_unit_test(point_shadow_tiles),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

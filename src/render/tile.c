@@ -7,23 +7,23 @@
 #include "base/rng.h"
 #include "base/trig.h"
 #include "render/mft_rays.h"
+#include "render/shadow_frusta.h"
 
-void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, fr_ray *rays, fr_hit *hits) {
+unsigned fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, fr_ray *rays, fr_hit *hits) {
   fr_mft_batch b;
   static _Thread_local fr_mft_hits h;
   const fr_mft_sets *cam_set = w->camera_set;
   fr_mft_batch_camera(&b, &w->cam, tx, ty);
-  t->intersect_frusta(t->ctx, &b, cam_set, &h);
+  const unsigned fetched = t->intersect_frusta(t->ctx, &b, cam_set, &h);
   fr_mft_active()->expand(&b, cam_set, &h, rays, hits);
+  return fetched;
 }
 
 /* Making a workload's rays is timed with either tracer, so it does only what
  * the rays need. */
 
-/* shadow: each hit's ray to the point light, [eps, (1 - 1e-4) |L - p|],
- * made without the normal and random numbers it does not use */
-static int point_light_rays(const fr_workload *w, fr_tile_buffers *B, int n) {
-  float px[TILE_PIX], py[TILE_PIX], pz[TILE_PIX], inv[TILE_PIX], dist[TILE_PIX];
+/* The camera rays' hit points, their pixels in B->owner; returns how many. */
+static int hit_points(fr_tile_buffers *B, int n, float *px, float *py, float *pz) {
   int m = 0;
   for (int i = 0; i < n; i++) {
     const fr_hit *h = &B->prim_hit[i];
@@ -32,6 +32,14 @@ static int point_light_rays(const fr_workload *w, fr_tile_buffers *B, int n) {
     px[m] = p.x; py[m] = p.y; pz[m] = p.z;
     B->owner[m++] = i;
   }
+  return m;
+}
+
+/* shadow: each hit's ray to the point light, [eps, (1 - 1e-4) |L - p|],
+ * made without the normal and random numbers it does not use */
+static int point_light_rays(const fr_workload *w, fr_tile_buffers *B, int n) {
+  float px[TILE_PIX], py[TILE_PIX], pz[TILE_PIX], inv[TILE_PIX], dist[TILE_PIX];
+  const int m = hit_points(B, n, px, py, pz);
   const vec3 L = w->view.light;
   for (int k = 0; k < m; k++) { /* one loop of square roots and divisions, vectorized */
     float dx = L.x - px[k], dy = L.y - py[k], dz = L.z - pz[k];
@@ -79,12 +87,44 @@ static int ao_rays(const fr_workload *w, fr_tile_buffers *B, int n) {
   return m;
 }
 
+/* A tile's point-light shadow rays go as multi-frusta from the light where
+ * its camera frusta fetched at most POINT_FRUSTA_MAX_TRIS triangles per
+ * frustum of 4x4 pixels: segments that end among few triangles pass few on
+ * the way, and frusta from the light beat packets from the points there
+ * (the interiors). Over fine geometry (dragon, hairball: over 100 per
+ * frustum) every batch would spend its node budget before going to rays. */
+#define POINT_FRUSTA_MAX_TRIS 8u
+
+/* shadow by frusta: each hit's segment to the light traced from the light's
+ * end (render/shadow_frusta.h), the segment of point_light_rays' ray: eps
+ * left out at the point, 1e-4 of the length at the light. Returns the
+ * segments traced, their pixels in B->owner. */
+static int point_light_frusta(const fr_workload *w, const fr_tracer *t, fr_tile_buffers *B, int n) {
+  float px[TILE_PIX], py[TILE_PIX], pz[TILE_PIX], points[3 * TILE_PIX];
+  const int m = hit_points(B, n, px, py, pz);
+  for (int k = 0; k < m; k++) points[3 * k] = px[k], points[3 * k + 1] = py[k], points[3 * k + 2] = pz[k];
+  const float light[3] = {w->view.light.x, w->view.light.y, w->view.light.z};
+  const fr_shadow_rays src = {NULL, light, points, w->eps};
+  fr_shadow_frusta_occluded(t, &src, B->occ, (size_t)m, !w->mft_no_fallback);
+  return m;
+}
+
 /* shadow and ao16: the rays traced as one call; lit[i] gets pixel i's
- * unoccluded fraction. Returns the rays traced. */
-static uint64_t point_or_ao_rays(const fr_workload *w, const fr_tracer *t, fr_tile_buffers *B, int n, float *lit) {
+ * unoccluded fraction. fetched: the triangles the tile's camera frusta
+ * fetched, or -1 where its camera rays went as rays. Returns the rays
+ * traced. */
+static uint64_t point_or_ao_rays(const fr_workload *w, const fr_tracer *t, fr_tile_buffers *B, int n, long fetched,
+                                 float *lit) {
   const int per = w->kind == FR_WL_SHADOW ? 1 : 16;
-  const int m = w->kind == FR_WL_SHADOW ? point_light_rays(w, B, n) : ao_rays(w, B, n);
-  t->occluded(t->ctx, B->rays, B->occ, (size_t)m, 0);
+  const int frusta = w->kind == FR_WL_SHADOW && t->occluded_frusta && fetched >= 0 &&
+                     (w->mft_no_fallback || fetched <= (long)(POINT_FRUSTA_MAX_TRIS * FR_MFT_FRUSTA));
+  int m;
+  if (frusta) {
+    m = point_light_frusta(w, t, B, n);
+  } else {
+    m = w->kind == FR_WL_SHADOW ? point_light_rays(w, B, n) : ao_rays(w, B, n);
+    t->occluded(t->ctx, B->rays, B->occ, (size_t)m, 0);
+  }
   /* each pixel's rays are consecutive: summed per pixel, not counted ray by
    * ray into its pixel (a chain through memory) */
   int cnt[TILE_PIX] = {0};
@@ -199,8 +239,9 @@ uint64_t fr_tile_run(const fr_workload *w, const fr_tracer *t, fr_tile_buffers *
           n++;
         }
   uint64_t rays = (uint64_t)n;
+  long fetched = -1;
   if (frusta)
-    fr_camera_frusta(w, t, tx, ty, B->prim_ray, B->prim_hit);
+    fetched = (long)fr_camera_frusta(w, t, tx, ty, B->prim_ray, B->prim_hit);
   else
     t->intersect(t->ctx, B->rays, B->prim_hit, (size_t)n, 1);
   float lit[TILE_PIX];
@@ -215,7 +256,7 @@ uint64_t fr_tile_run(const fr_workload *w, const fr_tracer *t, fr_tile_buffers *
     break;
   case FR_WL_SHADOW:
   case FR_WL_AO16:
-    rays += point_or_ao_rays(w, t, B, n, lit);
+    rays += point_or_ao_rays(w, t, B, n, fetched, lit);
     break;
   case FR_WL_DIFFUSE8:
   case FR_WL_SPECULAR8:

@@ -67,10 +67,12 @@ typedef struct fr_workload {
   /* whitted: which surfaces mirror and refract, recursion depth (0: 4) */
   const struct fr_whitted_mats *mats;
   int max_depth;
-  /* soft shadows with a frusta tracer: 0 (default) traces a tile's shadows as
-   * rays where its first batch's frusta fetched too many triangles each
-   * (SOFT_FRUSTA_MAX_TRIS in workload.c); 1 keeps every batch as frusta (the
-   * paper's pure multi-frusta, to measure) */
+  /* shadows with a frusta tracer: 0 (default) traces a tile's shadows as
+   * rays where frusta fetched too many triangles each (soft shadows: its
+   * first shadow batch's, SOFT_FRUSTA_MAX_TRIS in soft_tile.c; point-light
+   * shadows: its camera batch's, POINT_FRUSTA_MAX_TRIS in tile.c) and a
+   * point-light batch over its node budget as rays; 1 keeps every batch as
+   * frusta (the paper's pure multi-frusta, to measure) */
   int mft_no_fallback;
   /* 1: no tile shafts (SOFT_SHAFT_DECIDES_* in workload.c): every batch
    * walks the tree from the root and no shaft decides a fall-back, to
@@ -115,7 +117,8 @@ int fr_workload_tile_side(const fr_workload *w);
 /* Camera rays of the full 16x16 tile at (tx, ty) by multi-frusta tracing
  * (t->intersect_frusta): ray and hit 16 f + k are pixel (tx + 4 (f % 4) +
  * k % 4, ty + 4 (f / 4) + k / 4). The rays are fr_mft_ray's with unit
- * directions, as fr_camera_ray makes them, and the hits are in their units. */
-void fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, fr_ray *rays, fr_hit *hits);
+ * directions, as fr_camera_ray makes them, and the hits are in their units.
+ * Returns the triangles the frusta fetched. */
+unsigned fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int ty, fr_ray *rays, fr_hit *hits);
 
 #endif

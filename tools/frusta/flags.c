@@ -115,7 +115,8 @@ const cli_flag cli_flags[F_COUNT] = {
     [F_SHRINK] = {"--shrink", "on|corners|off", B,
                   "multi-frusta: shrink shadow frusta to their active rays (default on: corners and intervals)"},
     [F_MFT_LEAF] = {"--mft-leaf", "N", B, "multi-frusta: one binary tree of leaf size N for all frusta"},
-    [F_MFT_FALLBACK] = {"--mft-fallback", "on|off", B, "soft shadows: tiles fall back to ray streams (default on)"},
+    [F_MFT_FALLBACK] = {"--mft-fallback", "on|off", B,
+                        "soft and point-light shadows: tiles fall back to ray streams (default on)"},
     [F_MFT_SHAFT] = {"--mft-shaft", "on|off", B, "soft shadows: tile shafts (default on)"},
 };
 
