@@ -22,14 +22,16 @@ unsigned fr_camera_frusta(const fr_workload *w, const fr_tracer *t, int tx, int 
 /* Making a workload's rays is timed with either tracer, so it does only what
  * the rays need. */
 
-/* The camera rays' hit points, their pixels in B->owner; returns how many. */
-static int hit_points(fr_tile_buffers *B, int n, float *px, float *py, float *pz) {
+/* The camera rays' hit points, the k-th at x[k * stride], y[k * stride]
+ * and z[k * stride], its pixel in B->owner[k]; returns how many. */
+static int hit_points(fr_tile_buffers *B, int n, float *x, float *y, float *z, int stride) {
   int m = 0;
   for (int i = 0; i < n; i++) {
     const fr_hit *h = &B->prim_hit[i];
     if (h->prim == FR_INVALID_ID) continue;
     const vec3 p = hit_point(&B->prim_ray[i], h);
-    px[m] = p.x; py[m] = p.y; pz[m] = p.z;
+    const size_t at = (size_t)m * (size_t)stride;
+    x[at] = p.x; y[at] = p.y; z[at] = p.z;
     B->owner[m++] = i;
   }
   return m;
@@ -39,7 +41,7 @@ static int hit_points(fr_tile_buffers *B, int n, float *px, float *py, float *pz
  * made without the normal and random numbers it does not use */
 static int point_light_rays(const fr_workload *w, fr_tile_buffers *B, int n) {
   float px[TILE_PIX], py[TILE_PIX], pz[TILE_PIX], inv[TILE_PIX], dist[TILE_PIX];
-  const int m = hit_points(B, n, px, py, pz);
+  const int m = hit_points(B, n, px, py, pz, 1);
   const vec3 L = w->view.light;
   for (int k = 0; k < m; k++) { /* one loop of square roots and divisions, vectorized */
     float dx = L.x - px[k], dy = L.y - py[k], dz = L.z - pz[k];
@@ -100,9 +102,8 @@ static int ao_rays(const fr_workload *w, fr_tile_buffers *B, int n) {
  * left out at the point, 1e-4 of the length at the light. Returns the
  * segments traced, their pixels in B->owner. */
 static int point_light_frusta(const fr_workload *w, const fr_tracer *t, fr_tile_buffers *B, int n) {
-  float px[TILE_PIX], py[TILE_PIX], pz[TILE_PIX], points[3 * TILE_PIX];
-  const int m = hit_points(B, n, px, py, pz);
-  for (int k = 0; k < m; k++) points[3 * k] = px[k], points[3 * k + 1] = py[k], points[3 * k + 2] = pz[k];
+  float points[3 * TILE_PIX];
+  const int m = hit_points(B, n, points, points + 1, points + 2, 3);
   const float light[3] = {w->view.light.x, w->view.light.y, w->view.light.z};
   const fr_shadow_rays src = {NULL, light, points, w->eps};
   fr_shadow_frusta_occluded(t, &src, B->occ, (size_t)m, !w->mft_no_fallback);
@@ -126,12 +127,18 @@ static uint64_t point_or_ao_rays(const fr_workload *w, const fr_tracer *t, fr_ti
     t->occluded(t->ctx, B->rays, B->occ, (size_t)m, 0);
   }
   /* each pixel's rays are consecutive: summed per pixel, not counted ray by
-   * ray into its pixel (a chain through memory) */
+   * ray into its pixel (a chain through memory); a shadow ray is its
+   * pixel's verdict (the loop of a sum of `per` compiled for any per took a
+   * tenth of a tile's own time) */
   int cnt[TILE_PIX] = {0};
-  for (int k = 0; k < m; k += per) {
-    int c = 0;
-    for (int j = 0; j < per; j++) c += !B->occ[k + j];
-    cnt[B->owner[k]] = c;
+  if (per == 1) {
+    for (int k = 0; k < m; k++) cnt[B->owner[k]] = !B->occ[k];
+  } else {
+    for (int k = 0; k < m; k += 16) {
+      int c = 0;
+      for (int j = 0; j < 16; j++) c += !B->occ[k + j];
+      cnt[B->owner[k]] = c;
+    }
   }
   for (int i = 0; i < n; i++) lit[i] = (float)cnt[i] / (float)per;
   return (uint64_t)m;
