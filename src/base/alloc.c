@@ -20,3 +20,8 @@ void *fr_alloc_aligned(size_t bytes, size_t align) {
 }
 
 void fr_free_aligned(void *p) { free(p); }
+
+void *fr_malloc_array(size_t n, size_t size) {
+  size_t bytes;
+  return __builtin_mul_overflow(n, size, &bytes) ? NULL : malloc(bytes);
+}

@@ -12,4 +12,8 @@ static inline size_t fr_mul_size(size_t a, size_t b) {
   size_t r;
   return __builtin_mul_overflow(a, b, &r) ? SIZE_MAX : r;
 }
+
+/* malloc of n elements of size bytes; NULL where n * size overflows, without
+ * asking malloc for SIZE_MAX (which GCC warns of where it can see it). */
+void *fr_malloc_array(size_t n, size_t size);
 #endif

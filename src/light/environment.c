@@ -23,7 +23,7 @@ fr_error fr_env_from_image(fr_env *e, float *rgb, int w, int h) {
     fr_env_free(e);
     return fr_fail(FR_ERR_ARG, "an environment image of %dx%d pixels: at most 2^29 pixels", w, h);
   }
-  float *weight = malloc(fr_mul_size(fr_mul_size((size_t)w, (size_t)h), sizeof(float)));
+  float *weight = fr_malloc_array(fr_mul_size((size_t)w, (size_t)h), sizeof(float));
   if (!weight) { fr_env_free(e); return fr_fail(FR_ERR_NOMEM, "out of memory for the environment's distribution"); }
   for (int y = 0; y < h; y++) {
     const float s = sinf(FR_ENV_PI * ((float)y + 0.5f) / (float)h);
@@ -35,7 +35,7 @@ fr_error fr_env_from_image(fr_env *e, float *rgb, int w, int h) {
   fr_error err = fr_dist2d_build(&e->dist, weight, w, h);
   free(weight);
   if (err == FR_ERR_ARG) e->black = 1, err = FR_OK; /* an all-black image lights nothing */
-  if (!err && !(e->texels = malloc(fr_mul_size(fr_mul_size((size_t)w, (size_t)h), 4 * sizeof(float)))))
+  if (!err && !(e->texels = fr_malloc_array(fr_mul_size((size_t)w, (size_t)h), 4 * sizeof(float))))
     err = fr_fail(FR_ERR_NOMEM, "out of memory for the environment's texels");
   if (err) { fr_env_free(e); return err; }
   for (int y = 0; y < h; y++)
