@@ -119,12 +119,15 @@ static uint64_t point_or_ao_rays(const fr_workload *w, const fr_tracer *t, fr_ti
   const int per = w->kind == FR_WL_SHADOW ? 1 : 16;
   const int frusta = w->kind == FR_WL_SHADOW && t->occluded_frusta && fetched >= 0 &&
                      (w->mft_no_fallback || fetched <= (long)(POINT_FRUSTA_MAX_TRIS * FR_MFT_FRUSTA));
+  /* a tile whose camera frusta found fine geometry: its shadow rays part
+   * ways at the scale of the triangles */
+  const int divergent = w->kind == FR_WL_SHADOW && t->occluded_frusta && fetched >= 0 && !frusta;
   int m;
   if (frusta) {
     m = point_light_frusta(w, t, B, n);
   } else {
     m = w->kind == FR_WL_SHADOW ? point_light_rays(w, B, n) : ao_rays(w, B, n);
-    t->occluded(t->ctx, B->rays, B->occ, (size_t)m, 0);
+    t->occluded(t->ctx, B->rays, B->occ, (size_t)m, divergent ? FR_RAYS_DIVERGENT : 0);
   }
   /* each pixel's rays are consecutive: summed per pixel, not counted ray by
    * ray into its pixel (a chain through memory); a shadow ray is its
