@@ -23,6 +23,7 @@
 #include <string.h>
 #include "base/simd.h"
 #include "base/simd_packet.h"
+#include "base/vec3.h"
 #include "trace/mft/mft.h"
 
 #if P != 16
@@ -89,7 +90,8 @@ static int frustum_of(fr_mft_batch *b, fr_mft_set *S, int f, const vpf x[8], con
   vp_store(S->b, vb);
   S->amin = vp_reduce_min(va); S->amax = vp_reduce_max(va);
   S->bmin = vp_reduce_min(vb); S->bmax = vp_reduce_max(vb);
-  float big = fmaxf(fmaxf(fabsf(S->amin), fabsf(S->amax)), fmaxf(fabsf(S->bmin), fabsf(S->bmax)));
+  /* fr_maxf compiles to maxss, fmaxf to a call (NaN rules) */
+  float big = fr_maxf(fr_maxf(fabsf(S->amin), fabsf(S->amax)), fr_maxf(fabsf(S->bmin), fabsf(S->bmax)));
   const float pad = BOX_PAD * (big + sqrtf(sn * lam));
   if (!(pad < INFINITY)) return 0;
   S->amin -= pad; S->amax += pad; S->bmin -= pad; S->bmax += pad;
