@@ -205,9 +205,9 @@ static void soft_fallback(void **state) {
 /* The shadow workload through the multi-frusta tracer: tiles over few
  * triangles send their point-light shadow rays as frusta from the light,
  * the others as rays from the points (tile.c, POINT_FRUSTA_MAX_TRIS). Both
- * kinds of tile must occur, and every pixel's verdict must be the rays'
- * but where the segment's occluder lies at one of its ends, within the
- * rounding of where the two tracers place the end (counted, and few). */
+ * kinds of tile must occur, and the pixels' verdicts must be the rays':
+ * all but at most 1 in 2000 (none on this view), which the two ways may
+ * judge apart where an occluder lies within rounding of a segment's end. */
 static void point_shadow_tiles(void **state) {
   (void)state;
   char path[1024];
