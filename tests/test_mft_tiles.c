@@ -151,23 +151,30 @@ static const fr_bvh2 *counted_shaft_tree(void *ctx) {
   return c->inner.shaft_tree(c->inner.ctx);
 }
 
-static void soft_fallback(void **state) {
-  (void)state;
+/* Kitchen committed, and *w a one-thread workload of its view at size x
+ * size pixels; returns the scene (the caller releases it). */
+static fr_scene *kitchen_workload(fr_workload *w, int size) {
   char path[1024];
   shared_scene_path(path, sizeof path, "kitchen/kitchen.ply.zst");
   fr_scene *s;
   if (fr_scene_load(path, &s) != FR_OK) fail_msg("%s: %s", path, fr_last_error());
   assert_int_equal(fr_scene_commit(s), FR_OK);
-  enum { SZ = 128 };
-  fr_workload w;
-  memset(&w, 0, sizeof w);
-  w.scene = s;
-  assert_true(fr_view_lookup(s->name, &w.view));
-  assert_int_equal(fr_camera_setup(&w.cam, w.view.eye, w.view.at, w.view.up, w.view.fov, SZ, SZ), FR_OK);
+  memset(w, 0, sizeof *w);
+  w->scene = s;
+  assert_true(fr_view_lookup(s->name, &w->view));
+  assert_int_equal(fr_camera_setup(&w->cam, w->view.eye, w->view.at, w->view.up, w->view.fov, size, size), FR_OK);
   float lo[3], hi[3];
   fr_scene_bounds(s, lo, hi);
-  w.eps = 1e-4f * v3_len(v3_sub(v3_load(hi), v3_load(lo)));
-  w.threads = 1;
+  w->eps = 1e-4f * v3_len(v3_sub(v3_load(hi), v3_load(lo)));
+  w->threads = 1;
+  return s;
+}
+
+static void soft_fallback(void **state) {
+  (void)state;
+  enum { SZ = 128 };
+  fr_workload w;
+  fr_scene *s = kitchen_workload(&w, SZ);
   fr_softshadow_opts so = {16, 0, FR_LIGHT_SETS_SPREAD};
   static float img[SZ * SZ * 3], vis_mft[SZ * SZ], vis_rays[SZ * SZ];
   fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
@@ -210,22 +217,10 @@ static void soft_fallback(void **state) {
  * judge apart where an occluder lies within rounding of a segment's end. */
 static void point_shadow_tiles(void **state) {
   (void)state;
-  char path[1024];
-  shared_scene_path(path, sizeof path, "kitchen/kitchen.ply.zst");
-  fr_scene *s;
-  if (fr_scene_load(path, &s) != FR_OK) fail_msg("%s: %s", path, fr_last_error());
-  assert_int_equal(fr_scene_commit(s), FR_OK);
   enum { SZ = 256 };
   fr_workload w;
-  memset(&w, 0, sizeof w);
+  fr_scene *s = kitchen_workload(&w, SZ);
   w.kind = FR_WL_SHADOW;
-  w.scene = s;
-  assert_true(fr_view_lookup(s->name, &w.view));
-  assert_int_equal(fr_camera_setup(&w.cam, w.view.eye, w.view.at, w.view.up, w.view.fov, SZ, SZ), FR_OK);
-  float lo[3], hi[3];
-  fr_scene_bounds(s, lo, hi);
-  w.eps = 1e-4f * v3_len(v3_sub(v3_load(hi), v3_load(lo)));
-  w.threads = 1;
   static float vis_mft[SZ * SZ], vis_rays[SZ * SZ], depth[SZ * SZ], normal[3 * SZ * SZ], albedo[3 * SZ * SZ];
   w.gbuf_depth = depth;
   w.gbuf_normal = normal;

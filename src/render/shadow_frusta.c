@@ -52,13 +52,10 @@ void fr_shadow_frusta_occluded(const fr_tracer *t, const fr_shadow_rays *src, ui
     }
     a += m;
   }
-  if (a < n && src->rays) {
-    t->occluded(t->ctx, src->rays + a, occ + a, n - a, 1);
-  } else if (a < n) { /* made a piece at a time */
-    fr_ray piece[PIECE];
-    for (; a < n; a += PIECE) {
-      const size_t m = n - a < PIECE ? n - a : PIECE;
-      t->occluded(t->ctx, rays_of(src, a, m, piece), occ + a, m, 1);
-    }
+  /* the rest in one call, or made a piece at a time */
+  fr_ray piece[PIECE];
+  for (size_t m; a < n; a += m) {
+    m = src->rays || n - a < PIECE ? n - a : PIECE;
+    t->occluded(t->ctx, rays_of(src, a, m, piece), occ + a, m, 1);
   }
 }

@@ -117,11 +117,11 @@ static int point_light_frusta(const fr_workload *w, const fr_tracer *t, fr_tile_
 static uint64_t point_or_ao_rays(const fr_workload *w, const fr_tracer *t, fr_tile_buffers *B, int n, long fetched,
                                  float *lit) {
   const int per = w->kind == FR_WL_SHADOW ? 1 : 16;
-  const int frusta = w->kind == FR_WL_SHADOW && t->occluded_frusta && fetched >= 0 &&
-                     (w->mft_no_fallback || fetched <= (long)(POINT_FRUSTA_MAX_TRIS * FR_MFT_FRUSTA));
-  /* a tile whose camera frusta found fine geometry: its shadow rays part
-   * ways at the scale of the triangles */
-  const int divergent = w->kind == FR_WL_SHADOW && t->occluded_frusta && fetched >= 0 && !frusta;
+  /* point-light shadows whose tile's camera frusta told how fine its geometry is */
+  const int judged = w->kind == FR_WL_SHADOW && t->occluded_frusta && fetched >= 0;
+  const int frusta = judged && (w->mft_no_fallback || fetched <= (long)(POINT_FRUSTA_MAX_TRIS * FR_MFT_FRUSTA));
+  /* over fine geometry the shadow rays part ways at the scale of the triangles */
+  const int divergent = judged && !frusta;
   int m;
   if (frusta) {
     m = point_light_frusta(w, t, B, n);
