@@ -15,6 +15,8 @@
 #include "base/trig.h"
 #include "base/timer.h"
 #include "material/texture.h"
+#include "api/scene.h"
+#include "render/path_frames.h"
 #include "render/surfaces.h"
 #include "render/tile.h"
 
@@ -22,11 +24,9 @@
 #define WAVE FR_PATH_WAVE
 _Static_assert(WAVE >= TILE_PIX * FR_PATH_CHUNK && WAVE >= 32 * 32 * 2, "a pass's samples fill waves");
 _Static_assert(WAVE <= 65536, "path_state.slot is 16 bits");
-/* The shader loads a hit's surface record and corner indices this many
- * hits ahead: they are scattered over the scene's arrays. */
-#define PREFETCH_AHEAD 8
-/* Sample points are made for this many paths at a time, as vector code */
-#define POINT_BLOCK 64
+/* Sample points, environment lookups and hit frames are made for this many
+ * paths at a time, as vector code */
+#define POINT_BLOCK FR_PATH_FRAMES
 
 typedef struct path_state {
   vec3 weight;     /* throughput: what the radiance found next is multiplied by */
@@ -37,6 +37,15 @@ typedef struct path_state {
   uint8_t delta;   /* the ray left a delta lobe (or the camera): emitters it hits count whole */
   uint8_t depth;   /* segments before this one */
 } path_state;
+
+/* What shading a hit needs: the point, the geometric normal turned to the
+ * side shaded, the shading frame (t, b, n), wo in it, the material and its
+ * shading point. */
+typedef struct hit_frame {
+  vec3 p, ngo, n, t, b, wo;
+  const fr_bsdf *m;
+  fr_shading_point sp;
+} hit_frame;
 
 struct fr_path_scratch {
   fr_ray ray[WAVE];
@@ -52,6 +61,15 @@ struct fr_path_scratch {
   vec3 acc[WAVE], alb[WAVE], nrm[WAVE];
   float dep[WAVE];
   double stage[FR_STAGES];
+  /* the block of paths being shaded (frame_block, next_events,
+   * continue_paths): the lanes' frames, the frames as the shader reads
+   * them, the states, which paths go on from their hit, and a textured
+   * material's copy */
+  fr_path_frames lanes;
+  hit_frame frame[POINT_BLOCK];
+  path_state bst[POINT_BLOCK];
+  uint8_t live[POINT_BLOCK];
+  fr_bsdf textured[POINT_BLOCK];
 };
 
 fr_path_scratch *fr_path_scratch_new(void) {
@@ -233,6 +251,187 @@ static void env_block_sample(const fr_path_setup *P, const float (*pts)[POINT_BL
   }
 }
 
+/* The frames of a block's triangle hits, by the ISA's lanes. */
+static void frames_make(const fr_path_geometry *g, const fr_ray *ray, const fr_hit *hit, size_t m, fr_path_frames *f) {
+  const fr_isa isa = fr_get_isa();
+  if (isa == FR_ISA_AVX512) fr_path_frames_make_avx512(g, ray, hit, m, f);
+  else if (isa == FR_ISA_AVX2) fr_path_frames_make_avx2(g, ray, hit, m, f);
+  else fr_path_frames_make_scalar(g, ray, hit, m, f);
+}
+
+/* A sphere's frame, which the lanes leave out: the normal is p - c, the
+ * geometric normal is the shading normal. */
+static void sphere_frame(const fr_workload *w, const fr_ray *r, const fr_hit *h, fr_path_frames *f, size_t j) {
+  const fr_path_setup *P = w->path;
+  const vec3 d = v3_load(r->dir), p = v3_add(v3_load(r->org), v3_scale(d, h->t));
+  const float pp[3] = {p.x, p.y, p.z};
+  float ng3[3];
+  fr_scene_geometric_normal(w->scene, h->prim, pp, ng3);
+  const int32_t mat = fr_surface_material(w->scene, h->prim, (int32_t)P->count - 1);
+  const vec3 ng = v3_norm(v3_load(ng3));
+  const int front = v3_dot(ng, d) < 0.0f;
+  const vec3 n = P->mats[mat].kind == FR_BSDF_GLASS || front ? ng : v3_scale(ng, -1.0f);
+  vec3 t, b;
+  v3_onb(n, &t, &b);
+  const vec3 wo = to_local(v3_scale(d, -1.0f), t, b, n);
+  f->px[j] = p.x, f->py[j] = p.y, f->pz[j] = p.z;
+  f->gx[j] = f->nx[j] = n.x, f->gy[j] = f->ny[j] = n.y, f->gz[j] = f->nz[j] = n.z;
+  f->tx[j] = t.x, f->ty[j] = t.y, f->tz[j] = t.z, f->bx[j] = b.x, f->by[j] = b.y, f->bz[j] = b.z;
+  f->wx[j] = wo.x, f->wy[j] = wo.y, f->wz[j] = wo.z;
+  f->mat[j] = mat;
+  f->front[j] = (uint8_t)front;
+}
+
+/* The paths k0 .. k0 + m - 1 of the wave: adds what a segment that ended
+ * at the area light or in the sky brings; for those that hit a surface
+ * makes their frames (S->frame, the states in S->bst, S->live), adds the
+ * surface's emission and the first hit's AOVs. n: the wave's paths. */
+static void frame_block(const fr_workload *w, const quad_light *quad, const env_block *eb, fr_path_scratch *S,
+                        size_t k0, size_t m, size_t n, int depth) {
+  const fr_path_setup *P = w->path;
+  const fr_path_lights *L = &P->lights;
+  const int nlights = light_count(L);
+  const fr_mesh *mesh = &w->scene->mesh;
+  const fr_path_geometry g = {P->surf, (uint32_t)P->nsurf, P->mats, mesh->nrm.idx, mesh->nrm.val, (uint32_t)mesh->nrm.n};
+  fr_path_frames *f = &S->lanes;
+  /* the next block's records and corner indices start loading while this
+   * one is made */
+  for (size_t k = k0 + m; k < k0 + 2 * m && k < n; k++) {
+    const uint32_t prim = S->hit[k].prim;
+    if (prim < P->nsurf) {
+      __builtin_prefetch(&P->surf[prim]);
+      fr_scene_prefetch_shading(w->scene, prim);
+    }
+  }
+  frames_make(&g, S->ray + k0, S->hit + k0, m, f);
+  for (size_t j = 0; j < m; j++) {
+    const size_t k = k0 + j;
+    S->live[j] = 0;
+    path_state st = S->st[k];
+    const fr_ray *r = &S->ray[k];
+    const fr_hit h = S->hit[k];
+    const vec3 o = v3_load(r->org), d = v3_load(r->dir);
+    const int hit = h.prim != FR_INVALID_ID;
+    /* the area light, which is not in the scene's geometry, in front of the hit */
+    const float ta = L->area ? area_hit(quad, o, d, r->tnear, hit ? h.t : INFINITY) : 0.0f;
+    if (ta > 0.0f) { /* the lamp: it emits from its front, its back is dark */
+      if (depth == 0) S->dep[st.slot] = ta;
+      if (v3_dot(d, quad->n) < 0.0f) {
+        const float w_mis = st.delta ? 1.0f : power_heuristic(st.pdf, area_pdf(quad, d, ta) / (float)nlights);
+        S->acc[st.slot] = v3_add(S->acc[st.slot], v3_scale(v3_mul(st.weight, quad->radiance), w_mis));
+      }
+      continue;
+    }
+    if (!hit) {
+      float pe = 0.0f;
+      const vec3 le = depth == 0   ? fr_env_eval_smooth(L->env, d) /* the background, seen */
+                      : eb->sky[j] ? fr_env_texel_radiance(L->env, eb->sky[j], eb->sky_sin[j], st.delta ? NULL : &pe)
+                      : st.delta   ? fr_env_eval(L->env, d)
+                                   : fr_env_eval_pdf(L->env, d, &pe);
+      const float w_mis = st.delta ? 1.0f : power_heuristic(st.pdf, pe / (float)nlights);
+      S->acc[st.slot] = v3_add(S->acc[st.slot], v3_scale(v3_mul(st.weight, le), w_mis));
+      continue;
+    }
+    if (!f->made[j]) sphere_frame(w, r, &h, f, j);
+    hit_frame *fr = &S->frame[j];
+    fr->p = v3(f->px[j], f->py[j], f->pz[j]);
+    fr->ngo = v3(f->gx[j], f->gy[j], f->gz[j]);
+    fr->n = v3(f->nx[j], f->ny[j], f->nz[j]);
+    fr->t = v3(f->tx[j], f->ty[j], f->tz[j]);
+    fr->b = v3(f->bx[j], f->by[j], f->bz[j]);
+    fr->wo = v3(f->wx[j], f->wy[j], f->wz[j]);
+    const fr_bsdf *mat = &P->mats[f->mat[j]];
+    float st2[2];
+    if (mat->color_tex >= 0 && fr_scene_texcoord(w->scene, h.prim, h.u, h.v, st2)) {
+      S->textured[j] = *mat;
+      S->textured[j].color = fr_texture_lookup(&P->textures[mat->color_tex], st2[0], st2[1]);
+      mat = &S->textured[j];
+    }
+    fr->m = mat;
+    const int front = f->front[j];
+    if (mat->kind == FR_BSDF_GLASS && !front) { /* the segment ran inside: Beer's law */
+      const float a_k = h.t / mat->attenuation_distance;
+      const vec3 a = mat->attenuation_color;
+      st.weight = v3_mul(st.weight, v3(powf(a.x, a_k), powf(a.y, a_k), powf(a.z, a_k)));
+    }
+    if (front && nonzero(mat->emission)) S->acc[st.slot] = v3_add(S->acc[st.slot], v3_mul(st.weight, mat->emission));
+    fr_bsdf_prepare(mat, fr->p, &fr->sp);
+    if (depth == 0) S->dep[st.slot] = h.t;
+    if (depth == 0 && (w->gbuf_albedo || w->gbuf_normal)) {
+      S->alb[st.slot] = v3_add(S->alb[st.slot], fr_bsdf_albedo(mat));
+      S->nrm[st.slot] = v3_add(S->nrm[st.slot], v3_dot(fr->n, d) < 0.0f ? fr->n : v3_scale(fr->n, -1.0f)); /* facing the camera */
+    }
+    S->bst[j] = st;
+    S->live[j] = 1;
+  }
+}
+
+/* Next-event estimation for the block's live paths: a light sample each
+ * (dimension pair dim + 0 picks the light, dim + 1 places the sample),
+ * its contribution and shadow ray appended at S->scontrib, S->sray and
+ * S->spix[*ns]. */
+static void next_events(const fr_workload *w, const quad_light *quad, const env_block *eb,
+                        const float (*pts)[POINT_BLOCK], fr_path_scratch *S, size_t m, uint32_t dim, size_t *ns) {
+  const fr_path_setup *P = w->path;
+  const fr_path_lights *L = &P->lights;
+  if (!light_count(L)) return;
+  for (size_t j = 0; j < m; j++) {
+    if (!S->live[j]) continue;
+    const path_state *st = &S->bst[j];
+    const hit_frame *f = &S->frame[j];
+    if (!fr_bsdf_has_smooth(f->m, &f->sp)) continue;
+    float uc, ul, u1, u2;
+    path_point(P, pts, j, st, dim, 0, &uc, &ul);
+    path_point(P, pts, j, st, dim, 1, &u1, &u2);
+    vec3 wi, le;
+    float dist, pl;
+    int delta;
+    if (sample_light(L, quad, eb, j, f->p, uc, u1, u2, &wi, &dist, &le, &pl, &delta) && same_side(wi, f->n, f->ngo)) {
+      float pb;
+      const vec3 fv = fr_bsdf_eval(f->m, &f->sp, f->wo, to_local(wi, f->t, f->b, f->n), &pb);
+      if (nonzero(fv) && nonzero(le)) {
+        const float w_mis = delta ? 1.0f : power_heuristic(pl, pb);
+        S->scontrib[*ns] = v3_scale(v3_mul(v3_mul(st->weight, fv), le), w_mis / pl);
+        S->sray[*ns] = make_ray(f->p, wi, w->eps, isinf(dist) ? INFINITY : dist * (1.0f - 1e-4f));
+        S->spix[(*ns)++] = st->slot;
+      }
+    }
+  }
+}
+
+/* The next segment of the block's live paths: a BSDF sample each (pair
+ * dim + 0's second number picks the lobe, dim + 2 the direction), Russian
+ * roulette (dim + 3), and the survivors' states and rays written at
+ * S->st[*nn] and S->ray[*nn], never past the block's first path. */
+static void continue_paths(const fr_workload *w, const float (*pts)[POINT_BLOCK], fr_path_scratch *S, size_t m,
+                           uint32_t dim, int depth, size_t *nn) {
+  const fr_path_setup *P = w->path;
+  for (size_t j = 0; j < m; j++) {
+    if (!S->live[j]) continue;
+    path_state st = S->bst[j];
+    const hit_frame *f = &S->frame[j];
+    float uc, ul, v1, v2, ur, unused;
+    path_point(P, pts, j, &st, dim, 0, &uc, &ul);
+    path_point(P, pts, j, &st, dim, 2, &v1, &v2);
+    fr_bsdf_sample bs;
+    if (!fr_bsdf_sample_dir(f->m, &f->sp, f->wo, ul, v1, v2, &bs)) continue;
+    const vec3 wi = to_world(bs.wi, f->t, f->b, f->n);
+    if (!same_side(wi, f->n, f->ngo)) continue; /* through the surface by the shading normal alone: a leak */
+    st.weight = v3_mul(st.weight, bs.weight);
+    const float q = fr_maxf(st.weight.x, fr_maxf(st.weight.y, st.weight.z)) / FR_PATH_RR_WEIGHT;
+    if (q < 1.0f) {
+      path_point(P, pts, j, &st, dim, 3, &ur, &unused);
+      if (!(ur < q)) continue;
+      st.weight = v3_scale(st.weight, 1.0f / q);
+    }
+    st.pdf = bs.pdf;
+    st.delta = (uint8_t)bs.delta;
+    st.depth = (uint8_t)(depth + 1);
+    S->st[*nn] = st;
+    S->ray[(*nn)++] = make_ray(f->p, wi, w->eps, INFINITY);
+  }
+}
+
 /* Pixel i of a tile of the given side, in blocks of 4x4 (consecutive 16
  * are coherent). */
 static void tile_pixel(int i, int side, int *x, int *y) {
@@ -252,8 +451,6 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
   const fr_camera *c = &w->cam;
   const int W = c->width, H = c->height;
   const uint32_t seed = P->seed;
-  const float eps = w->eps;
-  const int nlights = light_count(L);
   const quad_light quad = quad_light_of(L);
   uint64_t rays = 0;
   const vec3 ru = v3_norm(c->right), uu = v3_norm(c->up);
@@ -313,128 +510,13 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
       S->stage[depth ? FR_STAGE_SECONDARY : FR_STAGE_CAMERA] += t2 - t1;
       size_t nn = 0, ns = 0;
       const uint32_t dim = 2u + 4u * (uint32_t)depth;
-      for (size_t k = 0; k < n; k++) {
-        const size_t b = k % POINT_BLOCK;
-        if (pts && !b) block_points(P, S->st + k, n - k, dim, 4, block);
-        if (!b) env_block_sample(P, pts, S->st + k, S->ray + k, S->hit + k, n - k, dim, &eb);
-        if (k + PREFETCH_AHEAD < n) {
-          const uint32_t ahead = S->hit[k + PREFETCH_AHEAD].prim;
-          if (ahead < P->nsurf) {
-            __builtin_prefetch(&P->surf[ahead]);
-            fr_scene_prefetch_shading(w->scene, ahead);
-          }
-        }
-        path_state st = S->st[k];
-        const fr_ray r = S->ray[k];
-        const fr_hit h = S->hit[k];
-        const vec3 o = v3_load(r.org), d = v3_load(r.dir);
-        const int hit = h.prim != FR_INVALID_ID;
-        const float tmax = hit ? h.t : INFINITY;
-        /* the area light, which is not in the scene's geometry, in front of the hit */
-        const float ta = L->area ? area_hit(&quad, o, d, r.tnear, tmax) : 0.0f;
-        if (ta > 0.0f) { /* the lamp: it emits from its front, its back is dark */
-          if (depth == 0) S->dep[st.slot] = ta;
-          if (v3_dot(d, quad.n) < 0.0f) {
-            const float w_mis = st.delta ? 1.0f : power_heuristic(st.pdf, area_pdf(&quad, d, ta) / (float)nlights);
-            S->acc[st.slot] = v3_add(S->acc[st.slot], v3_scale(v3_mul(st.weight, quad.radiance), w_mis));
-          }
-          continue;
-        }
-        if (!hit) {
-          float pe = 0.0f;
-          const vec3 le = depth == 0  ? fr_env_eval_smooth(L->env, d) /* the background, seen */
-                          : eb.sky[b] ? fr_env_texel_radiance(L->env, eb.sky[b], eb.sky_sin[b], st.delta ? NULL : &pe)
-                          : st.delta  ? fr_env_eval(L->env, d)
-                                      : fr_env_eval_pdf(L->env, d, &pe);
-          const float w_mis = st.delta ? 1.0f : power_heuristic(st.pdf, pe / (float)nlights);
-          S->acc[st.slot] = v3_add(S->acc[st.slot], v3_scale(v3_mul(st.weight, le), w_mis));
-          continue;
-        }
-        const vec3 p = v3_add(o, v3_scale(d, h.t));
-        fr_surface sf;
-        if (h.prim < P->nsurf) {
-          sf = P->surf[h.prim];
-        } else { /* a sphere: the normal is p - c */
-          const float pp[3] = {p.x, p.y, p.z};
-          fr_scene_geometric_normal(w->scene, h.prim, pp, sf.ng);
-          sf.mat = fr_surface_material(w->scene, h.prim, (int32_t)P->count - 1);
-        }
-        const vec3 ng = v3_norm(v3_load(sf.ng));
-        const fr_bsdf *m = &P->mats[sf.mat];
-        fr_bsdf textured;
-        float st2[2];
-        if (m->color_tex >= 0 && fr_scene_texcoord(w->scene, h.prim, h.u, h.v, st2)) {
-          textured = *m;
-          textured.color = fr_texture_lookup(&P->textures[m->color_tex], st2[0], st2[1]);
-          m = &textured;
-        }
-        const int front = v3_dot(ng, d) < 0.0f;
-        if (m->kind == FR_BSDF_GLASS && !front) { /* the segment ran inside: Beer's law */
-          const float k = h.t / m->attenuation_distance;
-          const vec3 a = m->attenuation_color;
-          st.weight = v3_mul(st.weight, v3(powf(a.x, k), powf(a.y, k), powf(a.z, k)));
-        }
-        if (front && nonzero(m->emission)) S->acc[st.slot] = v3_add(S->acc[st.slot], v3_mul(st.weight, m->emission));
-        /* the shading frame: the outward normal for glass, else the side the
-         * ray came from; the interpolated normal where the mesh has one and
-         * it sees the ray on the same side as the geometric normal */
-        const int outward = m->kind == FR_BSDF_GLASS || front;
-        const vec3 ngo = outward ? ng : v3_scale(ng, -1.0f);
-        vec3 n = ngo;
-        float sn[3];
-        if (h.prim < P->nsurf && fr_scene_shading_normal(w->scene, h.prim, h.u, h.v, sn)) {
-          vec3 ns = v3_load(sn);
-          if (v3_dot(ns, ngo) < 0.0f) ns = v3_scale(ns, -1.0f);
-          if ((v3_dot(ns, d) < 0.0f) == (v3_dot(ngo, d) < 0.0f)) n = ns;
-        }
-        vec3 tb, bb;
-        v3_onb(n, &tb, &bb);
-        const vec3 wo = to_local(v3_scale(d, -1.0f), tb, bb, n);
-        fr_shading_point sp;
-        fr_bsdf_prepare(m, p, &sp);
-        if (depth == 0) S->dep[st.slot] = h.t;
-        if (depth == 0 && (w->gbuf_albedo || w->gbuf_normal)) {
-          S->alb[st.slot] = v3_add(S->alb[st.slot], fr_bsdf_albedo(m));
-          S->nrm[st.slot] = v3_add(S->nrm[st.slot], v3_dot(n, d) < 0.0f ? n : v3_scale(n, -1.0f)); /* facing the camera */
-        }
-        float uc, ul, u1, u2, v1, v2, ur, unused;
-        path_point(P, pts, b, &st, dim, 0, &uc, &ul);
-        /* next-event estimation */
-        if (nlights && fr_bsdf_has_smooth(m, &sp)) {
-          path_point(P, pts, b, &st, dim, 1, &u1, &u2);
-          vec3 wi, le;
-          float dist, pl;
-          int delta;
-          if (sample_light(L, &quad, &eb, b, p, uc, u1, u2, &wi, &dist, &le, &pl, &delta) && same_side(wi, n, ngo)) {
-            float pb;
-            const vec3 f = fr_bsdf_eval(m, &sp, wo, to_local(wi, tb, bb, n), &pb);
-            if (nonzero(f) && nonzero(le)) {
-              const float w_mis = delta ? 1.0f : power_heuristic(pl, pb);
-              S->scontrib[ns] = v3_scale(v3_mul(v3_mul(st.weight, f), le), w_mis / pl);
-              S->sray[ns] = make_ray(p, wi, eps, isinf(dist) ? INFINITY : dist * (1.0f - 1e-4f));
-              S->spix[ns++] = st.slot;
-            }
-          }
-        }
-        /* the next segment */
-        if (depth + 1 >= P->max_depth) continue;
-        path_point(P, pts, b, &st, dim, 2, &v1, &v2);
-        fr_bsdf_sample bs;
-        if (!fr_bsdf_sample_dir(m, &sp, wo, ul, v1, v2, &bs)) continue;
-        const vec3 wi = to_world(bs.wi, tb, bb, n);
-        if (!same_side(wi, n, ngo)) continue; /* through the surface by the shading normal alone: a leak */
-        st.weight = v3_mul(st.weight, bs.weight);
-        const float q = fr_maxf(st.weight.x, fr_maxf(st.weight.y, st.weight.z)) / FR_PATH_RR_WEIGHT;
-        if (q < 1.0f) {
-          path_point(P, pts, b, &st, dim, 3, &ur, &unused);
-          if (!(ur < q)) continue;
-          st.weight = v3_scale(st.weight, 1.0f / q);
-        }
-        st.pdf = bs.pdf;
-        st.delta = (uint8_t)bs.delta;
-        st.depth = (uint8_t)(depth + 1);
-        S->st[nn] = st;
-        S->ray[nn++] = make_ray(p, wi, eps, INFINITY);
+      for (size_t k0 = 0; k0 < n; k0 += POINT_BLOCK) {
+        const size_t m = n - k0 < POINT_BLOCK ? n - k0 : POINT_BLOCK;
+        if (pts) block_points(P, S->st + k0, m, dim, 4, block);
+        env_block_sample(P, pts, S->st + k0, S->ray + k0, S->hit + k0, m, dim, &eb);
+        frame_block(w, &quad, &eb, S, k0, m, n, depth);
+        next_events(w, &quad, &eb, pts, S, m, dim, &ns);
+        if (depth + 1 < P->max_depth) continue_paths(w, pts, S, m, dim, depth, &nn);
       }
       double t3 = fr_seconds();
       S->stage[FR_STAGE_SHADE] += t3 - t2;
