@@ -62,10 +62,12 @@ struct fr_path_scratch {
   float dep[WAVE];
   double stage[FR_STAGES];
   /* the block of paths being shaded (frame_block, next_events,
-   * continue_paths): the lanes' frames, the frames as the shader reads
-   * them, the states, which paths go on from their hit, and a textured
-   * material's copy */
+   * continue_paths): the lanes' inputs and frames, the hits' materials,
+   * the frames as the shader reads them, the states, which paths go on
+   * from their hit, and a textured material's copy */
+  fr_path_frame_in lanes_in;
   fr_path_frames lanes;
+  int32_t mat[POINT_BLOCK];
   hit_frame frame[POINT_BLOCK];
   path_state bst[POINT_BLOCK];
   uint8_t live[POINT_BLOCK];
@@ -251,35 +253,44 @@ static void env_block_sample(const fr_path_setup *P, const float (*pts)[POINT_BL
   }
 }
 
-/* The frames of a block's triangle hits, by the ISA's lanes. */
-static void frames_make(const fr_path_geometry *g, const fr_ray *ray, const fr_hit *hit, size_t m, fr_path_frames *f) {
-  const fr_isa isa = fr_get_isa();
-  if (isa == FR_ISA_AVX512) fr_path_frames_make_avx512(g, ray, hit, m, f);
-  else if (isa == FR_ISA_AVX2) fr_path_frames_make_avx2(g, ray, hit, m, f);
-  else fr_path_frames_make_scalar(g, ray, hit, m, f);
+/* The lanes' inputs for a block's hits: the ray and distance, the
+ * geometric normal (a triangle's record, or p - c on a sphere), whether the
+ * material is glass, and the shading normal where the mesh has one; mat[j]
+ * the hit's material. A miss's lane gets any finite numbers. */
+static void frames_gather(const fr_workload *w, const fr_ray *ray, const fr_hit *hit, size_t m, fr_path_frame_in *in,
+                          int32_t *mat) {
+  const fr_path_setup *P = w->path;
+  for (size_t j = 0; j < m; j++) {
+    const uint32_t prim = hit[j].prim;
+    const vec3 o = v3_load(ray[j].org), d = v3_load(ray[j].dir);
+    in->ox[j] = o.x, in->oy[j] = o.y, in->oz[j] = o.z, in->dx[j] = d.x, in->dy[j] = d.y, in->dz[j] = d.z;
+    in->t[j] = hit[j].t;
+    in->shading[j] = 0;
+    float ng[3] = {0.0f, 0.0f, 1.0f}, sn[3] = {0.0f, 0.0f, 1.0f};
+    mat[j] = 0;
+    if (prim < P->nsurf) {
+      const fr_surface *sf = &P->surf[prim];
+      ng[0] = sf->ng[0], ng[1] = sf->ng[1], ng[2] = sf->ng[2];
+      mat[j] = sf->mat;
+      in->shading[j] = fr_scene_shading_normal(w->scene, prim, hit[j].u, hit[j].v, sn);
+    } else if (prim != FR_INVALID_ID) { /* a sphere: the normal is p - c */
+      const vec3 p = v3_add(o, v3_scale(d, hit[j].t));
+      const float pp[3] = {p.x, p.y, p.z};
+      fr_scene_geometric_normal(w->scene, prim, pp, ng);
+      mat[j] = fr_surface_material(w->scene, prim, (int32_t)P->count - 1);
+    }
+    in->ax[j] = ng[0], in->ay[j] = ng[1], in->az[j] = ng[2];
+    in->sx[j] = sn[0], in->sy[j] = sn[1], in->sz[j] = sn[2];
+    in->glass[j] = P->mats[mat[j]].kind == FR_BSDF_GLASS;
+  }
 }
 
-/* A sphere's frame, which the lanes leave out: the normal is p - c, the
- * geometric normal is the shading normal. */
-static void sphere_frame(const fr_workload *w, const fr_ray *r, const fr_hit *h, fr_path_frames *f, size_t j) {
-  const fr_path_setup *P = w->path;
-  const vec3 d = v3_load(r->dir), p = v3_add(v3_load(r->org), v3_scale(d, h->t));
-  const float pp[3] = {p.x, p.y, p.z};
-  float ng3[3];
-  fr_scene_geometric_normal(w->scene, h->prim, pp, ng3);
-  const int32_t mat = fr_surface_material(w->scene, h->prim, (int32_t)P->count - 1);
-  const vec3 ng = v3_norm(v3_load(ng3));
-  const int front = v3_dot(ng, d) < 0.0f;
-  const vec3 n = P->mats[mat].kind == FR_BSDF_GLASS || front ? ng : v3_scale(ng, -1.0f);
-  vec3 t, b;
-  v3_onb(n, &t, &b);
-  const vec3 wo = to_local(v3_scale(d, -1.0f), t, b, n);
-  f->px[j] = p.x, f->py[j] = p.y, f->pz[j] = p.z;
-  f->gx[j] = f->nx[j] = n.x, f->gy[j] = f->ny[j] = n.y, f->gz[j] = f->nz[j] = n.z;
-  f->tx[j] = t.x, f->ty[j] = t.y, f->tz[j] = t.z, f->bx[j] = b.x, f->by[j] = b.y, f->bz[j] = b.z;
-  f->wx[j] = wo.x, f->wy[j] = wo.y, f->wz[j] = wo.z;
-  f->mat[j] = mat;
-  f->front[j] = (uint8_t)front;
+/* The frames of a block's hits, by the ISA's lanes. */
+static void frames_make(const fr_path_frame_in *in, size_t m, fr_path_frames *f) {
+  const fr_isa isa = fr_get_isa();
+  if (isa == FR_ISA_AVX512) fr_path_frames_make_avx512(in, m, f);
+  else if (isa == FR_ISA_AVX2) fr_path_frames_make_avx2(in, m, f);
+  else fr_path_frames_make_scalar(in, m, f);
 }
 
 /* The paths k0 .. k0 + m - 1 of the wave: adds what a segment that ended
@@ -291,8 +302,6 @@ static void frame_block(const fr_workload *w, const quad_light *quad, const env_
   const fr_path_setup *P = w->path;
   const fr_path_lights *L = &P->lights;
   const int nlights = light_count(L);
-  const fr_mesh *mesh = &w->scene->mesh;
-  const fr_path_geometry g = {P->surf, (uint32_t)P->nsurf, P->mats, mesh->nrm.idx, mesh->nrm.val, (uint32_t)mesh->nrm.n};
   fr_path_frames *f = &S->lanes;
   /* the next block's records and corner indices start loading while this
    * one is made */
@@ -303,7 +312,8 @@ static void frame_block(const fr_workload *w, const quad_light *quad, const env_
       fr_scene_prefetch_shading(w->scene, prim);
     }
   }
-  frames_make(&g, S->ray + k0, S->hit + k0, m, f);
+  frames_gather(w, S->ray + k0, S->hit + k0, m, &S->lanes_in, S->mat);
+  frames_make(&S->lanes_in, m, f);
   for (size_t j = 0; j < m; j++) {
     const size_t k = k0 + j;
     S->live[j] = 0;
@@ -332,7 +342,6 @@ static void frame_block(const fr_workload *w, const quad_light *quad, const env_
       S->acc[st.slot] = v3_add(S->acc[st.slot], v3_scale(v3_mul(st.weight, le), w_mis));
       continue;
     }
-    if (!f->made[j]) sphere_frame(w, r, &h, f, j);
     hit_frame *fr = &S->frame[j];
     fr->p = v3(f->px[j], f->py[j], f->pz[j]);
     fr->ngo = v3(f->gx[j], f->gy[j], f->gz[j]);
@@ -340,7 +349,7 @@ static void frame_block(const fr_workload *w, const quad_light *quad, const env_
     fr->t = v3(f->tx[j], f->ty[j], f->tz[j]);
     fr->b = v3(f->bx[j], f->by[j], f->bz[j]);
     fr->wo = v3(f->wx[j], f->wy[j], f->wz[j]);
-    const fr_bsdf *mat = &P->mats[f->mat[j]];
+    const fr_bsdf *mat = &P->mats[S->mat[j]];
     float st2[2];
     if (mat->color_tex >= 0 && fr_scene_texcoord(w->scene, h.prim, h.u, h.v, st2)) {
       S->textured[j] = *mat;
