@@ -261,6 +261,20 @@ static void test_normals(void **st) {
   fr_scene_release(s);
 }
 
+/* An image that cannot be made fails with the user's path and the reason,
+ * and leaves no file, whatever the format. */
+static void test_image_write_fails(void **st) {
+  (void)st;
+  const float px[3] = {1, 0, 0};
+  const char *paths[3] = {"/nonexistent-dir/x.png", "/nonexistent-dir/x.exr", "/nonexistent-dir/x.pfm"};
+  for (int i = 0; i < 3; i++) {
+    assert_int_equal(fr_image_write(paths[i], 1, 1, px), FR_ERR_IO);
+    char want[200];
+    snprintf(want, sizeof want, "%s: No such file or directory", paths[i]);
+    assert_string_equal(fr_last_error(), want);
+  }
+}
+
 /* Texture coordinates (OBJ vt) and diffuse textures (map_Kd), confined to
  * the scene's folder, looked up by the path tracer's materials. */
 static void test_textures(void **st) {
@@ -388,7 +402,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_ply_ascii_fan),  cmocka_unit_test(test_ply_binary),   cmocka_unit_test(test_ply_hostile),
       cmocka_unit_test(test_obj_mtl_and_zst), cmocka_unit_test(test_assimp_path), cmocka_unit_test(test_degenerate_only),
-      cmocka_unit_test(test_normals),     cmocka_unit_test(test_textures),    cmocka_unit_test(test_from_buffers),
+      cmocka_unit_test(test_normals),     cmocka_unit_test(test_textures),    cmocka_unit_test(test_image_write_fails),    cmocka_unit_test(test_from_buffers),
   };
   int rc = cmocka_run_group_tests(tests, NULL, NULL);
   snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
