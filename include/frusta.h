@@ -416,7 +416,8 @@ typedef struct fr_render_desc {
   int temporal;           /* path, ao: after fr_renderer_set_camera, blend the last image carried to the
                              new view into the new one while it has few passes (SVGF's reprojection) [0] */
   int camera_frusta;      /* 1: camera rays, hard and soft shadows as multi-frusta where the scene has
-                             no spheres; 0: every ray as the scene's trace mode [1] */
+                             no spheres (path: the shadow rays from the camera's hits to the point
+                             light); 0: every ray as the scene's trace mode [1] */
   int pass_spp;           /* path: samples per pixel one pass adds, at least 1 [8]; 1 suits an
                              interactive frame. Any split sums to the same image. */
 } fr_render_desc;

@@ -12,6 +12,8 @@
  *     are the bits fr_sample2d makes one at a time;
  *   - the hit frames made as vector code (render/path_frames.h), on every
  *     ISA, are the bits of the scalar shader's arithmetic;
+ *   - the camera hits' shadow rays to a point light, traced by multi-frusta
+ *     from the light, give the image their rays give;
  *   - the image is the same bits on 1 and 3 threads and in every trace mode
  *     (up to rays that graze an edge: none on these spheres), and equals
  *     the one traced through Embree with the same seed but for a few
@@ -422,6 +424,92 @@ static void same_image_everywhere(void **st) {
   materials_scene_free(&m);
 }
 
+/* fr_mft_occluded_frusta, counted: that the frusta were asked at all */
+static unsigned (*mft_occluded_frusta)(void *, const fr_mft_batch *, const fr_mft_sets *, uint16_t *, fr_mft_budget *,
+                                       fr_mft_occluders *);
+static unsigned frusta_calls;
+static unsigned counted_occluded_frusta(void *ctx, const fr_mft_batch *b, const fr_mft_sets *t, uint16_t *occ,
+                                        fr_mft_budget *budget, fr_mft_occluders *cache) {
+  __atomic_add_fetch(&frusta_calls, 1u, __ATOMIC_RELAXED);
+  return mft_occluded_frusta(ctx, b, t, occ, budget, cache);
+}
+
+/* The camera hits' shadow rays to a point light, traced from the light by
+ * multi-frusta, give the image their rays give: a Lambert floor under a
+ * fog of 600 small triangles, lit by a point light above it alone,
+ * direct light (one segment) and full paths, 8 samples per pixel: the same
+ * bits but where a segment grazes a fog triangle's edge, which rays from
+ * either end may see either way (the rule of the multi-frusta tests). */
+static void point_shadows_by_frusta(void **st) {
+  (void)st;
+  enum { FOG = 600, NV = 4 + 3 * FOG, NT = 2 + FOG };
+  float *pos = malloc(3 * NV * sizeof(float));
+  uint32_t *idx = malloc(3 * NT * sizeof(uint32_t));
+  const float floor[12] = {-4, 0, -4, 4, 0, -4, 4, 0, 4, -4, 0, 4};
+  memcpy(pos, floor, sizeof floor);
+  const uint32_t quad[6] = {0, 2, 1, 0, 3, 2};
+  memcpy(idx, quad, sizeof quad);
+  fr_rng r = fr_rng_seed(11, 0);
+  for (int k = 0; k < FOG; k++) {
+    const float cx = 6.0f * fr_rng_float(&r) - 3.0f, cy = 0.3f + 1.5f * fr_rng_float(&r), cz = 6.0f * fr_rng_float(&r) - 3.0f;
+    for (int v = 0; v < 3; v++) {
+      float *q = pos + 3 * (4 + 3 * k + v);
+      q[0] = cx + 0.3f * fr_rng_float(&r) - 0.15f, q[1] = cy + 0.3f * fr_rng_float(&r) - 0.15f;
+      q[2] = cz + 0.3f * fr_rng_float(&r) - 0.15f;
+      idx[3 * (2 + k) + v] = (uint32_t)(4 + 3 * k + v);
+    }
+  }
+  fr_scene *s;
+  assert_int_equal(fr_scene_from_arrays(pos, NV, idx, NT, &s), FR_OK);
+  assert_int_equal(fr_scene_commit(s), FR_OK);
+  fr_bsdf mats[1] = {fr_bsdf_default(FR_BSDF_LAMBERT)};
+  fr_env black;
+  fr_env_constant(&black, v3(0, 0, 0));
+  fr_path_setup P = {.mats = mats, .count = 1, .max_depth = 1, .sampler = FR_SAMPLER_SOBOL, .seed = 4, .spp = 8,
+                     .spp_begin = 0, .spp_end = 8};
+  P.lights.env = &black;
+  P.lights.point = 1, P.lights.point_pos = v3(0.5f, 6.0f, 0.3f), P.lights.point_intensity = v3(30, 30, 30);
+  fr_workload w;
+  memset(&w, 0, sizeof w);
+  w.kind = FR_WL_PATH, w.scene = s, w.eps = 1e-4f * 12.0f, w.path = &P, w.threads = 2;
+  w.view.up = v3(0, 1, 0);
+  const int W = FR_TEST_SANITIZED ? 32 : 64;
+  assert_int_equal(fr_camera_setup(&w.cam, v3(0, 5, 7), v3(0, 0, 0), v3(0, 1, 0), 50.0f, W, W), FR_OK);
+  const size_t n = (size_t)W * W * 3;
+  float *ref = malloc(n * sizeof(float)), *img = malloc(n * sizeof(float));
+  const fr_mft_tracer mctx = fr_mft_tracer_of(s, fr_mft_opts_default());
+  fr_tracer by_rays = fr_tracer_frusta(s), by_frusta = fr_tracer_mft(&mctx);
+  mft_occluded_frusta = by_frusta.occluded_frusta;
+  by_frusta.occluded_frusta = counted_occluded_frusta;
+  for (int depth = 1; depth <= 13; depth += 12) {
+    P.max_depth = depth;
+    memset(ref, 0, n * sizeof(float));
+    w.image = ref;
+    fr_workload_run(&w, &by_rays);
+    memset(img, 0, n * sizeof(float));
+    w.image = img;
+    frusta_calls = 0;
+    fr_workload_run(&w, &by_frusta);
+    double lit = 0.0, lit_f = 0.0;
+    size_t dark = 0, differ = 0;
+    for (size_t i = 0; i < n; i += 3) {
+      lit += ref[i], lit_f += img[i], dark += ref[i] == 0.0f;
+      differ += memcmp(&img[i], &ref[i], 3 * sizeof(float)) != 0;
+    }
+    print_message("paths of %d segments: %u frusta calls, %zu of %zu pixels in shadow, %zu differ, means %.5f and %.5f\n",
+                  depth, frusta_calls, dark, n / 3, differ, lit / (double)(n / 3), lit_f / (double)(n / 3));
+    assert_true(frusta_calls > 0);
+    assert_true(dark > n / 3 / 50 && dark < n / 3 / 2); /* shadows and light both */
+    /* a segment that grazes an edge of the fog may go either way from
+     * either end: one pixel's sample in a thousand at most */
+    assert_true(differ <= n / 3 / 1000);
+    assert_true(fabs(lit_f - lit) <= 1e-3 * lit);
+  }
+  free(ref); free(img); free(pos); free(idx);
+  fr_env_free(&black);
+  fr_scene_release(s);
+}
+
 /* A run of samples split into passes of 1, 3 or 8 sums to the same bits
  * (render/path.h), so the viewer at rest and render agree; a pass
  * abandoned through the cancel flag restarts the sums. */
@@ -470,6 +558,7 @@ int main(void) {
       cmocka_unit_test(radiance_hdr),
       cmocka_unit_test(samplers_stratify),
       cmocka_unit_test(batch_points_alike),
+      cmocka_unit_test(point_shadows_by_frusta),
       cmocka_unit_test(frames_lanes_match_scalar),
       cmocka_unit_test(same_image_everywhere),
       cmocka_unit_test(passes_split_anyhow),

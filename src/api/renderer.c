@@ -452,7 +452,7 @@ void fr_renderer_tune(fr_renderer *r, const fr_renderer_tuning *t) {
 }
 
 int fr_renderer_uses_frusta(const fr_renderer *r) {
-  return !r->tune.has_tracer && r->d.d.camera_frusta && r->d.d.shade != FR_RENDER_PATH && !fr_scene_sphere_count(r->s);
+  return !r->tune.has_tracer && r->d.d.camera_frusta && !fr_scene_sphere_count(r->s);
 }
 
 const fr_path_setup *fr_renderer_path_setup(const fr_renderer *r) {

@@ -33,6 +33,8 @@ const fr_whitted_mats *fr_renderer_whitted_mats(const fr_renderer *r);
 int fr_renderer_passes(const fr_renderer *r);
 /* softshadow: the visibility the image shows (W*H). */
 void fr_renderer_visibility(const fr_renderer *r, float *vis);
-/* Whether passes trace camera rays as multi-frusta. */
+/* Whether passes trace through the multi-frusta tracer: camera rays and
+ * shadows, or a path tracer's shadow rays from its camera hits to the
+ * point light. */
 int fr_renderer_uses_frusta(const fr_renderer *r);
 #endif

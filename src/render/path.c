@@ -17,6 +17,7 @@
 #include "material/texture.h"
 #include "api/scene.h"
 #include "render/path_frames.h"
+#include "render/shadow_frusta.h"
 #include "render/surfaces.h"
 #include "render/tile.h"
 
@@ -55,6 +56,12 @@ struct fr_path_scratch {
   uint8_t occ[WAVE];
   vec3 scontrib[WAVE];
   uint16_t spix[WAVE];
+  /* the camera hits' shadow rays to the point light, where a multi-frusta
+   * tracer traces them from the light: each hit point, contribution and slot */
+  float ppts[3 * WAVE];
+  uint8_t pocc[WAVE];
+  vec3 pcontrib[WAVE];
+  uint16_t ppix[WAVE];
   /* per sample and pixel, so that a pixel's samples are summed in their
    * order however many a wave holds: the image is the same bits for any
    * split of the samples into calls */
@@ -378,9 +385,12 @@ static void frame_block(const fr_workload *w, const quad_light *quad, const env_
 /* Next-event estimation for the block's live paths: a light sample each
  * (dimension pair dim + 0 picks the light, dim + 1 places the sample),
  * its contribution and shadow ray appended at S->scontrib, S->sray and
- * S->spix[*ns]. */
+ * S->spix[*ns]; with point_apart, a sample of the point light goes as its
+ * hit point to S->ppts, S->pcontrib and S->ppix[*np] instead (the same
+ * segment, which trace_point_shadows traces from the light). */
 static void next_events(const fr_workload *w, const quad_light *quad, const env_block *eb,
-                        const float (*pts)[POINT_BLOCK], fr_path_scratch *S, size_t m, uint32_t dim, size_t *ns) {
+                        const float (*pts)[POINT_BLOCK], fr_path_scratch *S, size_t m, uint32_t dim, int point_apart,
+                        size_t *ns, size_t *np) {
   const fr_path_setup *P = w->path;
   const fr_path_lights *L = &P->lights;
   if (!light_count(L)) return;
@@ -400,7 +410,15 @@ static void next_events(const fr_workload *w, const quad_light *quad, const env_
       const vec3 fv = fr_bsdf_eval(f->m, &f->sp, f->wo, to_local(wi, f->t, f->b, f->n), &pb);
       if (nonzero(fv) && nonzero(le)) {
         const float w_mis = delta ? 1.0f : power_heuristic(pl, pb);
-        S->scontrib[*ns] = v3_scale(v3_mul(v3_mul(st->weight, fv), le), w_mis / pl);
+        const vec3 contrib = v3_scale(v3_mul(v3_mul(st->weight, fv), le), w_mis / pl);
+        if (point_apart && delta) { /* only the point light is a delta light */
+          float *q = S->ppts + 3 * *np;
+          q[0] = f->p.x, q[1] = f->p.y, q[2] = f->p.z;
+          S->pcontrib[*np] = contrib;
+          S->ppix[(*np)++] = st->slot;
+          continue;
+        }
+        S->scontrib[*ns] = contrib;
         S->sray[*ns] = make_ray(f->p, wi, w->eps, isinf(dist) ? INFINITY : dist * (1.0f - 1e-4f));
         S->spix[(*ns)++] = st->slot;
       }
@@ -517,14 +535,19 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
       rays += n;
       double t2 = fr_seconds();
       S->stage[depth ? FR_STAGE_SECONDARY : FR_STAGE_CAMERA] += t2 - t1;
-      size_t nn = 0, ns = 0;
+      size_t nn = 0, ns = 0, np = 0;
       const uint32_t dim = 2u + 4u * (uint32_t)depth;
+      /* The camera hits' shadow rays to a point light end at one point, in
+       * the 4x4 blocks the camera rays came in: 16 make a frustum from the
+       * light (render/shadow_frusta.h), as the Whitted renderer's. Later
+       * bounces' hits lie scattered, and their rays go as rays. */
+      const int point_apart = t->occluded_frusta && L->point && depth == 0;
       for (size_t k0 = 0; k0 < n; k0 += POINT_BLOCK) {
         const size_t m = n - k0 < POINT_BLOCK ? n - k0 : POINT_BLOCK;
         if (pts) block_points(P, S->st + k0, m, dim, 4, block);
         env_block_sample(P, pts, S->st + k0, S->ray + k0, S->hit + k0, m, dim, &eb);
         frame_block(w, &quad, &eb, S, k0, m, n, depth);
-        next_events(w, &quad, &eb, pts, S, m, dim, &ns);
+        next_events(w, &quad, &eb, pts, S, m, dim, point_apart, &ns, &np);
         if (depth + 1 < P->max_depth) continue_paths(w, pts, S, m, dim, depth, &nn);
       }
       double t3 = fr_seconds();
@@ -534,6 +557,14 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
         rays += ns;
         for (size_t k = 0; k < ns; k++)
           if (!S->occ[k]) S->acc[S->spix[k]] = v3_add(S->acc[S->spix[k]], S->scontrib[k]);
+      }
+      if (np) { /* a path has one light sample a bounce: its slot is in one list or the other */
+        const float light[3] = {L->point_pos.x, L->point_pos.y, L->point_pos.z};
+        const fr_shadow_rays src = {NULL, light, S->ppts, w->eps};
+        fr_shadow_frusta_occluded(t, &src, S->pocc, np, 1);
+        rays += np;
+        for (size_t k = 0; k < np; k++)
+          if (!S->pocc[k]) S->acc[S->ppix[k]] = v3_add(S->acc[S->ppix[k]], S->pcontrib[k]);
       }
       t0 = fr_seconds();
       S->stage[FR_STAGE_SHADOW] += t0 - t3;
