@@ -402,7 +402,8 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_ply_ascii_fan),  cmocka_unit_test(test_ply_binary),   cmocka_unit_test(test_ply_hostile),
       cmocka_unit_test(test_obj_mtl_and_zst), cmocka_unit_test(test_assimp_path), cmocka_unit_test(test_degenerate_only),
-      cmocka_unit_test(test_normals),     cmocka_unit_test(test_textures),    cmocka_unit_test(test_image_write_fails),    cmocka_unit_test(test_from_buffers),
+      cmocka_unit_test(test_normals),     cmocka_unit_test(test_textures),    cmocka_unit_test(test_image_write_fails),
+      cmocka_unit_test(test_from_buffers),
   };
   int rc = cmocka_run_group_tests(tests, NULL, NULL);
   snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);

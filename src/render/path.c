@@ -387,7 +387,7 @@ static void frame_block(const fr_workload *w, const quad_light *quad, const env_
  * its contribution and shadow ray appended at S->scontrib, S->sray and
  * S->spix[*ns]; with point_apart, a sample of the point light goes as its
  * hit point to S->ppts, S->pcontrib and S->ppix[*np] instead (the same
- * segment, which trace_point_shadows traces from the light). */
+ * segment, which fr_path_tile traces from the light). */
 static void next_events(const fr_workload *w, const quad_light *quad, const env_block *eb,
                         const float (*pts)[POINT_BLOCK], fr_path_scratch *S, size_t m, uint32_t dim, int point_apart,
                         size_t *ns, size_t *np) {

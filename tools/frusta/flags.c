@@ -36,7 +36,9 @@ const cli_flag cli_flags[F_COUNT] = {
     [F_LIGHT_SETS] = {"--light-sets", "cells|spread", R | B | V,
                       "soft shadows: each pixel's 16 samples in one cell of the light (render's default) or "
                       "stratified over all of it (bench's default)"},
-    [F_MFT] = {"--mft", "on|off", R, "camera and shadow rays as multi-frusta (path: the camera hits' rays to the point light; default on; off: streams)"},
+    [F_MFT] = {"--mft", "on|off", R,
+               "camera and shadow rays as multi-frusta (path: the camera hits' rays to the point light; default on; "
+               "off: streams)"},
     [F_REFERENCE_OUT] = {"--reference-out", "FILE", R,
                          "softshadow: also render the 256-sample reference there and print the error"},
     [F_SPP] = {"--spp", "N", R | B | V,
