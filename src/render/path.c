@@ -57,9 +57,9 @@ struct fr_path_scratch {
   vec3 scontrib[WAVE];
   uint16_t spix[WAVE];
   /* the camera hits' shadow rays to the point light, where a multi-frusta
-   * tracer traces them from the light: each hit point, contribution and slot */
+   * tracer traces them from the light: each hit point, contribution and slot
+   * (their verdicts go to occ once the other shadow rays' are used) */
   float ppts[3 * WAVE];
-  uint8_t pocc[WAVE];
   vec3 pcontrib[WAVE];
   uint16_t ppix[WAVE];
   /* per sample and pixel, so that a pixel's samples are summed in their
@@ -200,6 +200,12 @@ static int same_side(vec3 w, vec3 n, vec3 ng) { return (v3_dot(w, n) > 0.0f) == 
 static int nonzero(vec3 c) { return c.x > 0.0f || c.y > 0.0f || c.z > 0.0f; }
 
 static void add3(float *dst, vec3 v) { dst[0] += v.x, dst[1] += v.y, dst[2] += v.z; }
+
+/* The contributions of the n shadow rays that nothing occluded, each to its slot. */
+static void add_unoccluded(vec3 *acc, const uint8_t *occ, const uint16_t *slot, const vec3 *contrib, size_t n) {
+  for (size_t k = 0; k < n; k++)
+    if (!occ[k]) acc[slot[k]] = v3_add(acc[slot[k]], contrib[k]);
+}
 
 /* The sample points of dimension pairs d .. d + npairs - 1 for the next
  * POINT_BLOCK paths of st[0..left): pair q's in pts[2q] and pts[2q + 1]. */
@@ -555,16 +561,14 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
       if (ns) {
         t->occluded(t->ctx, S->sray, S->occ, ns, 0);
         rays += ns;
-        for (size_t k = 0; k < ns; k++)
-          if (!S->occ[k]) S->acc[S->spix[k]] = v3_add(S->acc[S->spix[k]], S->scontrib[k]);
+        add_unoccluded(S->acc, S->occ, S->spix, S->scontrib, ns);
       }
       if (np) { /* a path has one light sample a bounce: its slot is in one list or the other */
         const float light[3] = {L->point_pos.x, L->point_pos.y, L->point_pos.z};
         const fr_shadow_rays src = {NULL, light, S->ppts, w->eps};
-        fr_shadow_frusta_occluded(t, &src, S->pocc, np, 1);
+        fr_shadow_frusta_occluded(t, &src, S->occ, np, 1);
         rays += np;
-        for (size_t k = 0; k < np; k++)
-          if (!S->pocc[k]) S->acc[S->ppix[k]] = v3_add(S->acc[S->ppix[k]], S->pcontrib[k]);
+        add_unoccluded(S->acc, S->occ, S->ppix, S->pcontrib, np);
       }
       t0 = fr_seconds();
       S->stage[FR_STAGE_SHADOW] += t0 - t3;
