@@ -171,6 +171,19 @@ static void test_assimp_path(void **st) {
   expect_error("bad.stl", "solid x\nfacet garbage", 21, FR_ERR_FORMAT);
 }
 
+/* A scene path that is missing or not a file says which, by its path. */
+static void test_not_a_file(void **st) {
+  (void)st;
+  fr_scene *s = NULL;
+  assert_int_equal(fr_scene_load(tmpdir, &s), FR_ERR_IO);
+  char want[300];
+  snprintf(want, sizeof want, "%s: not a regular file", tmpdir);
+  assert_string_equal(fr_last_error(), want);
+  assert_int_equal(fr_scene_load("/nonexistent-dir/x.ply", &s), FR_ERR_IO);
+  assert_string_equal(fr_last_error(), "/nonexistent-dir/x.ply: No such file or directory");
+  assert_null(s);
+}
+
 static void test_degenerate_only(void **st) {
   (void)st;
   const float v[9] = {0, 0, 0, 1, 1, 1, 2, 2, 2};
@@ -402,6 +415,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_ply_ascii_fan),  cmocka_unit_test(test_ply_binary),   cmocka_unit_test(test_ply_hostile),
       cmocka_unit_test(test_obj_mtl_and_zst), cmocka_unit_test(test_assimp_path), cmocka_unit_test(test_degenerate_only),
+      cmocka_unit_test(test_not_a_file),
       cmocka_unit_test(test_normals),     cmocka_unit_test(test_textures),    cmocka_unit_test(test_image_write_fails),
       cmocka_unit_test(test_from_buffers),
   };

@@ -17,14 +17,21 @@ int fr_file_exists(const char *path) {
   return stat(path, &st) == 0 && S_ISREG(st.st_mode);
 }
 
-static fr_error read_raw(const char *path, size_t max, char **data, size_t *size) {
+fr_error fr_regular_file(const char *path, size_t *bytes) {
   struct stat st;
   if (stat(path, &st) != 0) return fr_fail(FR_ERR_IO, "%s: %s", path, strerror(errno));
   if (!S_ISREG(st.st_mode)) return fr_fail(FR_ERR_IO, "%s: not a regular file", path);
-  if ((size_t)st.st_size > max) return fr_fail(FR_ERR_UNSUPPORTED, "%s: larger than %zu bytes", path, max);
+  if (bytes) *bytes = (size_t)st.st_size;
+  return FR_OK;
+}
+
+static fr_error read_raw(const char *path, size_t max, char **data, size_t *size) {
+  size_t n;
+  fr_error e = fr_regular_file(path, &n);
+  if (e) return e;
+  if (n > max) return fr_fail(FR_ERR_UNSUPPORTED, "%s: larger than %zu bytes", path, max);
   FILE *f = fopen(path, "rb");
   if (!f) return fr_fail(FR_ERR_IO, "%s: %s", path, strerror(errno));
-  size_t n = (size_t)st.st_size;
   char *buf = malloc(n + 1);
   if (!buf) { fclose(f); return fr_fail(FR_ERR_NOMEM, "%s: cannot allocate %zu bytes", path, n); }
   size_t got = fread(buf, 1, n, f);

@@ -20,4 +20,8 @@ fr_error fr_read_file_max(const char *path, size_t max, char **data, size_t *siz
 fr_error fr_read_file(const char *path, char **data, size_t *size);
 int fr_has_suffix(const char *s, const char *suffix);
 int fr_file_exists(const char *path);
+/* FR_OK where path is a regular file (its size in *bytes, when not NULL),
+ * else FR_ERR_IO saying why ("PATH: No such file or directory", "PATH: not
+ * a regular file"). */
+fr_error fr_regular_file(const char *path, size_t *bytes);
 #endif

@@ -19,10 +19,10 @@ static void extension(const char *path, char *ext, size_t cap) {
 
 fr_error fr_import(const char *path, fr_mesh *m) {
   if (!path || !*path) return fr_fail(FR_ERR_ARG, "no scene file given");
-  if (!fr_file_exists(path)) return fr_fail(FR_ERR_IO, "%s: no such file", path);
+  fr_error e = fr_regular_file(path, NULL);
+  if (e) return e;
   char ext[32];
   extension(path, ext, sizeof ext);
-  fr_error e;
   if (strcmp(ext, "ply") == 0 || strcmp(ext, "obj") == 0) {
     char *data;
     size_t size;
