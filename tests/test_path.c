@@ -163,8 +163,8 @@ static void environment_sampling(void **st) {
   print_message("environment: exact %.4f\n", exact);
   assert_true(fabs(imp - exact) < 4.0 * se_imp + 1e-4 * exact);
   assert_true(se_imp < se_uni); /* and it pays */
-  /* the batched samples and lookups, in every ISA, and the two-step
-   * lookups are the one-at-a-time bits */
+  /* the batched samples and lookups (the filtered one too), in every ISA,
+   * and the two-step lookups are the one-at-a-time bits */
   enum { B = 200 }; /* more than three chunks of 64, and a part */
   float u1[B], u2[B], pdf[B], dx[B], dy[B], dz[B], sin_b[B];
   vec3 dir[B], le[B];
@@ -197,6 +197,11 @@ static void environment_sampling(void **st) {
       const float *t = fr_env_texel(&env, v3(dx[k], dy[k], dz[k]), &s);
       assert_ptr_equal(t, tex[k]);
       assert_memory_equal(&s, &sin_b[k], sizeof s);
+    }
+    fr_env_eval_smooth_batch(&env, B, dx, dy, dz, le);
+    for (int k = 0; k < B; k++) {
+      const vec3 a = fr_env_eval_smooth(&env, v3(dx[k], dy[k], dz[k]));
+      assert_memory_equal(&a, &le[k], sizeof a);
     }
   }
   fr_set_isa(best);

@@ -141,8 +141,11 @@ vec3 fr_env_eval_pdf(const fr_env *e, vec3 dir, float *pdf) {
 
 vec3 fr_env_eval_smooth(const fr_env *e, vec3 dir) {
   if (!e->rgb) return v3_scale(e->color, e->intensity);
-  float u, v, s;
-  to_uv(e, dir, &u, &v, &s);
-  /* texel centres at (i + 0.5) / w: around in u, clamped at the poles in v */
-  return v3_scale(fr_rgb_bilinear(e->rgb, e->w, e->h, u * (float)e->w - 0.5f, v * (float)e->h - 0.5f, 1), e->intensity);
+  float fx, fy;
+  fr_env_smooth_at(e, dir.x, dir.y, dir.z, &fx, &fy);
+  return fr_env_smooth_radiance(e, fx, fy);
+}
+
+vec3 fr_env_smooth_radiance(const fr_env *e, float fx, float fy) {
+  return v3_scale(fr_rgb_bilinear(e->rgb, e->w, e->h, fx, fy, 1), e->intensity);
 }

@@ -56,6 +56,8 @@ vec3 fr_env_texel_radiance(const fr_env *e, const float *texel, float sin_t, flo
 /* The same, interpolated bilinearly between texels: for the background
  * seen straight from the camera, where the map's texels would show. */
 vec3 fr_env_eval_smooth(const fr_env *e, vec3 dir);
+/* Its second step for an image: the radiance at (fx, fy) (fr_env_smooth_at). */
+vec3 fr_env_smooth_radiance(const fr_env *e, float fx, float fy);
 /* fr_env_eval and fr_env_pdf at once (one lookup). */
 vec3 fr_env_eval_pdf(const fr_env *e, vec3 dir, float *pdf);
 /* fr_env_texel for n directions (x, y, z arrays): texel[i] and sin_t[i]
@@ -63,12 +65,17 @@ vec3 fr_env_eval_pdf(const fr_env *e, vec3 dir, float *pdf);
  * (light/environment_lanes.c). An image environment. */
 void fr_env_texel_batch(const fr_env *e, size_t n, const float *x, const float *y, const float *z,
                         const float **texel, float *sin_t);
+/* fr_env_eval_smooth for n directions (x, y, z arrays) into le[i], the
+ * same bits; an image's coordinates made as vector code. */
+void fr_env_eval_smooth_batch(const fr_env *e, size_t n, const float *x, const float *y, const float *z, vec3 *le);
 
 #define FR_ENV_BATCH_FNS(isa)                                                                                     \
   void fr_env_sample_batch_##isa(const fr_env *e, size_t n, const float *u1, const float *u2, vec3 *dir, vec3 *le,  \
                                  float *pdf);                                                                        \
   void fr_env_texel_batch_##isa(const fr_env *e, size_t n, const float *x, const float *y, const float *z,          \
-                                int *texel, float *sin_t);
+                                int *texel, float *sin_t);                                                         \
+  void fr_env_smooth_at_batch_##isa(const fr_env *e, size_t n, const float *x, const float *y, const float *z,     \
+                                    float *fx, float *fy);
 FR_ENV_BATCH_FNS(scalar)
 FR_ENV_BATCH_FNS(avx2)
 FR_ENV_BATCH_FNS(avx512)
@@ -97,6 +104,15 @@ static inline int fr_env_texel_index(const fr_env *e, float u, float v) {
   x = x >= e->w ? e->w - 1 : x;
   y = y >= e->h ? e->h - 1 : y;
   return y * e->w + x;
+}
+
+/* Where fr_env_eval_smooth interpolates for dir, in texels (texel i's
+ * centre at i): around in x, clamped at the poles in y. */
+static inline void fr_env_smooth_at(const fr_env *e, float dx, float dy, float dz, float *fx, float *fy) {
+  float u, v, s;
+  fr_env_to_uv(e, dx, dy, dz, &u, &v, &s);
+  *fx = u * (float)e->w - 0.5f;
+  *fy = v * (float)e->h - 0.5f;
 }
 
 /* The light sample at image point (u, v) in a texel of density puv (its

@@ -29,3 +29,20 @@ void fr_env_texel_batch(const fr_env *e, size_t n, const float *x, const float *
     for (size_t j = 0; j < m; j++) texel[a + j] = e->texels + 4 * (size_t)at[j];
   }
 }
+
+void fr_env_eval_smooth_batch(const fr_env *e, size_t n, const float *x, const float *y, const float *z, vec3 *le) {
+  if (!e->rgb) {
+    for (size_t j = 0; j < n; j++) le[j] = fr_env_eval_smooth(e, v3(x[j], y[j], z[j]));
+    return;
+  }
+  enum { CHUNK = 64 };
+  float fx[CHUNK], fy[CHUNK];
+  const fr_isa isa = fr_get_isa();
+  for (size_t a = 0; a < n; a += CHUNK) {
+    const size_t m = n - a < CHUNK ? n - a : CHUNK;
+    if (isa == FR_ISA_AVX512) fr_env_smooth_at_batch_avx512(e, m, x + a, y + a, z + a, fx, fy);
+    else if (isa == FR_ISA_AVX2) fr_env_smooth_at_batch_avx2(e, m, x + a, y + a, z + a, fx, fy);
+    else fr_env_smooth_at_batch_scalar(e, m, x + a, y + a, z + a, fx, fy);
+    for (size_t j = 0; j < m; j++) le[a + j] = fr_env_smooth_radiance(e, fx[j], fy[j]);
+  }
+}

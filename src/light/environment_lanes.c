@@ -72,3 +72,9 @@ void FR_ISA_FN(fr_env_texel_batch)(const fr_env *env, size_t n, const float *res
     texel[j] = fr_env_texel_index(&e, u, v);
   }
 }
+
+void FR_ISA_FN(fr_env_smooth_at_batch)(const fr_env *env, size_t n, const float *restrict x, const float *restrict y,
+                                       const float *restrict z, float *restrict fx, float *restrict fy) {
+  const fr_env e = *env;
+  for (size_t j = 0; j < n; j++) fr_env_smooth_at(&e, x[j], y[j], z[j], &fx[j], &fy[j]);
+}

@@ -140,12 +140,13 @@ static int light_pick(int n, float uc) {
 /* What a block of paths reads of an image environment, fetched together
  * before the block is shaded: the light samples of the paths that hit
  * something and pick the environment (fr_env_sample_batch; ready[b]: path
- * b's is here), and the texels the bounces that escape see (sky[b], NULL
- * where none, with sin theta there). */
+ * b's is here), the texels the bounces that escape see (sky[b], NULL
+ * where none, with sin theta there), and the background the camera rays
+ * that escape see (bg[b] where seen[b]). */
 typedef struct env_block {
-  vec3 dir[POINT_BLOCK], le[POINT_BLOCK];
+  vec3 dir[POINT_BLOCK], le[POINT_BLOCK], bg[POINT_BLOCK];
   float pdf[POINT_BLOCK];
-  uint8_t ready[POINT_BLOCK];
+  uint8_t ready[POINT_BLOCK], seen[POINT_BLOCK];
   const float *sky[POINT_BLOCK];
   float sky_sin[POINT_BLOCK];
 } env_block;
@@ -233,19 +234,22 @@ static void env_block_sample(const fr_path_setup *P, const float (*pts)[POINT_BL
                              const fr_ray *ray, const fr_hit *hit, size_t left, uint32_t dim, env_block *eb) {
   const size_t m = left < POINT_BLOCK ? left : POINT_BLOCK;
   memset(eb->ready, 0, sizeof eb->ready);
+  memset(eb->seen, 0, sizeof eb->seen);
   memset(eb->sky, 0, sizeof eb->sky);
   const fr_env *e = P->lights.env;
   const int n = light_count(&P->lights);
   if (e->black || !e->rgb) return; /* nothing to fetch */
   float u1[POINT_BLOCK], u2[POINT_BLOCK], pdf[POINT_BLOCK], sx[POINT_BLOCK], sy[POINT_BLOCK], sz[POINT_BLOCK];
-  float sin_t[POINT_BLOCK];
+  float sin_t[POINT_BLOCK], bx[POINT_BLOCK], by[POINT_BLOCK], bz[POINT_BLOCK];
   const float *tex[POINT_BLOCK];
   vec3 dir[POINT_BLOCK], le[POINT_BLOCK];
-  uint8_t idx[POINT_BLOCK], sky[POINT_BLOCK];
-  size_t c = 0, ns = 0;
+  uint8_t idx[POINT_BLOCK], sky[POINT_BLOCK], bg[POINT_BLOCK];
+  size_t c = 0, ns = 0, nb = 0;
   for (size_t j = 0; j < m; j++) {
-    if (hit[j].prim == FR_INVALID_ID) { /* a bounce into the sky (the camera's see it filtered) */
-      if (st[j].depth > 0) sx[ns] = ray[j].dir[0], sy[ns] = ray[j].dir[1], sz[ns] = ray[j].dir[2], sky[ns++] = (uint8_t)j;
+    if (hit[j].prim == FR_INVALID_ID) { /* a bounce into the sky, or the background seen (filtered) */
+      const float *d = ray[j].dir;
+      if (st[j].depth > 0) sx[ns] = d[0], sy[ns] = d[1], sz[ns] = d[2], sky[ns++] = (uint8_t)j;
+      else bx[nb] = d[0], by[nb] = d[1], bz[nb] = d[2], bg[nb++] = (uint8_t)j;
       continue;
     }
     float uc, ul;
@@ -254,6 +258,8 @@ static void env_block_sample(const fr_path_setup *P, const float (*pts)[POINT_BL
     path_point(P, pts, j, st + j, dim, 1, &u1[c], &u2[c]);
     idx[c++] = (uint8_t)j;
   }
+  fr_env_eval_smooth_batch(e, nb, bx, by, bz, le);
+  for (size_t q = 0; q < nb; q++) eb->bg[bg[q]] = le[q], eb->seen[bg[q]] = 1;
   fr_env_texel_batch(e, ns, sx, sy, sz, tex, sin_t);
   for (size_t q = 0; q < ns; q++) {
     eb->sky[sky[q]] = tex[q], eb->sky_sin[sky[q]] = sin_t[q];
@@ -347,7 +353,7 @@ static void frame_block(const fr_workload *w, const quad_light *quad, const env_
     }
     if (!hit) {
       float pe = 0.0f;
-      const vec3 le = depth == 0   ? fr_env_eval_smooth(L->env, d) /* the background, seen */
+      const vec3 le = depth == 0   ? (eb->seen[j] ? eb->bg[j] : fr_env_eval_smooth(L->env, d)) /* the background */
                       : eb->sky[j] ? fr_env_texel_radiance(L->env, eb->sky[j], eb->sky_sin[j], st.delta ? NULL : &pe)
                       : st.delta   ? fr_env_eval(L->env, d)
                                    : fr_env_eval_pdf(L->env, d, &pe);
