@@ -25,7 +25,9 @@
 #include "light/environment.h"
 #include "base/rng.h"
 #include "render/path.h"
+#include "render/path_camera.h"
 #include "render/path_frames.h"
+#include "base/trig.h"
 #include "render/progressive.h"
 #include "material/texture.h"
 #include "render/sampler.h"
@@ -378,6 +380,53 @@ static void frames_lanes_match_scalar(void **st) {
   }
 }
 
+/* The camera rays' lanes are the scalar camera's bits in every ISA, through
+ * a pinhole and a lens: d = fwd + right sx + up sy, o on the lens, toward
+ * the point in focus, normalized as v3_norm does. */
+static void camera_lanes_match_scalar(void **st) {
+  (void)st;
+  enum { M = 150 }; /* two chunks of 64 and a part */
+  fr_camera c;
+  assert_int_equal(fr_camera_setup(&c, v3(1.5f, -2.0f, 7.0f), v3(0.3f, 0.1f, -1.0f), v3(0.1f, 1.0f, 0.0f), 52.0f, 640, 360), FR_OK);
+  const vec3 ru = v3_norm(c.right), uu = v3_norm(c.up);
+  fr_rng r = fr_rng_seed(7, 3);
+  float x[M], y[M], jx[M], jy[M], lx[M], ly[M];
+  for (int j = 0; j < M; j++) {
+    x[j] = (float)(fr_rng_u32(&r) % 640), y[j] = (float)(fr_rng_u32(&r) % 360);
+    jx[j] = fr_rng_float(&r), jy[j] = fr_rng_float(&r), lx[j] = fr_rng_float(&r), ly[j] = fr_rng_float(&r);
+  }
+  for (int lens = 0; lens < 2; lens++) {
+    const float aperture = lens ? 0.07f : 0.0f, focus = 6.5f;
+    const fr_path_camera k = {{c.eye.x, c.eye.y, c.eye.z}, {c.fwd.x, c.fwd.y, c.fwd.z}, {c.right.x, c.right.y, c.right.z},
+                              {c.up.x, c.up.y, c.up.z}, {ru.x, ru.y, ru.z}, {uu.x, uu.y, uu.z}, 640.0f, 360.0f,
+                              aperture, focus};
+    fr_ray ref[M];
+    for (int j = 0; j < M; j++) {
+      const float sx = 2.0f * (x[j] + jx[j]) / 640.0f - 1.0f, sy = 1.0f - 2.0f * (y[j] + jy[j]) / 360.0f;
+      vec3 d = v3_add(c.fwd, v3_add(v3_scale(c.right, sx), v3_scale(c.up, sy))), o = c.eye;
+      if (lens) {
+        float sn, cs;
+        fr_sincos_turns(ly[j], &sn, &cs);
+        const float rr = aperture * sqrtf(lx[j]);
+        const vec3 f = v3_add(c.eye, v3_scale(d, focus));
+        o = v3_add(o, v3_add(v3_scale(ru, rr * cs), v3_scale(uu, rr * sn)));
+        d = v3_sub(f, o);
+      }
+      d = v3_norm(d);
+      ref[j] = (fr_ray){{o.x, o.y, o.z}, 0.0f, {d.x, d.y, d.z}, INFINITY};
+    }
+    const fr_isa best = fr_get_isa();
+    for (int isa = FR_ISA_SCALAR; isa <= (int)best; isa++) {
+      fr_ray got[M];
+      const float *a = lens ? lx : NULL, *b = lens ? ly : NULL;
+      if (isa == FR_ISA_SCALAR) fr_path_camera_rays_scalar(&k, M, x, y, jx, jy, a, b, got);
+      if (isa == FR_ISA_AVX2) fr_path_camera_rays_avx2(&k, M, x, y, jx, jy, a, b, got);
+      if (isa == FR_ISA_AVX512) fr_path_camera_rays_avx512(&k, M, x, y, jx, jy, a, b, got);
+      for (int j = 0; j < M; j++) assert_memory_equal(&got[j], &ref[j], sizeof got[j]);
+    }
+  }
+}
+
 /* The same image on 1 and 3 threads, in every trace mode, and through Embree. */
 static void same_image_everywhere(void **st) {
   (void)st;
@@ -565,6 +614,7 @@ int main(void) {
       cmocka_unit_test(batch_points_alike),
       cmocka_unit_test(point_shadows_by_frusta),
       cmocka_unit_test(frames_lanes_match_scalar),
+      cmocka_unit_test(camera_lanes_match_scalar),
       cmocka_unit_test(same_image_everywhere),
       cmocka_unit_test(passes_split_anyhow),
   };

@@ -12,10 +12,10 @@
 #include <string.h>
 #include "base/alloc.h"
 #include "base/error.h"
-#include "base/trig.h"
 #include "base/timer.h"
 #include "material/texture.h"
 #include "api/scene.h"
+#include "render/path_camera.h"
 #include "render/path_frames.h"
 #include "render/shadow_frusta.h"
 #include "render/surfaces.h"
@@ -28,6 +28,8 @@ _Static_assert(WAVE <= 65536, "path_state.slot is 16 bits");
 /* Sample points, environment lookups and hit frames are made for this many
  * paths at a time, as vector code */
 #define POINT_BLOCK FR_PATH_FRAMES
+/* the largest tile side (fr_path_tile_side) */
+#define SIDE_MAX 32
 
 typedef struct path_state {
   vec3 weight;     /* throughput: what the radiance found next is multiplied by */
@@ -79,6 +81,11 @@ struct fr_path_scratch {
   path_state bst[POINT_BLOCK];
   uint8_t live[POINT_BLOCK];
   fr_bsdf textured[POINT_BLOCK];
+  /* the tile's pixels: coordinates in the image, sampler keys, and whether
+   * each lies inside it */
+  float pix_x[SIDE_MAX * SIDE_MAX], pix_y[SIDE_MAX * SIDE_MAX];
+  uint32_t pix_key[SIDE_MAX * SIDE_MAX];
+  uint8_t pix_in[SIDE_MAX * SIDE_MAX];
 };
 
 fr_path_scratch *fr_path_scratch_new(void) {
@@ -481,7 +488,40 @@ static void tile_pixel(int i, int side, int *x, int *y) {
 
 int fr_path_tile_side(const fr_path_setup *P) {
   const int spp = P->spp_end - P->spp_begin;
-  return spp <= 2 ? 32 : TILE;
+  return spp <= 2 ? SIDE_MAX : TILE;
+}
+_Static_assert(TILE <= SIDE_MAX, "a tile's pixels fit the scratch");
+
+/* The camera rays of paths st[0..n) (their first segments) into ray, a
+ * block at a time as vector code: pair 0 places each sample in its pixel,
+ * pair 1 on the lens. */
+static void camera_rays(const fr_workload *w, fr_path_scratch *S, const path_state *st, size_t n, int npix,
+                        float (*block)[POINT_BLOCK], fr_ray *ray) {
+  const fr_path_setup *P = w->path;
+  const fr_camera *c = &w->cam;
+  const vec3 ru = v3_norm(c->right), uu = v3_norm(c->up);
+  const fr_path_camera cam = {{c->eye.x, c->eye.y, c->eye.z}, {c->fwd.x, c->fwd.y, c->fwd.z},
+                              {c->right.x, c->right.y, c->right.z}, {c->up.x, c->up.y, c->up.z},
+                              {ru.x, ru.y, ru.z}, {uu.x, uu.y, uu.z}, (float)c->width, (float)c->height,
+                              P->aperture, P->focus};
+  const int lens = P->aperture > 0.0f, batches = fr_sampler_batches(P->sampler, (uint32_t)P->spp);
+  const fr_isa isa = fr_get_isa();
+  for (size_t k0 = 0; k0 < n; k0 += POINT_BLOCK) {
+    const size_t m = n - k0 < POINT_BLOCK ? n - k0 : POINT_BLOCK;
+    float x[POINT_BLOCK], y[POINT_BLOCK];
+    if (batches) block_points(P, st + k0, m, 0, 1 + lens, block);
+    for (size_t j = 0; j < m; j++) {
+      const path_state *p = &st[k0 + j];
+      const int i = p->slot % npix;
+      x[j] = S->pix_x[i], y[j] = S->pix_y[i];
+      if (!batches)
+        for (int q = 0; q <= lens; q++) path_point(P, NULL, j, p, 0, q, &block[2 * q][j], &block[2 * q + 1][j]);
+    }
+    const float *lx = lens ? block[2] : NULL, *ly = lens ? block[3] : NULL;
+    if (isa == FR_ISA_AVX512) fr_path_camera_rays_avx512(&cam, m, x, y, block[0], block[1], lx, ly, ray + k0);
+    else if (isa == FR_ISA_AVX2) fr_path_camera_rays_avx2(&cam, m, x, y, block[0], block[1], lx, ly, ray + k0);
+    else fr_path_camera_rays_scalar(&cam, m, x, y, block[0], block[1], lx, ly, ray + k0);
+  }
 }
 
 uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch *S, int tx, int ty) {
@@ -492,8 +532,15 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
   const uint32_t seed = P->seed;
   const quad_light quad = quad_light_of(L);
   uint64_t rays = 0;
-  const vec3 ru = v3_norm(c->right), uu = v3_norm(c->up);
   const int side = fr_path_tile_side(P), npix = side * side, chunk = WAVE / npix;
+  for (int i = 0; i < npix; i++) {
+    int x, y;
+    tile_pixel(i, side, &x, &y);
+    x += tx, y += ty;
+    S->pix_in[i] = x < W && y < H;
+    S->pix_x[i] = (float)x, S->pix_y[i] = (float)y;
+    S->pix_key[i] = fr_sampler_pixel_key(seed, (uint32_t)y * (uint32_t)W + (uint32_t)x);
+  }
   float block[8][POINT_BLOCK];
   env_block eb;
   const int batches = fr_sampler_batches(P->sampler, (uint32_t)P->spp);
@@ -508,38 +555,10 @@ uint64_t fr_path_tile(const fr_workload *w, const fr_tracer *t, fr_path_scratch 
     for (size_t k = 0; k < nslot; k++) S->dep[k] = FR_PATH_DEPTH_MISS;
     size_t n = 0;
     for (int s = s0; s < s1; s++)
-      for (int i = 0; i < npix; i++) {
-        int x, y;
-        tile_pixel(i, side, &x, &y);
-        x += tx, y += ty;
-        if (x >= W || y >= H) continue;
-        const uint32_t key = fr_sampler_pixel_key(seed, (uint32_t)y * (uint32_t)W + (uint32_t)x);
-        S->st[n++] = (path_state){v3(1, 1, 1), 0.0f, (uint32_t)s, key, (uint16_t)((s - s0) * npix + i), 1, 0};
-      }
-    /* the camera rays: pair 0 places the sample in its pixel, pair 1 on the lens */
-    const int lens = P->aperture > 0.0f;
-    for (size_t k = 0; k < n; k++) {
-      const size_t b = k % POINT_BLOCK;
-      if (pts && !b) block_points(P, S->st + k, n - k, 0, 1 + lens, block);
-      int x, y;
-      tile_pixel(S->st[k].slot % npix, side, &x, &y);
-      x += tx, y += ty;
-      float jx, jy;
-      path_point(P, pts, b, &S->st[k], 0, 0, &jx, &jy);
-      const float sx = 2.0f * ((float)x + jx) / (float)W - 1.0f, sy = 1.0f - 2.0f * ((float)y + jy) / (float)H;
-      vec3 d = v3_add(c->fwd, v3_add(v3_scale(c->right, sx), v3_scale(c->up, sy)));
-      vec3 o = c->eye;
-      if (lens) {
-        float lx, ly, sn, cs;
-        path_point(P, pts, b, &S->st[k], 0, 1, &lx, &ly);
-        fr_sincos_turns(ly, &sn, &cs);
-        const float r = P->aperture * sqrtf(lx);
-        const vec3 focus = v3_add(c->eye, v3_scale(d, P->focus)); /* the image plane lies at distance 1 along fwd */
-        o = v3_add(o, v3_add(v3_scale(ru, r * cs), v3_scale(uu, r * sn)));
-        d = v3_sub(focus, o);
-      }
-      S->ray[k] = make_ray(o, v3_norm(d), 0.0f, INFINITY);
-    }
+      for (int i = 0; i < npix; i++)
+        if (S->pix_in[i])
+          S->st[n++] = (path_state){v3(1, 1, 1), 0.0f, (uint32_t)s, S->pix_key[i], (uint16_t)((s - s0) * npix + i), 1, 0};
+    camera_rays(w, S, S->st, n, npix, block, S->ray);
     for (int depth = 0; n; depth++) {
       double t1 = fr_seconds();
       S->stage[FR_STAGE_SHADE] += t1 - t0;
