@@ -84,3 +84,65 @@ int CHUNK_NAME(FR_ISA_SUFFIX)(const float planes[6][8], int nchildren, const fr_
   for (int c = 0; c < 8; c++) any |= (child_rays[c] != 0) << c;
   return any == hit ? -1 : 16;
 }
+
+/* chunk_block_any against tri4_test, per ray of a stream of 16 (any
+ * directions) and a block: a ray's verdict is its hit bit, or tri4_test's
+ * where the chunk sends it back (*redo). Returns the first ray whose
+ * verdict differs, -1 when none does, -3 where this level has no
+ * ray-major leaf test; *hits gets the rays hit. Then chunk_block_closest
+ * against tri4_test and tri4_nearest: 32 + the first ray whose nearest hit
+ * differs in any bit, or that changed without a hit; 17 where it answers
+ * for a ray not asked about or sent back. */
+#define BLOCK_NAME2(isa) fr_test_block_chunk_##isa
+#define BLOCK_NAME(isa) BLOCK_NAME2(isa)
+int BLOCK_NAME(FR_ISA_SUFFIX)(const fr_tri4 *blk, const fr_ray *rays, unsigned lanes, int *hits);
+int BLOCK_NAME(FR_ISA_SUFFIX)(const fr_tri4 *blk, const fr_ray *rays, unsigned lanes, int *hits) {
+#if LEAF_DENSE
+  uint32_t idx[16];
+  for (int i = 0; i < 16; i++) idx[i] = (uint32_t)i;
+  static stream_rays s __attribute__((aligned(64)));
+  int uniform;
+  const uint64_t valid = stream_setup(rays, idx, 16, &s, &uniform);
+  lanes &= (unsigned)valid;
+  unsigned redo;
+  const unsigned hit = chunk_block_any(blk, &s, 0, lanes, &redo);
+  if ((hit | redo) & ~lanes) return 16;
+  *hits = 0;
+  for (int i = 0; i < 16; i++) {
+    if (!((lanes >> i) & 1)) continue;
+    tri4_result res;
+    const ray_pre ri = stream_ray(&s, i);
+    tri4_test(blk, &ri, s.tfar[i], &res);
+    const int want = res.mask != 0;
+    int got = (int)((hit >> i) & 1);
+    if ((redo >> i) & 1) got = want; /* sent back: tri4_test's own verdict */
+    if (got != want) return i;
+    *hits += got;
+  }
+  /* closest hits: the nearest lane's t, u, v and id, or nothing changed */
+  fr_subtree_hit best[16];
+  const fr_subtree_hit none = {-1.0f, -1.0f, -1.0f, 7u};
+  float tfar0[16];
+  for (int i = 0; i < 16; i++) best[i] = none, tfar0[i] = s.tfar[i];
+  const uint32_t k = 5;
+  const unsigned took = chunk_block_closest(blk, k, &s, 0, lanes, best, &redo);
+  if ((took | redo) & ~lanes || took & redo) return 17;
+  for (int i = 0; i < 16; i++) {
+    if (!((took >> i) & 1)) {
+      if (memcmp(&best[i], &none, sizeof none) || !same_bits(&s.tfar[i], &tfar0[i], 4)) return 32 + i;
+      continue;
+    }
+    tri4_result res;
+    const ray_pre ri = stream_ray(&s, i);
+    tri4_test(blk, &ri, tfar0[i], &res);
+    if (!res.mask) return 32 + i;
+    fr_subtree_hit want;
+    const float t = tri4_nearest(&res, k, &want);
+    if (memcmp(&best[i], &want, sizeof want) || !same_bits(&s.tfar[i], &t, 4)) return 32 + i;
+  }
+  return -1;
+#else
+  (void)blk, (void)rays, (void)lanes, (void)hits;
+  return -3;
+#endif
+}

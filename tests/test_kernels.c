@@ -412,6 +412,50 @@ static void test_tri4_pair(void **st) {
   assert_true(hits > tested / 4);
 }
 
+typedef int (*block_chunk_fn)(const fr_tri4 *, const fr_ray *, unsigned, int *);
+int fr_test_block_chunk_scalar(const fr_tri4 *blk, const fr_ray *rays, unsigned lanes, int *hits);
+int fr_test_block_chunk_avx2(const fr_tri4 *blk, const fr_ray *rays, unsigned lanes, int *hits);
+int fr_test_block_chunk_avx512(const fr_tri4 *blk, const fr_ray *rays, unsigned lanes, int *hits);
+
+/* Ray streams test a leaf block reached by many of a chunk's 16 rays
+ * ray-major (chunk_block_any and chunk_block_closest, stream_rays.h, where
+ * the level has them): each ray's verdict and nearest hit must be the
+ * one-ray test's, bit for bit, for rays of any directions
+ * (every shear axis in one register) at random and at axis-aligned grid
+ * blocks through vertices and edges (exact zeros, which the chunk sends
+ * back to tri4_test), with a NaN lane in every fourth block and a thin
+ * triangle in every third. */
+static void test_block_chunk(void **st) {
+  (void)st;
+  const struct { fr_isa isa; block_chunk_fn fn; } levels[] = {{FR_ISA_SCALAR, fr_test_block_chunk_scalar},
+                                                              {FR_ISA_AVX2, fr_test_block_chunk_avx2},
+                                                              {FR_ISA_AVX512, fr_test_block_chunk_avx512}};
+  fr_rng r = fr_rng_seed(61, 5);
+  long tested = 0, hits = 0;
+  for (int n = 0; n < 3000; n++) {
+    fr_tri4 blk;
+    const int grid = n % 2;
+    test_block(&r, n, grid, &blk);
+    if (n % 3 == 0) blk.prim[(int)urand(&r, 0, 3.99f)] |= FR_TRI4_THIN;
+    fr_ray rays[16];
+    for (int i = 0; i < 16; i++) rays[i] = test_ray(&r, grid, &blk, urand(&r, 0, 1) < 0.5f ? 4.0f : -4.0f, 0.0f);
+    const unsigned lanes = n % 4 ? 0xFFFFu : (unsigned)(urand(&r, 0, 65535.99f));
+    for (size_t l = 0; l < sizeof levels / sizeof levels[0]; l++) {
+      if (!fr_isa_supported(levels[l].isa)) continue;
+      int h = 0;
+      const int bad = levels[l].fn(&blk, rays, lanes, &h);
+      if (bad == -3) continue; /* no ray-major leaf test on this level */
+      if (bad == 16 || bad == 17) fail_msg("level %zu, case %d: an answer for a ray not asked about", l, n);
+      if (bad >= 32) fail_msg("level %zu, case %d, ray %d: chunk_block_closest differs from tri4_nearest", l, n, bad - 32);
+      if (bad >= 0) fail_msg("level %zu, case %d, ray %d: chunk_block_any differs from tri4_test", l, n, bad);
+      hits += h;
+      tested++;
+    }
+  }
+  print_message("ray-major leaf blocks: %ld, %ld rays hit\n", tested, hits);
+  if (fr_isa_supported(FR_ISA_AVX512)) assert_true(tested > 0 && hits > tested);
+}
+
 typedef int (*stream_setup_fn)(const fr_ray *, int, int, int *);
 int fr_test_stream_setup_scalar(const fr_ray *rays, int n, int in_row, int *uniform);
 int fr_test_stream_setup_avx2(const fr_ray *rays, int n, int in_row, int *uniform);
@@ -612,6 +656,7 @@ int main(void) {
       cmocka_unit_test(test_tri4_pair),
       cmocka_unit_test(test_stream_setup),
       cmocka_unit_test(test_stream_chunk),
+      cmocka_unit_test(test_block_chunk),
       cmocka_unit_test(test_tri4_quad),
       cmocka_unit_test(test_agreement),
       cmocka_unit_test(test_child_sort8),

@@ -124,14 +124,23 @@ static uint64_t occluded_group(const fr_bvhn *b, const fr_ray *rays, const uint3
       m = child_rays[last];
     }
     {
-      /* block by block, two rays to a test (tri4_test2); a ray leaves
-       * the leaf at its first hit, so each ray meets the same blocks as
-       * when it went through them alone */
+      /* block by block: chunks of 16 dense with rays ray-major
+       * (chunk_block_any), the other rays two to a test (tri4_test2); a
+       * ray leaves the leaf at its first hit, so each ray meets the same
+       * blocks as when it went through them alone */
       const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
       FR_COUNT(leaves, (uint64_t)__builtin_popcountll(m));
       for (uint32_t k = first; k < first + nb && m; k++) {
         FR_COUNT(tri_tests, 4 * (uint64_t)__builtin_popcountll(m));
-        for (uint64_t mm = m; mm;) {
+        uint64_t mm = m;
+#if LEAF_DENSE
+        unsigned lanes, redo;
+        for (int o = 0; __builtin_popcountll(m) >= LEAF_DENSE && (lanes = next_dense_chunk(m, n, &o)); o += 16) {
+          occ |= (uint64_t)chunk_block_any(&b->tris[k], &s, o, lanes, &redo) << o;
+          mm &= ~((uint64_t)(lanes & ~redo) << o);
+        }
+#endif
+        while (mm) {
           const int i = __builtin_ctzll(mm);
           mm &= mm - 1;
           if (!mm) {
@@ -214,14 +223,23 @@ static void intersect_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t
       m = child_rays[order[0]];
     }
     {
-      /* block by block, two rays to a test (tri4_test2): each ray meets
-       * the blocks in the same order, with the same tfar, as alone; a
-       * leaf is reached by two rays at least (one goes to single_closest) */
+      /* block by block, dense chunks ray-major (chunk_block_closest), the
+       * other rays two to a test (tri4_test2): each ray meets the blocks in
+       * the same order, with the same tfar, as alone; a leaf is reached by
+       * two rays at least (one goes to single_closest) */
       const uint32_t first = FR_BVHN_LEAF_FIRST(ref), nb = FR_BVHN_LEAF_BLOCKS(ref);
       FR_COUNT(leaves, (uint64_t)__builtin_popcountll(m));
       FR_COUNT(tri_tests, 4 * (uint64_t)nb * (uint64_t)__builtin_popcountll(m));
-      for (uint32_t k = first; k < first + nb; k++)
-        for (uint64_t mm = m; mm;) {
+      for (uint32_t k = first; k < first + nb; k++) {
+        uint64_t rest = m;
+#if LEAF_DENSE
+        unsigned lanes, redo;
+        for (int o = 0; __builtin_popcountll(m) >= LEAF_DENSE && (lanes = next_dense_chunk(m, n, &o)); o += 16) {
+          found |= (uint64_t)chunk_block_closest(&b->tris[k], k, &s, o, lanes, best, &redo) << o;
+          rest &= ~((uint64_t)(lanes & ~redo) << o);
+        }
+#endif
+        for (uint64_t mm = rest; mm;) {
           const int i = __builtin_ctzll(mm);
           mm &= mm - 1;
           tri4_result ra, rb;
@@ -244,6 +262,7 @@ static void intersect_group(const fr_bvhn *b, const fr_ray *rays, const uint32_t
             found |= 1ull << i;
           }
         }
+      }
       continue;
     }
   single: {

@@ -143,4 +143,145 @@ FR_INLINE void chunk_node(const node_t *n, const stream_rays *s, int o, unsigned
     *hit |= (bits != 0) << c;
   }
 }
+
+/* Leaf blocks reached by at least LEAF_DENSE of a chunk's 16 rays are
+ * tested ray-major (chunk_block_any, chunk_block_closest): each triangle
+ * against those rays at once, 16 to a register, rather than two rays
+ * against a block at a time (tri4_test2). Each ray has its own shear axes,
+ * so every vertex coordinate is picked out per lane by a permute from the
+ * block's rows. AVX-512 only: it needs 16 lanes and the permute. */
+#if defined(FR_BUILD_ISA_AVX512)
+#define LEAF_DENSE 8
+
+/* The rays of the first chunk from *o on (o a multiple of 16, below n)
+ * with at least LEAF_DENSE of m, *o its first ray; 0 where none is left. */
+FR_INLINE unsigned next_dense_chunk(uint64_t m, int n, int *o) {
+  for (; *o < n; *o += 16) {
+    const unsigned lanes = (unsigned)(m >> *o) & 0xFFFFu;
+    if (__builtin_popcount(lanes) >= LEAF_DENSE) return lanes;
+  }
+  return 0;
+}
+
+/* What the ray-major test reads of a chunk's rays, and the block's rows:
+ * coordinate a of lane l of a vertex at 4 a + l (fr_tri4's layout). */
+typedef struct chunk_leaf {
+  __m512i kx, ky, kz;
+  __m512 okx, oky, okz, sx, sy, nsz, tn;
+  __m512 A, B, C;
+} chunk_leaf;
+
+FR_INLINE chunk_leaf chunk_leaf_load(const fr_tri4 *tr, const stream_rays *s, int o) {
+  chunk_leaf c = {_mm512_load_si512((const void *)(s->kx4 + o)), _mm512_load_si512((const void *)(s->ky4 + o)),
+                  _mm512_load_si512((const void *)(s->kz4 + o)), _mm512_load_ps(s->okx + o),
+                  _mm512_load_ps(s->oky + o), _mm512_load_ps(s->okz + o), _mm512_load_ps(s->sx + o),
+                  _mm512_load_ps(s->sy + o), _mm512_load_ps(s->nsz + o), _mm512_load_ps(s->tnear + o),
+                  _mm512_loadu_ps(tr->v0[0]), _mm512_loadu_ps(tr->v1[0]), _mm512_loadu_ps(tr->v2[0])};
+  return c;
+}
+
+/* Triangle l of the block against the rays `lanes`, each lane the
+ * operations of tri4_test for that ray and triangle: the rays hit in
+ * (tnear, tf), their t, edge values e1, e2 and 1 / det; *zeros gains the
+ * rays with an edge value of exactly zero, left to tri4_test's exact path. */
+FR_INLINE unsigned chunk_tri(const chunk_leaf *c, int l, __m512 tf, unsigned lanes, unsigned *zeros, __m512 *t,
+                             __m512 *e1_out, __m512 *e2_out, __m512 *inv_out) {
+  const __m512 zero = _mm512_setzero_ps();
+  const __m512i L = _mm512_set1_epi32(l);
+  const __m512i ix = _mm512_add_epi32(c->kx, L), iy = _mm512_add_epi32(c->ky, L), iz = _mm512_add_epi32(c->kz, L);
+  const __m512 az = _mm512_sub_ps(c->okz, _mm512_permutexvar_ps(iz, c->A));
+  const __m512 bz = _mm512_sub_ps(c->okz, _mm512_permutexvar_ps(iz, c->B));
+  const __m512 cz = _mm512_sub_ps(c->okz, _mm512_permutexvar_ps(iz, c->C));
+  const __m512 ax = _mm512_sub_ps(_mm512_sub_ps(c->okx, _mm512_permutexvar_ps(ix, c->A)), _mm512_mul_ps(c->sx, az));
+  const __m512 ay = _mm512_sub_ps(_mm512_sub_ps(c->oky, _mm512_permutexvar_ps(iy, c->A)), _mm512_mul_ps(c->sy, az));
+  const __m512 bx = _mm512_sub_ps(_mm512_sub_ps(c->okx, _mm512_permutexvar_ps(ix, c->B)), _mm512_mul_ps(c->sx, bz));
+  const __m512 by = _mm512_sub_ps(_mm512_sub_ps(c->oky, _mm512_permutexvar_ps(iy, c->B)), _mm512_mul_ps(c->sy, bz));
+  const __m512 cx = _mm512_sub_ps(_mm512_sub_ps(c->okx, _mm512_permutexvar_ps(ix, c->C)), _mm512_mul_ps(c->sx, cz));
+  const __m512 cy = _mm512_sub_ps(_mm512_sub_ps(c->oky, _mm512_permutexvar_ps(iy, c->C)), _mm512_mul_ps(c->sy, cz));
+  const __m512 e0 = _mm512_sub_ps(_mm512_mul_ps(cx, by), _mm512_mul_ps(cy, bx));
+  const __m512 e1 = _mm512_sub_ps(_mm512_mul_ps(ax, cy), _mm512_mul_ps(ay, cx));
+  const __m512 e2 = _mm512_sub_ps(_mm512_mul_ps(bx, ay), _mm512_mul_ps(by, ax));
+  const unsigned z = (unsigned)(_mm512_cmp_ps_mask(e0, zero, _CMP_EQ_OQ) | _mm512_cmp_ps_mask(e1, zero, _CMP_EQ_OQ) |
+                                _mm512_cmp_ps_mask(e2, zero, _CMP_EQ_OQ)) & lanes;
+  *zeros |= z;
+  const __m512 lo = _mm512_min_ps(e0, _mm512_min_ps(e1, e2)), hi = _mm512_max_ps(e0, _mm512_max_ps(e1, e2));
+  const unsigned inside =
+      (unsigned)(_mm512_cmp_ps_mask(lo, zero, _CMP_GE_OQ) | _mm512_cmp_ps_mask(hi, zero, _CMP_LE_OQ)) & lanes & ~z;
+  if (!inside) return 0;
+  const __m512 det = _mm512_add_ps(_mm512_add_ps(e0, e1), e2);
+  const __m512 inv = _mm512_div_ps(_mm512_set1_ps(1.0f), det);
+  const __m512 tz = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(e0, _mm512_mul_ps(c->nsz, az)),
+                                                _mm512_mul_ps(e1, _mm512_mul_ps(c->nsz, bz))),
+                                  _mm512_mul_ps(e2, _mm512_mul_ps(c->nsz, cz)));
+  *t = _mm512_mul_ps(tz, inv);
+  *e1_out = e1;
+  *e2_out = e2;
+  *inv_out = inv;
+  return inside & (unsigned)(_mm512_cmp_ps_mask(det, zero, _CMP_NEQ_UQ) & _mm512_cmp_ps_mask(*t, c->tn, _CMP_GT_OQ) &
+                             _mm512_cmp_ps_mask(*t, tf, _CMP_LT_OQ));
+}
+
+/* Rays `lanes` of chunk o (rays o .. o + 15) against block tr for any hit:
+ * returns the rays with one. *redo gets the rays without one whose verdict
+ * tri4_test must give: an exact zero, or a hit on a thin triangle only
+ * (the plane's t). */
+FR_INLINE unsigned chunk_block_any(const fr_tri4 *tr, const stream_rays *s, int o, unsigned lanes, unsigned *redo) {
+  const chunk_leaf c = chunk_leaf_load(tr, s, o);
+  const __m512 tf = _mm512_load_ps(s->tfar + o);
+  unsigned hit = 0, zeros = 0, thin = 0;
+  for (int l = 0; l < 4; l++) {
+    const uint32_t id = tr->prim[l];
+    if (id == FR_INVALID_ID) continue; /* NaN vertices: no hit */
+    __m512 t, e1, e2, inv;
+    const unsigned ok = chunk_tri(&c, l, tf, lanes, &zeros, &t, &e1, &e2, &inv);
+    if (id & FR_TRI4_THIN) thin |= ok;
+    else hit |= ok;
+  }
+  *redo = (zeros | thin) & ~hit;
+  return hit;
+}
+
+/* The same for closest hits, as tri4_test and tri4_nearest give them for
+ * block k: a ray takes the nearest of its lanes hit before its tfar, the
+ * first on ties, into best[o + i] and tfar[o + i]; returns those rays.
+ * *redo gets the rays for which tri4_test must decide the whole block
+ * (an exact zero, or a hit on a thin triangle), left as they were. */
+FR_INLINE unsigned chunk_block_closest(const fr_tri4 *tr, uint32_t k, stream_rays *s, int o, unsigned lanes,
+                                       fr_subtree_hit *best, unsigned *redo) {
+  const chunk_leaf c = chunk_leaf_load(tr, s, o);
+  __m512 bt = _mm512_load_ps(s->tfar + o), bu = _mm512_setzero_ps(), bv = bu;
+  __m512i bid = _mm512_setzero_si512();
+  unsigned got = 0, zeros = 0, thin = 0;
+  for (int l = 0; l < 4; l++) {
+    const uint32_t id = tr->prim[l];
+    if (id == FR_INVALID_ID) continue;
+    __m512 t, e1, e2, inv;
+    const unsigned ok = chunk_tri(&c, l, bt, lanes, &zeros, &t, &e1, &e2, &inv);
+    if (!ok) continue;
+    if (id & FR_TRI4_THIN) { thin |= ok; continue; }
+    const __mmask16 m = (__mmask16)ok;
+    bt = _mm512_mask_blend_ps(m, bt, t);
+    bu = _mm512_mask_blend_ps(m, bu, _mm512_mul_ps(e1, inv));
+    bv = _mm512_mask_blend_ps(m, bv, _mm512_mul_ps(e2, inv));
+    bid = _mm512_mask_blend_epi32(m, bid, _mm512_set1_epi32((int)(4 * k + (uint32_t)l)));
+    got |= ok;
+  }
+  *redo = zeros | thin;
+  got &= ~*redo;
+  if (got) {
+    float T[16] __attribute__((aligned(64))), U[16] __attribute__((aligned(64))), V[16] __attribute__((aligned(64)));
+    uint32_t I[16] __attribute__((aligned(64)));
+    _mm512_store_ps(T, bt); _mm512_store_ps(U, bu); _mm512_store_ps(V, bv);
+    _mm512_store_si512((void *)I, bid);
+    for (unsigned g = got; g; g &= g - 1) {
+      const int i = __builtin_ctz(g);
+      s->tfar[o + i] = T[i];
+      best[o + i] = (fr_subtree_hit){T[i], U[i], V[i], I[i]};
+    }
+  }
+  return got;
+}
+#else
+#define LEAF_DENSE 0 /* never */
+#endif
 #endif
