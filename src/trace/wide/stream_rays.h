@@ -164,7 +164,9 @@ FR_INLINE unsigned next_dense_chunk(uint64_t m, int n, int *o) {
 }
 
 /* What the ray-major test reads of a chunk's rays, and the block's rows:
- * coordinate a of lane l of a vertex at 4 a + l (fr_tri4's layout). */
+ * coordinate a of lane l of a vertex at 4 a + l (fr_tri4's layout). A
+ * chunk past the stream's end reads stale lanes, which its masks leave out
+ * (a permute reads only an index's low four bits). */
 typedef struct chunk_leaf {
   __m512i kx, ky, kz;
   __m512 okx, oky, okz, sx, sy, nsz, tn;
